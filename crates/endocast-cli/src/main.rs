@@ -1,0 +1,3 @@
+//! The `endocast` command-line tool.
+
+fn main() {}

@@ -1,0 +1,18 @@
+//! The heart of endocast, free of file formats and GUI: the [`Volume`] every reader produces,
+//! its [`Geometry`] in the patient frame, and analytic [`phantom`]s whose right answers are known.
+//!
+//! ```
+//! use endocast_core::phantom::{Phantom, PhantomOptions};
+//!
+//! let volume = Phantom::SphereShell.build(&PhantomOptions { size: 32, ..Default::default() });
+//! assert_eq!(volume.dims(), [32, 32, 32]);
+//! let (lo, hi) = volume.physical_range();
+//! assert!(lo < -500.0 && hi > 0.0);
+//! ```
+
+pub mod geometry;
+pub mod phantom;
+pub mod volume;
+
+pub use geometry::{Geometry, GeometryError};
+pub use volume::{Modality, ValueMap, Volume, VolumeError};

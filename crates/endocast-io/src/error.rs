@@ -1,0 +1,102 @@
+//! The one error type of every reader and writer: few broad kinds, each naming the file.
+
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Why a scan could not be read or written. Every variant names the file it is about.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ReadError {
+    /// The operating system refused (missing file, permission, disk full, ...).
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The file is not what its format requires: what was expected and what was found.
+    #[error("{}: {message}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// Expected versus found, in words.
+        message: String,
+    },
+    /// A valid file using a feature we do not read (e.g. a DICOM transfer syntax or data type).
+    #[error("{}: unsupported {what}", path.display())]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// The feature, named so a user can look it up.
+        what: String,
+    },
+    /// The header asks for more than the configured resource limit.
+    #[error("{}: {what} needs {requested} but the limit is {limit}", path.display())]
+    Limit {
+        /// The file.
+        path: PathBuf,
+        /// What was being sized (e.g. "voxels").
+        what: String,
+        /// How much the header asks for.
+        requested: u64,
+        /// The configured limit.
+        limit: u64,
+    },
+    /// Parts of the input contradict each other (e.g. slices of different sizes in a series).
+    #[error("{}: inconsistent input: {message}", path.display())]
+    Inconsistent {
+        /// The file or directory.
+        path: PathBuf,
+        /// What disagrees with what.
+        message: String,
+    },
+}
+
+impl ReadError {
+    /// An I/O error about `path`.
+    pub fn io(path: &Path, source: std::io::Error) -> Self {
+        Self::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// A format error about `path`.
+    pub fn format(path: &Path, message: impl Into<String>) -> Self {
+        Self::Format {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+
+    /// An unsupported-feature error about `path`.
+    pub fn unsupported(path: &Path, what: impl Into<String>) -> Self {
+        Self::Unsupported {
+            path: path.to_path_buf(),
+            what: what.into(),
+        }
+    }
+
+    /// An inconsistency error about `path`.
+    pub fn inconsistent(path: &Path, message: impl Into<String>) -> Self {
+        Self::Inconsistent {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+
+    /// The file or directory the error is about.
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::Io { path, .. }
+            | Self::Format { path, .. }
+            | Self::Unsupported { path, .. }
+            | Self::Limit { path, .. }
+            | Self::Inconsistent { path, .. } => path,
+        }
+    }
+}
+
+/// Result of reading or writing a scan.
+pub type Result<T, E = ReadError> = std::result::Result<T, E>;

@@ -1,0 +1,34 @@
+//! Readers and writers of endocast: every scan format becomes the one
+//! [`Volume`](endocast_core::Volume), with its geometry in the LPS patient frame and its values
+//! in physical units, or a [`ReadError`] that names the file and the problem.
+//!
+//! [`open`] picks the reader from the path (a directory or DICOM magic → DICOM series;
+//! `.nii`/`.nii.gz` → NIfTI; `.nrrd`/`.nhdr` → NRRD; `.mha`/`.mhd` → MetaImage; or raw when
+//! [`OpenOptions::raw`] says how):
+//!
+//! ```no_run
+//! use endocast_io::{open, OpenOptions};
+//!
+//! let loaded = open("../shared/data/brain-mri-t1/chris_t1.nii.gz".as_ref(), &OpenOptions::default())?;
+//! println!("{:?} {}", loaded.volume.dims(), loaded.volume.geometry().orientation_code());
+//! for warning in &loaded.warnings {
+//!     eprintln!("warning: {warning}");
+//! }
+//! # Ok::<(), endocast_io::ReadError>(())
+//! ```
+
+pub mod atomic;
+pub mod dicom;
+pub mod error;
+pub mod limits;
+pub mod metaimage;
+pub mod nifti;
+pub mod nrrd;
+mod open;
+pub mod raw;
+pub mod samples;
+
+pub use error::{ReadError, Result};
+pub use limits::Limits;
+pub use open::{open, write, Format, Loaded, OpenOptions, SeriesSummary, SourceInfo};
+pub use samples::{ElementType, Endian, Rescale};
