@@ -1,3 +1,41 @@
-//! The `endocast` command-line tool.
+//! The `endocast` command-line tool: every command is a thin front end over the libraries.
 
-fn main() {}
+mod commands;
+mod input;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Virtual endoscopy of CT and MRI scans.
+#[derive(Parser)]
+#[command(name = "endocast", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Describe a scan: dimensions, spacing, orientation, value range, series, warnings.
+    Info(commands::info::InfoArgs),
+    /// Make an analytic phantom volume and save it (.nii, .nii.gz, .nrrd or .mha).
+    Phantom(commands::phantom::PhantomArgs),
+    /// Convert a scan to another format (.nii, .nii.gz, .nrrd or .mha).
+    Convert(commands::convert::ConvertArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(args) => commands::info::run(&args),
+        Command::Phantom(args) => commands::phantom::run(&args),
+        Command::Convert(args) => commands::convert::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -8,12 +8,12 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum ReadError {
     /// The operating system refused (missing file, permission, disk full, ...).
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {cause}", path.display())]
     Io {
         /// The file or directory.
         path: PathBuf,
-        /// The underlying error.
-        source: std::io::Error,
+        /// The underlying error (shown in this error's message, so not chained as a source).
+        cause: std::io::Error,
     },
     /// The file is not what its format requires: what was expected and what was found.
     #[error("{}: {message}", path.display())]
@@ -55,10 +55,10 @@ pub enum ReadError {
 
 impl ReadError {
     /// An I/O error about `path`.
-    pub fn io(path: &Path, source: std::io::Error) -> Self {
+    pub fn io(path: &Path, cause: std::io::Error) -> Self {
         Self::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         }
     }
 

@@ -1,0 +1,158 @@
+//! `endocast info`: what a scan is, where it sits in the patient, and what went wrong reading it.
+
+use crate::input::InputArgs;
+use anyhow::Result;
+use clap::Args;
+use endocast_core::{Modality, Volume};
+use endocast_io::Loaded;
+use serde::Serialize;
+
+/// Arguments of `endocast info`.
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    #[command(flatten)]
+    input: InputArgs,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Everything `info` reports; the text and JSON outputs are two views of it.
+#[derive(Serialize)]
+struct Report {
+    path: String,
+    format: &'static str,
+    stored_type: String,
+    modality: String,
+    dimensions: [usize; 3],
+    spacing_mm: [f64; 3],
+    origin_mm: [f64; 3],
+    /// Columns: unit world (LPS) vectors of the i, j, k axes.
+    direction_columns: [[f64; 3]; 3],
+    orientation: String,
+    orthogonal: bool,
+    world_bounds_mm: [[f64; 3]; 2],
+    value_range: [f64; 2],
+    value_unit: &'static str,
+    value_map: ValueMapReport,
+    voxel_bytes: usize,
+    series_uid: Option<String>,
+    series_found: Vec<SeriesReport>,
+    warnings: Vec<String>,
+}
+
+#[derive(Serialize)]
+struct ValueMapReport {
+    scale: f64,
+    offset: f64,
+}
+
+#[derive(Serialize)]
+struct SeriesReport {
+    uid: String,
+    description: String,
+    modality: String,
+    images: usize,
+}
+
+/// Runs `endocast info`.
+pub fn run(args: &InfoArgs) -> Result<()> {
+    let loaded = args.input.open()?;
+    let report = Report::new(&args.input.path.display().to_string(), &loaded);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.text());
+    }
+    Ok(())
+}
+
+impl Report {
+    fn new(path: &str, loaded: &Loaded) -> Self {
+        let volume: &Volume = &loaded.volume;
+        let g = volume.geometry();
+        let (lo, hi) = volume.physical_range();
+        let (min_w, max_w) = g.world_bounds();
+        let map = volume.value_map();
+        Self {
+            path: path.to_string(),
+            format: loaded.source.format.name(),
+            stored_type: loaded.source.stored_type.clone(),
+            modality: volume.modality().name().to_string(),
+            dimensions: g.dims(),
+            spacing_mm: g.spacing_mm().to_array(),
+            origin_mm: g.origin_mm().to_array(),
+            direction_columns: g.direction().to_cols_array_2d(),
+            orientation: g.orientation_code(),
+            orthogonal: g.is_orthogonal(),
+            world_bounds_mm: [min_w.to_array(), max_w.to_array()],
+            value_range: [lo, hi],
+            value_unit: if *volume.modality() == Modality::Ct { "HU" } else { "" },
+            value_map: ValueMapReport {
+                scale: map.scale(),
+                offset: map.offset(),
+            },
+            voxel_bytes: volume.voxel_bytes(),
+            series_uid: loaded.source.series_uid.clone(),
+            series_found: loaded
+                .source
+                .series_found
+                .iter()
+                .map(|s| SeriesReport {
+                    uid: s.uid.clone(),
+                    description: s.description.clone(),
+                    modality: s.modality.clone(),
+                    images: s.images,
+                })
+                .collect(),
+            warnings: loaded.warnings.clone(),
+        }
+    }
+
+    fn text(&self) -> String {
+        let v3 = |v: [f64; 3]| format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2]);
+        let [nx, ny, nz] = self.dimensions;
+        let [sx, sy, sz] = self.spacing_mm;
+        let mut out = format!(
+            "file:         {}\nformat:       {} ({})\nmodality:     {}\n\
+             dimensions:   {nx} × {ny} × {nz}\nspacing:      {sx:.4} × {sy:.4} × {sz:.4} mm\n\
+             origin:       {} mm (LPS)\ndirection:    i {}  j {}  k {}{}\n\
+             orientation:  {}\nworld bounds: {} … {} mm\nvalues:       {} … {} {}\n\
+             stored:       u16, physical = stored × {} + {}\nmemory:       {:.1} MiB\n",
+            self.path,
+            self.format,
+            self.stored_type,
+            self.modality,
+            v3(self.origin_mm),
+            v3(self.direction_columns[0]),
+            v3(self.direction_columns[1]),
+            v3(self.direction_columns[2]),
+            if self.orthogonal { "" } else { "  (sheared)" },
+            self.orientation,
+            v3(self.world_bounds_mm[0]),
+            v3(self.world_bounds_mm[1]),
+            self.value_range[0],
+            self.value_range[1],
+            self.value_unit,
+            self.value_map.scale,
+            self.value_map.offset,
+            self.voxel_bytes as f64 / (1024.0 * 1024.0),
+        );
+        if let Some(uid) = &self.series_uid {
+            out += &format!("series:       {uid}\n");
+        }
+        if self.series_found.len() > 1 {
+            out += "series found:\n";
+            for s in &self.series_found {
+                out += &format!(
+                    "  {} {} images {} {}\n",
+                    s.uid, s.images, s.modality, s.description
+                );
+            }
+        }
+        for w in &self.warnings {
+            out += &format!("warning:      {w}\n");
+        }
+        out
+    }
+}

@@ -1,0 +1,95 @@
+//! The options every command that reads a scan shares: series choice, limits, raw layout.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use endocast_io::raw::RawSpec;
+use endocast_io::{ElementType, Endian, Limits, Loaded, OpenOptions};
+use std::path::PathBuf;
+
+/// How to read the input scan.
+#[derive(Args, Debug)]
+pub struct InputArgs {
+    /// The scan: a DICOM directory or file, .nii/.nii.gz, .nrrd/.nhdr, .mha/.mhd, or a raw file.
+    pub path: PathBuf,
+    /// DICOM: load this SeriesInstanceUID instead of the largest series.
+    #[arg(long, value_name = "UID")]
+    pub series: Option<String>,
+    /// Refuse volumes with more voxels than this (default: half the memory at 2 bytes a voxel).
+    #[arg(long, value_name = "N")]
+    pub max_voxels: Option<u64>,
+    /// Raw input: dimensions X,Y,Z (makes the file be read as headerless samples).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_dims)]
+    pub raw_dims: Option<[usize; 3]>,
+    /// Raw input: voxel spacing in mm.
+    #[arg(long, value_name = "X,Y,Z", default_value = "1,1,1", value_parser = parse_spacing)]
+    pub raw_spacing: [f64; 3],
+    /// Raw input: sample type (uint8, int8, uint16, int16, uint32, int32, float32, float64, ...).
+    #[arg(long, value_name = "TYPE", default_value = "int16")]
+    pub raw_type: String,
+    /// Raw input: byte order of the samples.
+    #[arg(long, value_name = "little|big", default_value = "little")]
+    pub raw_endian: String,
+    /// Raw input: bytes to skip before the first sample.
+    #[arg(long, value_name = "BYTES", default_value_t = 0)]
+    pub raw_header_bytes: u64,
+}
+
+impl InputArgs {
+    /// Reads the scan these options name.
+    pub fn open(&self) -> Result<Loaded> {
+        let mut options = OpenOptions::default();
+        options.series.clone_from(&self.series);
+        if let Some(max) = self.max_voxels {
+            options.limits = Limits::with_max_voxels(max);
+        }
+        options.raw = self.raw_spec()?;
+        endocast_io::open(&self.path, &options)
+            .context("cannot read the scan")
+    }
+
+    fn raw_spec(&self) -> Result<Option<RawSpec>> {
+        let Some(dims) = self.raw_dims else {
+            return Ok(None);
+        };
+        let Some(element) = ElementType::from_name(&self.raw_type) else {
+            bail!("unknown --raw-type {:?}", self.raw_type);
+        };
+        let endian = match self.raw_endian.to_ascii_lowercase().as_str() {
+            "little" | "le" => Endian::Little,
+            "big" | "be" => Endian::Big,
+            other => bail!("--raw-endian must be little or big, not {other:?}"),
+        };
+        Ok(Some(RawSpec {
+            dims,
+            spacing_mm: self.raw_spacing,
+            element,
+            endian,
+            header_bytes: self.raw_header_bytes,
+        }))
+    }
+}
+
+fn parse_triple<T: std::str::FromStr>(text: &str) -> Result<[T; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [a, b, c] = parts.as_slice() else {
+        return Err(format!("expected three comma-separated numbers, found {text:?}"));
+    };
+    let parse = |s: &str| s.parse::<T>().map_err(|_| format!("{s:?} is not a valid number"));
+    Ok([parse(a)?, parse(b)?, parse(c)?])
+}
+
+fn parse_dims(text: &str) -> Result<[usize; 3], String> {
+    let dims = parse_triple::<usize>(text)?;
+    if dims.contains(&0) {
+        return Err("dimensions must be positive".into());
+    }
+    Ok(dims)
+}
+
+fn parse_spacing(text: &str) -> Result<[f64; 3], String> {
+    let spacing = parse_triple::<f64>(text)?;
+    if spacing.iter().any(|s| !s.is_finite() || *s <= 0.0) {
+        return Err(format!("spacing must be finite and positive, found {text:?}"));
+    }
+    Ok(spacing)
+}
