@@ -43,8 +43,7 @@ impl InputArgs {
             options.limits = Limits::with_max_voxels(max);
         }
         options.raw = self.raw_spec()?;
-        endocast_io::open(&self.path, &options)
-            .context("cannot read the scan")
+        endocast_io::open(&self.path, &options).context("cannot read the scan")
     }
 
     fn raw_spec(&self) -> Result<Option<RawSpec>> {
@@ -72,9 +71,14 @@ impl InputArgs {
 fn parse_triple<T: std::str::FromStr>(text: &str) -> Result<[T; 3], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
     let [a, b, c] = parts.as_slice() else {
-        return Err(format!("expected three comma-separated numbers, found {text:?}"));
+        return Err(format!(
+            "expected three comma-separated numbers, found {text:?}"
+        ));
     };
-    let parse = |s: &str| s.parse::<T>().map_err(|_| format!("{s:?} is not a valid number"));
+    let parse = |s: &str| {
+        s.parse::<T>()
+            .map_err(|_| format!("{s:?} is not a valid number"))
+    };
     Ok([parse(a)?, parse(b)?, parse(c)?])
 }
 
@@ -89,7 +93,9 @@ fn parse_dims(text: &str) -> Result<[usize; 3], String> {
 fn parse_spacing(text: &str) -> Result<[f64; 3], String> {
     let spacing = parse_triple::<f64>(text)?;
     if spacing.iter().any(|s| !s.is_finite() || *s <= 0.0) {
-        return Err(format!("spacing must be finite and positive, found {text:?}"));
+        return Err(format!(
+            "spacing must be finite and positive, found {text:?}"
+        ));
     }
     Ok(spacing)
 }

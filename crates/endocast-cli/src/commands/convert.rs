@@ -21,8 +21,7 @@ pub fn run(args: &ConvertArgs) -> Result<()> {
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
-    endocast_io::write(&args.output, &loaded.volume)
-        .context("cannot write the converted scan")?;
+    endocast_io::write(&args.output, &loaded.volume).context("cannot write the converted scan")?;
     let [nx, ny, nz] = loaded.volume.dims();
     println!("{}: {nx} × {ny} × {nz} voxels", args.output.display());
     Ok(())

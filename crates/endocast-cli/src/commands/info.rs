@@ -87,7 +87,11 @@ impl Report {
             orthogonal: g.is_orthogonal(),
             world_bounds_mm: [min_w.to_array(), max_w.to_array()],
             value_range: [lo, hi],
-            value_unit: if *volume.modality() == Modality::Ct { "HU" } else { "" },
+            value_unit: if *volume.modality() == Modality::Ct {
+                "HU"
+            } else {
+                ""
+            },
             value_map: ValueMapReport {
                 scale: map.scale(),
                 offset: map.offset(),

@@ -31,21 +31,27 @@ const MAX_SIZE: usize = 1024;
 pub fn run(args: &PhantomArgs) -> Result<()> {
     let Some(phantom) = Phantom::from_name(&args.name) else {
         let names: Vec<&str> = Phantom::ALL.iter().map(|p| p.name()).collect();
-        bail!("unknown phantom {:?}; choose one of {}", args.name, names.join(", "));
+        bail!(
+            "unknown phantom {:?}; choose one of {}",
+            args.name,
+            names.join(", ")
+        );
     };
     if !(8..=MAX_SIZE).contains(&args.size) {
         bail!("--size must be between 8 and {MAX_SIZE}, not {}", args.size);
     }
     if !args.noise.is_finite() || args.noise < 0.0 {
-        bail!("--noise must be a finite, non-negative HU value, not {}", args.noise);
+        bail!(
+            "--noise must be a finite, non-negative HU value, not {}",
+            args.noise
+        );
     }
     let mut options = PhantomOptions::default();
     options.size = args.size;
     options.noise_hu = args.noise;
     options.seed = args.seed;
     let volume = phantom.build(&options);
-    endocast_io::write(&args.output, &volume)
-        .context("cannot write the phantom")?;
+    endocast_io::write(&args.output, &volume).context("cannot write the phantom")?;
     let [nx, ny, nz] = volume.dims();
     println!(
         "{}: {} phantom, {nx} × {ny} × {nz} voxels",
