@@ -1,7 +1,8 @@
 //! Mutation testing of every reader: thousands of damaged files (truncated at many offsets,
 //! flipped bytes, header numbers replaced by 0, negative, huge and NaN values, missing detached
 //! files) must each give `Ok` or a clean `Err` — never a panic, never an allocation beyond the
-//! configured limit. Truncated files must give `Err`.
+//! configured limit. Truncated files must give `Err`; valid ones must load and keep no more
+//! than 1.1 × their voxel bytes (plus a little bookkeeping).
 //!
 //! This is its own test binary with a single test so that the counting allocator below measures
 //! only the reader under test.
@@ -56,6 +57,9 @@ const MAX_VOXELS: u64 = 1 << 20;
 /// voxels at the limit in the widest sample type, plus room for decoders' buffers.
 const MEMORY_BUDGET: usize = (MAX_VOXELS as usize) * 8 + (48 << 20);
 
+/// Bytes a loaded volume may keep beyond 1.1 × its voxel bytes: the `Loaded` record's strings.
+const RETAINED_SLACK: usize = 64 << 10;
+
 /// A valid file set: the files (name, bytes) and the one to open.
 struct Seed {
     name: &'static str,
@@ -91,13 +95,24 @@ impl Tally {
         let before = CURRENT.load(Ordering::Relaxed);
         PEAK.store(before, Ordering::Relaxed);
         let outcome = catch_unwind(AssertUnwindSafe(|| {
-            open(&dir.join(entry), &options).map(|_| ())
+            open(&dir.join(entry), &options).map(|loaded| {
+                // What a loaded volume keeps: its voxels and little else.
+                let retained = CURRENT.load(Ordering::Relaxed).saturating_sub(before);
+                (retained, loaded.volume.voxel_bytes())
+            })
         }));
         let used = PEAK.load(Ordering::Relaxed).saturating_sub(before);
         match outcome {
             Err(_) => self.failures.push(format!("{what}: panicked")),
-            Ok(Ok(())) if expect == Expect::Err => self.failures.push(format!("{what}: accepted")),
-            Ok(Ok(())) => {}
+            Ok(Ok((retained, voxel_bytes)))
+                if retained > voxel_bytes * 11 / 10 + RETAINED_SLACK =>
+            {
+                self.failures.push(format!(
+                    "{what}: keeps {retained} bytes for {voxel_bytes} voxel bytes"
+                ));
+            }
+            Ok(Ok(_)) if expect == Expect::Err => self.failures.push(format!("{what}: accepted")),
+            Ok(Ok(_)) => {}
             Ok(Err(e)) if expect == Expect::Ok => self.failures.push(format!("{what}: {e}")),
             Ok(Err(_)) => self.errors += 1,
         }
