@@ -340,6 +340,46 @@ fn two_dimensional_image_is_one_slice() {
     assert_eq!(loaded.volume.physical(0, 0, 0), Some(1.5));
 }
 
+#[test]
+fn text_encodings() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ascii = write_file(
+        tmp.path(),
+        "ascii.nrrd",
+        "NRRD0004\ntype: short\ndimension: 3\nsizes: 3 1 1\nencoding: ascii\nendian: big\n\n",
+        b"-1024 7,\n 3071\n",
+    );
+    let loaded = read(&ascii);
+    assert_eq!(loaded.source.stored_type, "int16, ascii");
+    let values: Vec<f64> = (0..3)
+        .map(|i| loaded.volume.physical(i, 0, 0).unwrap())
+        .collect();
+    assert_eq!(values, vec![-1024.0, 7.0, 3071.0]);
+    let hex = write_file(
+        tmp.path(),
+        "hex.nrrd",
+        "NRRD0004\ntype: ushort\ndimension: 3\nsizes: 2 1 1\nencoding: hex\nendian: big\n\n",
+        b"01 02\nFF\n00\n",
+    );
+    let loaded = read(&hex);
+    assert_eq!(loaded.volume.physical(0, 0, 0), Some(258.0));
+    assert_eq!(loaded.volume.physical(1, 0, 0), Some(65280.0));
+    for (name, data) in [
+        ("short.nrrd", &b"1 2"[..]),
+        ("word.nrrd", b"1 x 3"),
+        ("odd.nrrd", b"010"),
+    ] {
+        let encoding = if name == "odd.nrrd" { "hex" } else { "ascii" };
+        let path = write_file(
+            tmp.path(),
+            name,
+            &format!("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 1 1\nencoding: {encoding}\n\n"),
+            data,
+        );
+        assert_fails(&path, &OpenOptions::default());
+    }
+}
+
 fn assert_fails(path: &Path, options: &OpenOptions) -> ReadError {
     match nrrd::read(path, options) {
         Ok(_) => panic!("{} was read but should fail", path.display()),

@@ -1,5 +1,6 @@
 //! Reading the samples a NRRD header describes, wherever they are: after the header, in one
-//! detached file, or spread over many files (a `LIST` or a `%d` pattern), raw or gzip.
+//! detached file, or spread over many files (a `LIST` or a `%d` pattern), raw, gzip, ascii or
+//! hex.
 //!
 //! Every file becomes one segment of a single stream that [`read_voxels`] consumes, so samples
 //! go straight from disk (through the decompressor) into the voxel buffer, and a volume split
@@ -8,7 +9,7 @@
 use super::header::{ByteSkip, DataFiles, Encoding, Header};
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
-use crate::samples::{read_voxels, Endian, Rescale};
+use crate::samples::{read_voxels, ElementType, Endian, Rescale};
 use endocast_core::ValueMap;
 use flate2::read::MultiGzDecoder;
 use std::fs::File;
@@ -225,6 +226,12 @@ fn open_segment(segment: &Segment, header: &Header) -> io::Result<Box<dyn Read>>
     let mut decoded: Box<dyn Read> = match header.encoding {
         Encoding::Raw => Box::new(reader),
         Encoding::Gzip => Box::new(MultiGzDecoder::new(reader)),
+        Encoding::Ascii | Encoding::Hex => Box::new(io::Cursor::new(decode_text(
+            reader,
+            header.encoding,
+            header.element,
+            segment.bytes,
+        )?)),
     };
     // The spec applies the line skip to the file and the byte skip to the decoded data.
     if let ByteSkip::Bytes(skip) = header.byte_skip {
@@ -237,6 +244,79 @@ fn open_segment(segment: &Segment, header: &Header) -> io::Result<Box<dyn Read>>
         }
     }
     Ok(decoded)
+}
+
+/// Decodes a text encoding into the bytes of `bytes` bytes of samples (plus whatever a byte
+/// skip needs): hex digits into the bytes they spell, in the file's byte order; ascii numbers
+/// into little-endian samples of `element` (the caller reads ascii data as little-endian).
+fn decode_text(
+    reader: impl Read,
+    encoding: Encoding,
+    element: ElementType,
+    bytes: u64,
+) -> io::Result<Vec<u8>> {
+    // No number needs 64 characters per byte; the bound stops a runaway file, not real data.
+    let limit = bytes.saturating_mul(64).saturating_add(1 << 20);
+    let mut text = Vec::new();
+    reader.take(limit).read_to_end(&mut text)?;
+    let mut out = Vec::new();
+    if encoding == Encoding::Hex {
+        let digits: Vec<u8> = text
+            .iter()
+            .copied()
+            .filter(|b| !b.is_ascii_whitespace())
+            .collect();
+        for pair in digits.chunks(2) {
+            let byte = std::str::from_utf8(pair)
+                .ok()
+                .filter(|p| p.len() == 2)
+                .and_then(|p| u8::from_str_radix(p, 16).ok());
+            out.push(byte.ok_or_else(|| {
+                let found = String::from_utf8_lossy(pair);
+                io::Error::new(
+                    ErrorKind::InvalidData,
+                    format!("{found:?} is not a pair of hex digits"),
+                )
+            })?);
+        }
+        return Ok(out);
+    }
+    let tokens = text
+        .split(|b| b.is_ascii_whitespace() || *b == b',')
+        .filter(|t| !t.is_empty());
+    for token in tokens {
+        push_ascii_sample(token, element, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// Appends the little-endian bytes of one ascii sample.
+fn push_ascii_sample(token: &[u8], element: ElementType, out: &mut Vec<u8>) -> io::Result<()> {
+    let text = String::from_utf8_lossy(token);
+    let bad = || {
+        io::Error::new(
+            ErrorKind::InvalidData,
+            format!("{text:?} is not a {} value", element.name()),
+        )
+    };
+    macro_rules! push {
+        ($t:ty) => {
+            out.extend_from_slice(&text.parse::<$t>().map_err(|_| bad())?.to_le_bytes())
+        };
+    }
+    match element {
+        ElementType::U8 => push!(u8),
+        ElementType::I8 => push!(i8),
+        ElementType::U16 => push!(u16),
+        ElementType::I16 => push!(i16),
+        ElementType::U32 => push!(u32),
+        ElementType::I32 => push!(i32),
+        ElementType::U64 => push!(u64),
+        ElementType::I64 => push!(i64),
+        ElementType::F32 => push!(f32),
+        ElementType::F64 => push!(f64),
+    }
+    Ok(())
 }
 
 /// Skips `lines` newline-terminated lines without holding them in memory.

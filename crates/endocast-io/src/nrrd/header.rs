@@ -27,6 +27,10 @@ pub(super) enum Encoding {
     Raw,
     /// gzip-compressed raw bytes.
     Gzip,
+    /// Samples as decimal numbers separated by white space (or commas).
+    Ascii,
+    /// The raw bytes as pairs of hexadecimal digits, white space ignored.
+    Hex,
 }
 
 impl Encoding {
@@ -34,6 +38,8 @@ impl Encoding {
         match self {
             Self::Raw => "raw",
             Self::Gzip => "gzip",
+            Self::Ascii => "ascii",
+            Self::Hex => "hex",
         }
     }
 }

@@ -1,7 +1,7 @@
 //! NRRD, the format of teem and 3D Slicer: a text header followed by the samples (`.nrrd`), or
 //! a header naming the file(s) that hold them (`.nhdr`).
 //!
-//! Read: every sample type of the spec, raw or gzip encoding, either byte order, `line skip` and
+//! Read: every sample type of the spec, raw, gzip, ascii or hex encoding (not bzip2), either byte order, `line skip` and
 //! `byte skip` (−1 included), a single detached file, a `LIST` of files or a `%d` pattern of
 //! slice files, 2-D images (as one slice) and 4-D files whose first axis has size 1. Geometry
 //! comes from `space directions` and `space origin` in any anatomical space (converted to LPS),
@@ -24,7 +24,7 @@ use crate::open::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::Endian;
 use endocast_core::{Geometry, Modality, Volume};
 use glam::{DMat3, DVec3};
-use header::{Center, DataFiles, Header, Space};
+use header::{Center, DataFiles, Encoding, Header, Space};
 use std::path::Path;
 
 /// Reads the NRRD file (`.nrrd`) or detached header (`.nhdr`) at `path` into a volume in the
@@ -219,6 +219,10 @@ fn axis_spacing(path: &Path, spacing: f64, axis: usize, warnings: &mut Vec<Strin
 }
 
 fn endian(path: &Path, header: &Header, warnings: &mut Vec<String>) -> Endian {
+    if header.encoding == Encoding::Ascii {
+        // Numbers in text have no byte order; the decoder hands them on little-endian.
+        return Endian::Little;
+    }
     header.endian.unwrap_or_else(|| {
         if header.element.size() > 1 {
             warnings.push(format!(
@@ -234,7 +238,7 @@ fn endian(path: &Path, header: &Header, warnings: &mut Vec<String>) -> Endian {
 /// E.g. `int16 big-endian, raw, 113 data files`.
 fn stored_type(header: &Header, endian: Endian) -> String {
     let mut text = header.element.name().to_owned();
-    if header.element.size() > 1 {
+    if header.element.size() > 1 && header.encoding != Encoding::Ascii {
         text += match endian {
             Endian::Little => " little-endian",
             Endian::Big => " big-endian",

@@ -71,9 +71,11 @@ pub(super) fn parse_encoding(path: &Path, value: &str) -> Result<Encoding> {
     match value.to_ascii_lowercase().as_str() {
         "raw" => Ok(Encoding::Raw),
         "gzip" | "gz" => Ok(Encoding::Gzip),
-        "bzip2" | "bz2" | "ascii" | "text" | "txt" | "hex" | "zstd" => Err(ReadError::unsupported(
+        "ascii" | "text" | "txt" => Ok(Encoding::Ascii),
+        "hex" => Ok(Encoding::Hex),
+        "bzip2" | "bz2" | "zstd" => Err(ReadError::unsupported(
             path,
-            format!("NRRD encoding {value:?} (read: raw, gzip)"),
+            format!("NRRD encoding {value:?} (read: raw, gzip, ascii, hex)"),
         )),
         _ => Err(ReadError::format(
             path,
