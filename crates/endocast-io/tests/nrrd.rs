@@ -427,6 +427,17 @@ fn bad_headers_fail_cleanly() {
         assert_fails(&huge, &options_with_max_voxels(1_000_000)),
         ReadError::Limit { .. }
     ));
+    let pattern = write_file(
+        tmp.path(),
+        "pattern.nhdr",
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 4000000000\n\
+         data file: s%d.raw 1 4000000000 1\n",
+        &[],
+    );
+    assert!(matches!(
+        assert_fails(&pattern, &OpenOptions::default()),
+        ReadError::Limit { .. }
+    ));
     let overflow = write_file(
         tmp.path(),
         "overflow.nrrd",

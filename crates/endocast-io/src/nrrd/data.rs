@@ -72,7 +72,7 @@ fn segments(
     limits: &Limits,
 ) -> Result<Vec<Segment>> {
     let sample_bytes = header.element.size() as u64;
-    let total_bytes = count as u64 * sample_bytes;
+    let total_bytes = (count as u64).saturating_mul(sample_bytes);
     let folder = header_path.parent().unwrap_or(Path::new(""));
     let (names, subdim) = match &header.data {
         DataFiles::Attached => {

@@ -2,6 +2,7 @@
 
 use super::header::DataFiles;
 use crate::error::{ReadError, Result};
+use crate::limits::Limits;
 use std::path::Path;
 
 /// The `data file` field in its three forms: one name, `LIST [subdim]` with the names on the
@@ -11,6 +12,7 @@ pub(super) fn parse_data_file(
     value: &str,
     list: &[String],
     dimension: usize,
+    limits: &Limits,
 ) -> Result<DataFiles> {
     let words: Vec<&str> = value.split_whitespace().collect();
     let subdim = |word: Option<&&str>| -> Result<Option<usize>> {
@@ -53,16 +55,12 @@ pub(super) fn parse_data_file(
             format!("data file: expected \"FORMAT first last step [subdim]\" with integers, found {value:?}"),
         ));
     };
-    let names = expand_pattern(path, words[0], first, last, step)?;
+    let names = expand_pattern(path, words[0], first, last, step, limits)?;
     Ok(DataFiles::Many {
         names,
         subdim: subdim(words.get(4))?,
     })
 }
-
-/// Most files a `%d` pattern may name; far above any real slice count, and it bounds the list
-/// before it is built (the caller checks the slice limit on the actual count).
-const MAX_PATTERN_FILES: i128 = 1_000_000;
 
 /// The file names of a `%d` pattern: `first`, `first + step`, … while not past `last`.
 fn expand_pattern(
@@ -71,6 +69,7 @@ fn expand_pattern(
     first: i64,
     last: i64,
     step: i64,
+    limits: &Limits,
 ) -> Result<Vec<String>> {
     let bad = |why: &str| {
         ReadError::format(
@@ -88,9 +87,8 @@ fn expand_pattern(
         return Err(bad("the step goes away from the last index"));
     }
     let count = span / i128::from(step) + 1;
-    if count > MAX_PATTERN_FILES {
-        return Err(bad("names more than a million files"));
-    }
+    // Checked before the names are built: the range may claim billions of files.
+    limits.check_slices(path, u64::try_from(count).unwrap_or(u64::MAX))?;
     Ok((0..count)
         .map(|n| {
             let index = i128::from(first) + n * i128::from(step);

@@ -11,6 +11,7 @@ use super::values::{
     parse_space, parse_type, PerAxis,
 };
 use crate::error::{ReadError, Result};
+use crate::limits::Limits;
 use crate::samples::{ElementType, Endian};
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read};
@@ -122,10 +123,15 @@ pub(super) struct Header {
 }
 
 /// Reads and validates the header of the NRRD file at `path`; unknown fields are warned about.
-pub(super) fn read_header(path: &Path, warnings: &mut Vec<String>) -> Result<Header> {
+/// `limits` bounds the number of data files a `%d` pattern may name.
+pub(super) fn read_header(
+    path: &Path,
+    limits: &Limits,
+    warnings: &mut Vec<String>,
+) -> Result<Header> {
     let file = std::fs::File::open(path).map_err(|e| ReadError::io(path, e))?;
     let text = read_header_lines(path, BufReader::new(file).take(MAX_HEADER_BYTES))?;
-    Fields::parse(path, &text.lines)?.into_header(path, &text, warnings)
+    Fields::parse(path, &text.lines)?.into_header(path, &text, limits, warnings)
 }
 
 /// The header as lines, before interpretation.
@@ -256,6 +262,7 @@ impl Fields {
         self,
         path: &Path,
         text: &HeaderText,
+        limits: &Limits,
         warnings: &mut Vec<String>,
     ) -> Result<Header> {
         self.warn_unknown(path, warnings);
@@ -266,7 +273,7 @@ impl Fields {
         let encoding = parse_encoding(path, self.get("encoding").unwrap_or("raw"))?;
         let byte_skip = parse_byte_skip(path, self.get("byteskip"), encoding)?;
         let data = match self.get("datafile") {
-            Some(value) => parse_data_file(path, value, &self.list, dimension)?,
+            Some(value) => parse_data_file(path, value, &self.list, dimension, limits)?,
             None if text.blank_line => DataFiles::Attached,
             None => {
                 return Err(ReadError::format(
@@ -388,6 +395,7 @@ mod tests {
         Fields::parse(Path::new("t.nhdr"), &lines.lines)?.into_header(
             Path::new("t.nhdr"),
             &lines,
+            &Limits::default(),
             &mut warnings,
         )
     }

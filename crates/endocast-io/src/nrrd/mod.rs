@@ -32,7 +32,7 @@ use std::path::Path;
 /// [`read_voxels`](crate::samples::read_voxels)'s mapping onto 16 bits.
 pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let mut warnings = Vec::new();
-    let header = header::read_header(path, &mut warnings)?;
+    let header = header::read_header(path, &options.limits, &mut warnings)?;
     let axes = spatial_axes(path, &header)?;
     let count = options.limits.check_dims(path, &header.sizes)?;
     let geometry = geometry(path, &header, &axes, &mut warnings)?;
