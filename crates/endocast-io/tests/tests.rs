@@ -1,3 +1,5 @@
 //! Integration tests of the readers and writers, one module per topic, one test binary.
 
 mod common;
+mod nifti;
+mod test_volumes;
