@@ -1,5 +1,6 @@
 //! Integration tests of the readers and writers, one module per topic, one test binary.
 
 mod common;
+mod metaimage;
 mod nifti;
 mod test_volumes;
