@@ -3,13 +3,16 @@
 //! Reading streams the file (through a gzip decoder when it starts with the gzip magic, whatever
 //! its name) and never reads more than the header, the bytes up to `vox_offset` and the first
 //! 3-D volume's voxels. The version and byte order come from `sizeof_hdr` (348 or 540 in the
-//! file's byte order). Geometry comes from the sform, else the qform, else the voxel sizes
-//! (see [`affine`]); NIfTI's RAS world becomes endocast's LPS by negating x and y. A non-zero,
+//! file's byte order). Geometry comes from the sform when `sform_code > 0`, else the qform
+//! when `qform_code > 0`, else the voxel sizes alone (with a warning); NIfTI's RAS world
+//! becomes endocast's LPS by negating x and y, and the 3×4 affine splits into spacing (column
+//! lengths), direction (unit columns) and origin. Spatial units in metres or microns are
+//! converted to mm. A non-zero,
 //! finite `scl_slope` is applied with `scl_inter`. NIfTI says nothing reliable about the
 //! modality, so it is [`Modality::Unknown`].
 //!
 //! Writing produces a little-endian NIfTI-1 file, gzip-compressed when the name ends in `.gz`;
-//! see [`write`] for the sample type chosen.
+//! see [`write()`] for the sample type chosen.
 
 mod affine;
 mod header;
