@@ -19,6 +19,7 @@
 
 pub mod atomic;
 pub mod dicom;
+mod encode;
 pub mod error;
 pub mod limits;
 pub mod metaimage;
