@@ -66,7 +66,7 @@ struct Seed {
     files: Vec<(String, Vec<u8>)>,
     entry: String,
     /// The byte count at the end of the entry file that a reader may legitimately not need
-    /// (a gzip trailer), so truncating inside it need not fail.
+    /// (a text header's final newline), so truncating inside it need not fail.
     optional_tail: usize,
 }
 
@@ -151,8 +151,8 @@ fn seeds(dir: &Path) -> Vec<Seed> {
     let mut seeds = Vec::new();
     for (name, file, tail) in [
         ("nifti", "v.nii", 0),
-        ("nifti-gz", "v.nii.gz", 8),
-        ("nrrd", "v.nrrd", 8),
+        ("nifti-gz", "v.nii.gz", 0),
+        ("nrrd", "v.nrrd", 0),
         ("metaimage", "v.mha", 0),
     ] {
         let path = dir.join(file);
@@ -195,7 +195,7 @@ fn detached_nrrd(volume: &Volume) -> Seed {
             ("v.raw".into(), raw_i16(volume)),
         ],
         entry: "v.nhdr".into(),
-        optional_tail: 0,
+        optional_tail: 1,
     }
 }
 
@@ -214,7 +214,7 @@ fn detached_metaimage(volume: &Volume) -> Seed {
             ("v.raw".into(), raw_i16(volume)),
         ],
         entry: "v.mhd".into(),
-        optional_tail: 0,
+        optional_tail: 1,
     }
 }
 
@@ -298,11 +298,10 @@ fn text_number_mutations(bytes: &[u8]) -> Vec<Vec<u8>> {
         .position(|w| w == b"\n\n")
         .unwrap_or(bytes.len())
         .min(4096);
-    let text = String::from_utf8_lossy(&bytes[..header_len]).into_owned();
     let mut spans = Vec::new();
     let mut start = None;
-    for (i, c) in text.char_indices() {
-        let numeric = c.is_ascii_digit() || c == '.' || c == '-';
+    for (i, &c) in bytes[..header_len].iter().enumerate() {
+        let numeric = c.is_ascii_digit() || c == b'.' || c == b'-';
         match (numeric, start) {
             (true, None) => start = Some(i),
             (false, Some(s)) => {

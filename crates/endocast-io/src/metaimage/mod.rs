@@ -198,16 +198,16 @@ fn open_data(data_path: &Path, header: &Header, count: usize) -> Result<Box<dyn 
 /// flate2 reports a corrupt stream as an I/O error; it is a fault of the file.
 fn corrupt_zlib_as_format(error: ReadError, compressed: bool) -> ReadError {
     match error {
-        ReadError::Io { path, source }
+        ReadError::Io { path, cause }
             if compressed
                 && matches!(
-                    source.kind(),
+                    cause.kind(),
                     ErrorKind::InvalidInput | ErrorKind::InvalidData
                 ) =>
         {
             ReadError::format(
                 &path,
-                format!("the zlib-compressed voxel data are corrupt: {source}"),
+                format!("the zlib-compressed voxel data are corrupt: {cause}"),
             )
         }
         other => other,

@@ -88,6 +88,9 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         rescale(path, &header, &mut warnings),
         &mut warnings,
     )?;
+    if gzip {
+        verify_gzip_end(path, &mut reader)?;
+    }
 
     // check_dims proved the product fits usize, so each factor does.
     let dims = dims.map(|d| d as usize);
@@ -98,6 +101,18 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         volume,
         source: SourceInfo::new(Format::Nifti, stored_type(&header, element.name(), gzip)),
         warnings,
+    })
+}
+
+/// Reads one byte past the voxels: for a 3-D file this reaches the end of the gzip member, so
+/// the decoder checks its CRC and length and a truncated or corrupt file is refused rather than
+/// silently accepted.
+fn verify_gzip_end(path: &Path, reader: &mut dyn Read) -> Result<()> {
+    reader.read(&mut [0u8; 1]).map(|_| ()).map_err(|e| {
+        ReadError::format(
+            path,
+            format!("the gzip stream is corrupt or truncated: {e}"),
+        )
     })
 }
 

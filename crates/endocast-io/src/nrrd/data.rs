@@ -56,7 +56,14 @@ pub(super) fn read_samples(
         count,
         Rescale::IDENTITY,
         warnings,
-    );
+    )
+    .and_then(|voxels| {
+        // One more read finishes the last segment: a gzip member's CRC and length get checked.
+        chain
+            .read(&mut [0u8; 1])
+            .map(|_| voxels)
+            .map_err(|e| ReadError::format(header_path, e.to_string()))
+    });
     match (result, chain.failure) {
         // The chain knows which file failed and why; read_voxels only saw an I/O error.
         (Err(_), Some(failure)) => Err(failure),
