@@ -257,7 +257,8 @@ fn read_wide(
             path.display()
         ));
     }
-    let map = ValueMap::fitting(lo, hi, integral).map_err(|e| ReadError::format(path, e.to_string()))?;
+    let map =
+        ValueMap::fitting(lo, hi, integral).map_err(|e| ReadError::format(path, e.to_string()))?;
     if map.scale() != 1.0 {
         warnings.push(format!(
             "{}: {} values in [{lo}, {hi}] quantised to 16 bits (step {:.3e})",
