@@ -3,19 +3,19 @@
 //!
 //! # How a series is read
 //!
-//! 1. [`scan`]: every file under the directory is listed (sorted) and its header, everything
+//! 1. `scan`: every file under the directory is listed (sorted) and its header, everything
 //!    before PixelData, is parsed in parallel. Files without the DICOM magic, DICOM objects
 //!    without an image and unreadable headers are skipped and reported in one warning.
-//! 2. [`series`]: images are grouped by SeriesInstanceUID; the largest series is loaded unless
+//! 2. `series`: images are grouped by SeriesInstanceUID; the largest series is loaded unless
 //!    [`OpenOptions::series`] names another.
-//! 3. [`stack`]: frames (a file is one frame, an enhanced multi-frame file many) are ordered by
+//! 3. `stack`: frames (a file is one frame, an enhanced multi-frame file many) are ordered by
 //!    the projection of ImagePositionPatient on the slice normal (row × column cosine), never
 //!    by file name or InstanceNumber, which scanners number in either direction.
-//! 4. [`pixels`]: each file is decoded (any transfer syntax dicom-rs decodes: uncompressed
+//! 4. `pixels`: each file is decoded (any transfer syntax dicom-rs decodes: uncompressed
 //!    little/big endian, RLE, JPEG lossless, JPEG-LS, JPEG 2000, deflate) straight into its
 //!    slice of the final voxel buffer, files in parallel. Peak memory is that buffer plus one
 //!    file per thread (a multi-frame file is held whole while its frames are decoded).
-//! 5. [`values`]: one value map for the series (exact when all slices share their rescale).
+//! 5. `values`: one value map for the series (exact when all slices share their rescale).
 //!
 //! # Geometry decisions
 //!
@@ -32,7 +32,9 @@
 //! - Slices must lie on one line (else [`ReadError::Inconsistent`]). When the gaps between
 //!   them differ by more than 1 %, the stack is resampled onto a uniform step (the smallest
 //!   gap, at most 4× the original slice count) by linear interpolation between the two
-//!   neighbouring slices; the first and last slices stay exactly where they were.
+//!   neighbouring slices; the first and last slices stay exactly where they were. The limits
+//!   are checked before the resampled buffer is allocated; while it is filled, the decoded
+//!   stack is held too (freed before returning).
 //!
 //! # Values
 //!
@@ -87,6 +89,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     ];
     let slice_len = dims[0] * dims[1];
     let count = stack.slices.len();
+    options.limits.check_slices(path, count as u64)?;
     let total = options
         .limits
         .check_dims(path, &[dims[0] as u64, dims[1] as u64, count as u64])?;
