@@ -1,0 +1,203 @@
+//! The DICOM reader: a series from a directory (searched recursively), or one single- or
+//! multi-frame file, becomes one [`Volume`].
+//!
+//! # How a series is read
+//!
+//! 1. `scan`: every file under the directory is listed (sorted) and its header, everything
+//!    before PixelData, is parsed in parallel. Files without the DICOM magic, DICOM objects
+//!    without an image and unreadable headers are skipped and reported in one warning.
+//! 2. `series`: images are grouped by SeriesInstanceUID; the largest series is loaded unless
+//!    [`OpenOptions::series`] names another.
+//! 3. `stack`: frames (a file is one frame, an enhanced multi-frame file many) are ordered by
+//!    the projection of ImagePositionPatient on the slice normal (row × column cosine), never
+//!    by file name or InstanceNumber, which scanners number in either direction.
+//! 4. `pixels`: each file is decoded (any transfer syntax dicom-rs decodes: uncompressed
+//!    little/big endian, RLE, JPEG lossless, JPEG-LS, JPEG 2000, deflate) straight into its
+//!    slice of the final voxel buffer, files in parallel. Peak memory is that buffer plus one
+//!    file per thread (a multi-frame file is held whole while its frames are decoded).
+//! 5. `values`: one value map for the series (exact when all slices share their rescale).
+//!
+//! # Geometry decisions
+//!
+//! - Direction columns are the row cosine (`i`), the column cosine (`j`) and the unit vector
+//!   from the first to the last slice position (`k`). With gantry tilt that last vector is not
+//!   the slice normal: the stack is sheared, and we keep the shear in the affine rather than
+//!   resample every slice in-plane (which would blur them and move the pixels the scanner
+//!   measured). The renderer works in the volume's affine, so a sheared grid costs nothing;
+//!   a warning names the tilt angle.
+//! - Spacing is PixelSpacing (DICOM lists the spacing between rows first, so `i` takes its
+//!   second value and `j` its first) and the mean step between slice positions, never
+//!   SliceThickness (which may overlap or leave gaps). A single slice, with no neighbour to
+//!   measure, takes its SliceThickness (or 1 mm).
+//! - Slices must lie on one line (else [`ReadError::Inconsistent`]). When the gaps between
+//!   them differ by more than 1 %, the stack is resampled onto a uniform step (the smallest
+//!   gap, at most 4× the original slice count) by linear interpolation between the two
+//!   neighbouring slices; the first and last slices stay exactly where they were. The limits
+//!   are checked before the resampled buffer is allocated; while it is filled, the decoded
+//!   stack is held too (freed before returning).
+//!
+//! # Values
+//!
+//! RescaleSlope/Intercept apply per slice (per frame through PixelValueTransformationSequence).
+//! When every slice shares them, voxels hold raw samples exactly (signed samples offset by
+//! 2^(BitsAllocated−1)) and the value map carries the rescale. Otherwise the physical range is
+//! requantised onto 16 bits (warned). BitsStored masks unused high bits and sign-extends;
+//! PixelPaddingValue voxels take the lowest real value of the series (warned). MONOCHROME1 is
+//! inverted so that bright means high, except for CT, whose Hounsfield units are kept.
+
+mod pixels;
+mod scan;
+mod series;
+mod stack;
+mod values;
+
+use crate::error::{ReadError, Result};
+use crate::open::{Format, Loaded, OpenOptions, SourceInfo};
+use endocast_core::{Modality, Volume};
+use pixels::{FrameStats, SampleMap};
+use rayon::prelude::*;
+use scan::ImageFile;
+use stack::Stack;
+use std::path::Path;
+
+/// Reads the DICOM series in directory `path` (or the single DICOM file `path`).
+///
+/// Errors: no image found, an unknown [`OpenOptions::series`] (the message lists the series
+/// found), images of one series that disagree (size, orientation, spacing, or positions off
+/// one line: [`ReadError::Inconsistent`]), a transfer syntax or sample format that cannot be
+/// decoded ([`ReadError::Unsupported`]), a truncated or malformed file, or a volume beyond
+/// [`OpenOptions::limits`].
+pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
+    let mut warnings = Vec::new();
+    let files = scan::list_files(path, &options.limits)?;
+    let scanned = scan::scan_all(&files, &options.limits);
+    let images = series::images(path, &files, scanned, &mut warnings)?;
+    let (chosen, series_found) = series::choose(path, images, options.series.as_deref())?;
+    let stack = Stack::build(path, &chosen, &mut warnings)?;
+    let first = &chosen[0];
+    let ts_names = chosen
+        .iter()
+        .map(|file| pixels::transfer_syntax_name(&file.path, &file.transfer_syntax))
+        .collect::<Result<Vec<_>>>()?;
+    let modality = Modality::from_code(&first.modality);
+    let invert = monochrome1_inversion(first, &modality, &mut warnings);
+    let map = SampleMap::new(&first.path, &first.layout, first.padding, invert)?;
+
+    let dims = [
+        usize::from(first.layout.columns),
+        usize::from(first.layout.rows),
+    ];
+    let slice_len = dims[0] * dims[1];
+    let count = stack.slices.len();
+    options.limits.check_slices(path, count as u64)?;
+    let total = options
+        .limits
+        .check_dims(path, &[dims[0] as u64, dims[1] as u64, count as u64])?;
+    let mut voxels = vec![0u16; total];
+    let stats = decode_all(&chosen, &ts_names, &stack, &mut voxels, slice_len, &map)?;
+    let rescales: Vec<_> = stack.slices.iter().map(|s| s.rescale).collect();
+    let value_map = values::unify(
+        path,
+        &mut voxels,
+        slice_len,
+        &rescales,
+        &stats,
+        &map,
+        &mut warnings,
+    )?;
+
+    let (voxels, geometry) = match stack.uniform_resampling(path, &mut warnings) {
+        Some((new_count, step_mm)) => {
+            let total = options
+                .limits
+                .check_dims(path, &[dims[0] as u64, dims[1] as u64, new_count as u64])?;
+            let mut resampled = vec![0u16; total];
+            let offsets: Vec<f64> = stack.slices.iter().map(|s| s.offset_mm).collect();
+            stack::resample(&voxels, slice_len, &offsets, &mut resampled, step_mm);
+            (resampled, stack.geometry(path, dims, new_count, step_mm)?)
+        }
+        None => (voxels, stack.geometry(path, dims, count, stack.spacing.z)?),
+    };
+    let volume = Volume::new(geometry, voxels, value_map, modality)
+        .map_err(|e| ReadError::format(path, e.to_string()))?;
+    let mut source = SourceInfo::new(Format::Dicom, stored_type(first, ts_names[0]));
+    source.series_uid = Some(first.series_uid.clone());
+    source.series_found = series_found;
+    Ok(Loaded {
+        volume,
+        source,
+        warnings,
+    })
+}
+
+/// Decodes every slice of `stack` into its slot of `voxels`, one file per task, and returns
+/// the statistics of each slice in stack order.
+fn decode_all(
+    files: &[ImageFile],
+    ts_names: &[&str],
+    stack: &Stack,
+    voxels: &mut [u16],
+    slice_len: usize,
+    map: &SampleMap,
+) -> Result<Vec<FrameStats>> {
+    // Hand each file the slots of its frames, so that a multi-frame file is opened once.
+    let mut per_file: Vec<Vec<(usize, u32, &mut [u16])>> =
+        files.iter().map(|_| Vec::new()).collect();
+    for (k, (slot, slice)) in voxels.chunks_mut(slice_len).zip(&stack.slices).enumerate() {
+        per_file[slice.file].push((k, slice.frame, slot));
+    }
+    let decoded = per_file
+        .into_par_iter()
+        .enumerate()
+        .filter(|(_, frames)| !frames.is_empty())
+        .map(|(file, frames)| {
+            let (ks, slots): (Vec<usize>, Vec<(u32, &mut [u16])>) = frames
+                .into_iter()
+                .map(|(k, frame, slot)| (k, (frame, slot)))
+                .unzip();
+            let stats = pixels::decode_file(&files[file].path, ts_names[file], slots, map)?;
+            Ok(ks.into_iter().zip(stats).collect::<Vec<_>>())
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut stats = vec![None; stack.slices.len()];
+    for (k, frame_stats) in decoded.into_iter().flatten() {
+        stats[k] = Some(frame_stats);
+    }
+    Ok(stats.into_iter().flatten().collect())
+}
+
+/// Whether to invert MONOCHROME1 samples (minimum is white): yes, so that bright means high,
+/// except for CT, whose values are Hounsfield units whatever the display convention.
+fn monochrome1_inversion(
+    first: &ImageFile,
+    modality: &Modality,
+    warnings: &mut Vec<String>,
+) -> bool {
+    if first.layout.photometric != "MONOCHROME1" {
+        return false;
+    }
+    let invert = *modality != Modality::Ct;
+    warnings.push(if invert {
+        format!(
+            "{}: MONOCHROME1 (minimum is white) samples were inverted so that bright is high",
+            first.path.display()
+        )
+    } else {
+        format!(
+            "{}: CT marked MONOCHROME1; Hounsfield units are kept as stored (not inverted)",
+            first.path.display()
+        )
+    });
+    invert
+}
+
+/// E.g. `uint16, 12 bits stored, Implicit VR Little Endian`.
+fn stored_type(first: &ImageFile, ts_name: &str) -> String {
+    let layout = &first.layout;
+    format!(
+        "{}int{}, {} bits stored, {ts_name}",
+        if layout.signed { "" } else { "u" },
+        layout.bits_allocated,
+        layout.bits_stored
+    )
+}

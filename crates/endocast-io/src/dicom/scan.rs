@@ -1,0 +1,399 @@
+//! Finding DICOM files and reading their headers (everything before the pixel data), in
+//! parallel, into plain structs the later stages can reason about without the DICOM object.
+
+use crate::error::{ReadError, Result};
+use crate::limits::Limits;
+use crate::samples::Rescale;
+use dicom_core::Tag;
+use dicom_dictionary_std::tags;
+use dicom_object::{InMemDicomObject, OpenFileOptions};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// Directory levels followed below the given folder; deeper trees are almost certainly a
+/// mistake (or a link loop) rather than a series.
+const MAX_DEPTH: usize = 16;
+
+/// Every regular file under `root` (recursively, sorted by path), or `root` itself when it is a
+/// file. Refuses more files than [`Limits::max_slices`] before reading any of them.
+pub(super) fn list_files(root: &Path, limits: &Limits) -> Result<Vec<PathBuf>> {
+    if !root.is_dir() {
+        return Ok(vec![root.to_path_buf()]);
+    }
+    let mut files = Vec::new();
+    collect_files(root, root, 0, limits, &mut files)?;
+    files.sort();
+    Ok(files)
+}
+
+fn collect_files(
+    root: &Path,
+    dir: &Path,
+    depth: usize,
+    limits: &Limits,
+    files: &mut Vec<PathBuf>,
+) -> Result<()> {
+    let entries = std::fs::read_dir(dir).map_err(|e| ReadError::io(dir, e))?;
+    let mut paths = entries
+        .map(|entry| entry.map(|e| e.path()))
+        .collect::<std::io::Result<Vec<_>>>()
+        .map_err(|e| ReadError::io(dir, e))?;
+    paths.sort();
+    for path in paths {
+        // `symlink_metadata` so that a link to a parent folder cannot make us loop.
+        let meta = std::fs::symlink_metadata(&path).map_err(|e| ReadError::io(&path, e))?;
+        if meta.is_dir() {
+            if depth < MAX_DEPTH {
+                collect_files(root, &path, depth + 1, limits, files)?;
+            }
+        } else if path.is_file() {
+            files.push(path);
+            limits.check_slices(root, files.len() as u64)?;
+        }
+    }
+    Ok(())
+}
+
+/// One image file (single- or multi-frame) as its header describes it.
+#[derive(Debug, Clone)]
+pub(super) struct ImageFile {
+    /// The file.
+    pub path: PathBuf,
+    /// SeriesInstanceUID (empty when absent).
+    pub series_uid: String,
+    /// SeriesDescription (empty when absent).
+    pub description: String,
+    /// Modality code (empty when absent).
+    pub modality: String,
+    /// Transfer syntax UID from the file meta group.
+    pub transfer_syntax: String,
+    /// The pixel layout, as stored.
+    pub layout: PixelLayout,
+    /// PixelPaddingValue, as a raw sample value (sign already resolved).
+    pub padding: Option<i32>,
+    /// One entry per frame (one for a classic single-frame image).
+    pub frames: Vec<FrameHeader>,
+}
+
+/// How samples are stored; must be the same for every file of a series.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct PixelLayout {
+    /// Rows (the `j` extent).
+    pub rows: u16,
+    /// Columns (the `i` extent).
+    pub columns: u16,
+    /// SamplesPerPixel.
+    pub samples_per_pixel: u16,
+    /// BitsAllocated.
+    pub bits_allocated: u16,
+    /// BitsStored.
+    pub bits_stored: u16,
+    /// HighBit.
+    pub high_bit: u16,
+    /// PixelRepresentation 1: two's complement samples.
+    pub signed: bool,
+    /// PhotometricInterpretation, trimmed (e.g. `MONOCHROME2`).
+    pub photometric: String,
+}
+
+/// Where one frame lies and how its values map to physical units.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FrameHeader {
+    /// Frame number inside its file (0 for single-frame files).
+    pub frame: u32,
+    /// ImagePositionPatient: world position (mm) of the centre of the first pixel.
+    pub position: Option<DVec3>,
+    /// ImageOrientationPatient: row cosine (direction of increasing column index), then
+    /// column cosine (direction of increasing row index).
+    pub orientation: Option<[DVec3; 2]>,
+    /// PixelSpacing in DICOM order: between rows (mm), then between columns (mm).
+    pub pixel_spacing: Option<[f64; 2]>,
+    /// SliceThickness (mm); used only for a volume of a single slice.
+    pub thickness: Option<f64>,
+    /// RescaleSlope / RescaleIntercept (identity when absent).
+    pub rescale: Rescale,
+}
+
+/// What a file turned out to be.
+#[derive(Debug)]
+pub(super) enum Scanned {
+    /// An image we can place and decode.
+    Image(ImageFile),
+    /// No DICOM magic: not a DICOM file at all.
+    NotDicom,
+    /// A DICOM object without an image (report, DICOMDIR, presentation state, ...).
+    NoImage,
+    /// A DICOM file whose header could not be parsed; the error says why.
+    Unreadable(ReadError),
+}
+
+/// Reads the headers of all `files` in parallel, in the order given.
+pub(super) fn scan_all(files: &[PathBuf], limits: &Limits) -> Vec<Scanned> {
+    files.par_iter().map(|path| scan(path, limits)).collect()
+}
+
+/// Reads the header of one file, stopping before the pixel data.
+pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
+    match has_dicom_magic(path) {
+        Ok(true) => {}
+        Ok(false) => return Scanned::NotDicom,
+        Err(e) => return Scanned::Unreadable(e),
+    }
+    let object = match OpenFileOptions::new()
+        .read_until(tags::PIXEL_DATA)
+        .open_file(path)
+    {
+        Ok(object) => object,
+        Err(e) => return Scanned::Unreadable(open_error(path, &e)),
+    };
+    match image_file(path, &object, &object.meta().transfer_syntax, limits) {
+        Ok(Some(image)) => Scanned::Image(image),
+        Ok(None) => Scanned::NoImage,
+        Err(e) => Scanned::Unreadable(e),
+    }
+}
+
+/// Turns a dicom-object open error into ours: an unknown or undecodable transfer syntax is
+/// [`ReadError::Unsupported`], anything else a format error.
+pub(super) fn open_error(path: &Path, error: &dicom_object::ReadError) -> ReadError {
+    use dicom_object::ReadError as E;
+    match error {
+        E::OpenFile { source, .. } | E::ReadFile { source, .. } => {
+            ReadError::io(path, std::io::Error::new(source.kind(), source.to_string()))
+        }
+        E::ReadUnrecognizedTransferSyntax { uid, .. } => ReadError::unsupported(
+            path,
+            format!("transfer syntax {uid} (not a transfer syntax this reader knows)"),
+        ),
+        E::ReadUnsupportedTransferSyntax { uid, name, .. }
+        | E::ReadUnsupportedTransferSyntaxWithSuggestion { uid, name, .. } => {
+            ReadError::unsupported(path, format!("transfer syntax {uid} ({name})"))
+        }
+        other => ReadError::format(path, format!("not a readable DICOM file: {}", chain(other))),
+    }
+}
+
+/// An error and its causes in one line, so that "premature end" says where.
+pub(super) fn chain(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        source = cause.source();
+    }
+    text
+}
+
+/// `DICM` at byte 128 (after the preamble) or at byte 0 (a file without preamble).
+fn has_dicom_magic(path: &Path) -> Result<bool> {
+    let mut head = Vec::with_capacity(132);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(132).read_to_end(&mut head))
+        .map_err(|e| ReadError::io(path, e))?;
+    Ok(head.get(128..132) == Some(b"DICM") || head.starts_with(b"DICM"))
+}
+
+/// The header of an image, or `None` for an object without Rows/Columns (no image).
+fn image_file(
+    path: &Path,
+    object: &InMemDicomObject,
+    transfer_syntax: &str,
+    limits: &Limits,
+) -> Result<Option<ImageFile>> {
+    let (Some(rows), Some(columns)) = (
+        integer::<u16>(object, tags::ROWS),
+        integer::<u16>(object, tags::COLUMNS),
+    ) else {
+        return Ok(None);
+    };
+    let bits_stored = integer(object, tags::BITS_STORED).unwrap_or(0u16);
+    let layout = PixelLayout {
+        rows,
+        columns,
+        samples_per_pixel: integer(object, tags::SAMPLES_PER_PIXEL).unwrap_or(1),
+        bits_allocated: integer(object, tags::BITS_ALLOCATED).unwrap_or(0),
+        bits_stored,
+        high_bit: integer(object, tags::HIGH_BIT).unwrap_or(bits_stored.saturating_sub(1)),
+        signed: integer::<u16>(object, tags::PIXEL_REPRESENTATION) == Some(1),
+        photometric: text(object, tags::PHOTOMETRIC_INTERPRETATION).to_ascii_uppercase(),
+    };
+    let frame_count = integer::<u32>(object, tags::NUMBER_OF_FRAMES)
+        .unwrap_or(1)
+        .max(1);
+    limits.check_slices(path, u64::from(frame_count))?;
+    let frames = (0..frame_count)
+        .map(|frame| frame_header(path, object, frame))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Some(ImageFile {
+        path: path.to_path_buf(),
+        series_uid: text(object, tags::SERIES_INSTANCE_UID),
+        description: text(object, tags::SERIES_DESCRIPTION),
+        modality: text(object, tags::MODALITY).to_ascii_uppercase(),
+        transfer_syntax: transfer_syntax.trim_end_matches(['\0', ' ']).to_string(),
+        padding: padding_value(object, layout.signed),
+        layout,
+        frames,
+    }))
+}
+
+/// PixelPaddingValue as the raw sample it marks. Implicit VR files give no VR, so a signed
+/// padding of −1500 may arrive as the unsigned 64036: reinterpret it for signed images.
+fn padding_value(object: &InMemDicomObject, signed: bool) -> Option<i32> {
+    let value = integer::<i32>(object, tags::PIXEL_PADDING_VALUE)?;
+    Some(if signed && value > i32::from(i16::MAX) {
+        value - 65536
+    } else {
+        value
+    })
+}
+
+/// The attributes of frame `frame`: from its PerFrameFunctionalGroupsSequence item, then the
+/// SharedFunctionalGroupsSequence, then the top level (classic single-frame images).
+fn frame_header(path: &Path, object: &InMemDicomObject, frame: u32) -> Result<FrameHeader> {
+    let per_frame = first_items(object, tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE)
+        .and_then(|items| items.get(usize::try_from(frame).ok()?));
+    let shared = first_items(object, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE)
+        .and_then(|items| items.first());
+    let scope = FrameScope {
+        groups: [per_frame, shared],
+        top: object,
+    };
+    let position = scope
+        .floats(tags::PLANE_POSITION_SEQUENCE, tags::IMAGE_POSITION_PATIENT)
+        .map(|v| vector3(path, "ImagePositionPatient", &v))
+        .transpose()?;
+    let orientation = scope
+        .floats(
+            tags::PLANE_ORIENTATION_SEQUENCE,
+            tags::IMAGE_ORIENTATION_PATIENT,
+        )
+        .map(|v| orientation(path, &v))
+        .transpose()?;
+    let pixel_spacing = scope
+        .floats(tags::PIXEL_MEASURES_SEQUENCE, tags::PIXEL_SPACING)
+        .map(|v| pixel_spacing(path, &v))
+        .transpose()?;
+    let thickness = scope
+        .floats(tags::PIXEL_MEASURES_SEQUENCE, tags::SLICE_THICKNESS)
+        .and_then(|v| v.first().copied())
+        .filter(|t| t.is_finite() && *t > 0.0);
+    let transform = tags::PIXEL_VALUE_TRANSFORMATION_SEQUENCE;
+    let slope = scope.floats(transform, tags::RESCALE_SLOPE);
+    let intercept = scope.floats(transform, tags::RESCALE_INTERCEPT);
+    let rescale = Rescale {
+        slope: slope.and_then(|v| v.first().copied()).unwrap_or(1.0),
+        intercept: intercept.and_then(|v| v.first().copied()).unwrap_or(0.0),
+    };
+    if !rescale.slope.is_finite() || rescale.slope == 0.0 || !rescale.intercept.is_finite() {
+        return Err(ReadError::format(
+            path,
+            format!(
+                "RescaleSlope {} / RescaleIntercept {} must be finite with a non-zero slope",
+                rescale.slope, rescale.intercept
+            ),
+        ));
+    }
+    Ok(FrameHeader {
+        frame,
+        position,
+        orientation,
+        pixel_spacing,
+        thickness,
+        rescale,
+    })
+}
+
+/// The places a frame attribute may live, most specific first.
+struct FrameScope<'a> {
+    groups: [Option<&'a InMemDicomObject>; 2],
+    top: &'a InMemDicomObject,
+}
+
+impl FrameScope<'_> {
+    /// The numbers of `tag` inside the functional group `sequence`, or at the top level.
+    fn floats(&self, sequence: Tag, tag: Tag) -> Option<Vec<f64>> {
+        self.groups
+            .iter()
+            .flatten()
+            .find_map(|group| {
+                let item = first_items(group, sequence)?.first()?;
+                floats(item, tag)
+            })
+            .or_else(|| floats(self.top, tag))
+    }
+}
+
+fn first_items(object: &InMemDicomObject, tag: Tag) -> Option<&[InMemDicomObject]> {
+    object.get(tag)?.items()
+}
+
+fn floats(object: &InMemDicomObject, tag: Tag) -> Option<Vec<f64>> {
+    object
+        .get(tag)?
+        .to_multi_float64()
+        .ok()
+        .filter(|v| !v.is_empty())
+}
+
+/// An integer attribute that fits `T` (`None` when absent, malformed or out of range).
+fn integer<T: TryFrom<i64>>(object: &InMemDicomObject, tag: Tag) -> Option<T> {
+    let value = object.get(tag)?.to_int::<i64>().ok()?;
+    T::try_from(value).ok()
+}
+
+/// A string attribute without DICOM padding (trailing spaces or NULs); empty when absent.
+fn text(object: &InMemDicomObject, tag: Tag) -> String {
+    object
+        .get(tag)
+        .and_then(|e| e.to_str().ok())
+        .map(|s| s.trim_matches(['\0', ' ']).to_string())
+        .unwrap_or_default()
+}
+
+fn vector3(path: &Path, name: &str, values: &[f64]) -> Result<DVec3> {
+    match values {
+        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok(DVec3::new(*x, *y, *z)),
+        _ => Err(ReadError::format(
+            path,
+            format!("{name} must be 3 finite numbers, found {values:?}"),
+        )),
+    }
+}
+
+fn orientation(path: &Path, values: &[f64]) -> Result<[DVec3; 2]> {
+    let bad = || {
+        ReadError::format(
+            path,
+            format!(
+                "ImageOrientationPatient must be two orthogonal unit vectors (6 numbers), \
+                 found {values:?}"
+            ),
+        )
+    };
+    let [a, b, c, d, e, f] = values else {
+        return Err(bad());
+    };
+    let row = DVec3::new(*a, *b, *c);
+    let column = DVec3::new(*d, *e, *f);
+    // Headers round cosines to a few digits; accept that, refuse anything that is not a frame.
+    let unit = |v: DVec3| v.is_finite() && (v.length() - 1.0).abs() < 1e-2;
+    if !unit(row) || !unit(column) || row.dot(column).abs() > 1e-2 {
+        return Err(bad());
+    }
+    Ok([row.normalize(), column.normalize()])
+}
+
+fn pixel_spacing(path: &Path, values: &[f64]) -> Result<[f64; 2]> {
+    match values {
+        [between_rows, between_columns] if values.iter().all(|v| v.is_finite() && *v > 0.0) => {
+            Ok([*between_rows, *between_columns])
+        }
+        _ => Err(ReadError::format(
+            path,
+            format!("PixelSpacing must be 2 positive numbers (mm), found {values:?}"),
+        )),
+    }
+}
