@@ -69,6 +69,6 @@ pub fn joint(options: &PhantomOptions) -> (Volume, Joint) {
         curvature_radius_vox: 1.5 * size,
         gap_vox: 2.5,
     };
-    let volume = rasterize(dims, options, |p| truth.hu_at(p));
+    let volume = rasterize(dims, options, &|p| truth.hu_at(p));
     (volume, truth)
 }

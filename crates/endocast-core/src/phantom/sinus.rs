@@ -1,7 +1,7 @@
 //! The sinus: air cavities walled and divided by thin bone, for thin structures that a coarse
 //! step or a blurred gradient would miss or punch through.
 
-use super::profile::{paint, AIR_HU, BONE_HU, RAMP_WIDTH_VOX, TISSUE_HU};
+use super::profile::{paint, AIR_HU, BONE_HU, RAMP_WIDTH_VOX, REACH_VOX, TISSUE_HU};
 use super::raster::rasterize;
 use super::shape::{rounded_box, slab};
 use super::PhantomOptions;
@@ -97,19 +97,25 @@ impl Sinus {
 
     /// The noiseless value at `p`: bone walls, then air, then septa reaching into the walls.
     fn hu_at(&self, p: DVec3) -> f64 {
-        let mut hu = TISSUE_HU;
-        for cavity in &self.cavities {
-            hu = paint(
-                hu,
-                cavity.signed_distance(p) - self.wall_thickness_vox,
-                BONE_HU,
-            );
+        let mut distances = [f64::INFINITY; 3];
+        for (d, cavity) in distances.iter_mut().zip(&self.cavities) {
+            *d = cavity.signed_distance(p);
         }
-        for cavity in &self.cavities {
-            hu = paint(hu, cavity.signed_distance(p), AIR_HU);
+        if distances
+            .iter()
+            .all(|&d| d >= self.wall_thickness_vox + REACH_VOX)
+        {
+            return TISSUE_HU;
+        }
+        let mut hu = TISSUE_HU;
+        for &d in &distances {
+            hu = paint(hu, d - self.wall_thickness_vox, BONE_HU);
+        }
+        for &d in &distances {
+            hu = paint(hu, d, AIR_HU);
         }
         for septum in &self.septa {
-            let within = self.cavities[septum.cavity].signed_distance(p) - RAMP_WIDTH_VOX;
+            let within = distances[septum.cavity] - RAMP_WIDTH_VOX;
             let d = slab(p, septum.point_vox, septum.normal, septum.thickness_vox);
             hu = paint(hu, d.max(within), BONE_HU);
         }
@@ -121,6 +127,6 @@ impl Sinus {
 /// 1.5 voxels thick.
 pub fn sinus(options: &PhantomOptions) -> (Volume, Sinus) {
     let truth = Sinus::new(options.size_vox());
-    let volume = rasterize(options.cube(), options, |p| truth.hu_at(p));
+    let volume = rasterize(options.cube(), options, &|p| truth.hu_at(p));
     (volume, truth)
 }

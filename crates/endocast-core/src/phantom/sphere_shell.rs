@@ -26,7 +26,7 @@ pub fn sphere_shell(options: &PhantomOptions) -> (Volume, SphereShell) {
         inner_radius_vox: 0.35 * size,
         outer_radius_vox: 0.45 * size,
     };
-    let volume = rasterize(dims, options, |p| {
+    let volume = rasterize(dims, options, &|p: DVec3| {
         let r = p.distance(truth.centre_vox);
         // The shell's signed distance; the two surfaces are 0.1 · size ≥ 0.8 voxel apart, but
         // each is exact only where the other's ramp does not reach (size ≥ 20).

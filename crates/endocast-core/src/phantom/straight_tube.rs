@@ -30,7 +30,7 @@ pub fn straight_tube(options: &PhantomOptions) -> (Volume, Tube) {
         ]),
         radius_vox: 0.2 * options.size_vox(),
     };
-    let volume = rasterize(dims, options, |p| {
+    let volume = rasterize(dims, options, &|p: DVec3| {
         let (r, _) = cylindrical(p, centre, DVec3::Z);
         ramp(r - truth.radius_vox, AIR_HU, TISSUE_HU)
     });

@@ -2,7 +2,9 @@
 //! render modes (MIP, two isosurfaces) and for values far above the tissue range.
 
 use super::centreline::Centreline;
-use super::profile::{paint, CALCIFICATION_HU, FAT_HU, LUMEN_CONTRAST_HU, STENT_HU, TISSUE_HU};
+use super::profile::{
+    paint, CALCIFICATION_HU, FAT_HU, LUMEN_CONTRAST_HU, REACH_VOX, STENT_HU, TISSUE_HU,
+};
 use super::raster::{grid_centre, rasterize};
 use super::shape::{cylindrical, Ball};
 use super::PhantomOptions;
@@ -48,6 +50,25 @@ pub struct Vessel {
 }
 
 impl Vessel {
+    /// The noiseless value at `p`; `centre` is a point of the axis. The calcifications and the
+    /// stent are only evaluated in the shells of radii where they can reach (the stent's angle is
+    /// an `atan2`, which would otherwise dominate).
+    fn hu_at(&self, p: DVec3, centre: DVec3) -> f64 {
+        let (r, _) = cylindrical(p, centre, DVec3::Z);
+        let mut hu = paint(FAT_HU, r - self.wall_radius_vox, TISSUE_HU);
+        hu = paint(hu, r - self.lumen_radius_vox, LUMEN_CONTRAST_HU);
+        let in_wall = 0.5 * (self.lumen_radius_vox + self.wall_radius_vox);
+        for ball in &self.calcifications {
+            if (r - in_wall).abs() <= ball.radius_vox + REACH_VOX {
+                hu = paint(hu, ball.signed_distance(p), CALCIFICATION_HU);
+            }
+        }
+        if (r - self.stent.radius_vox).abs() <= self.stent.wire_radius_vox + REACH_VOX {
+            hu = paint(hu, self.stent_distance(p, centre), STENT_HU);
+        }
+        hu
+    }
+
     /// Signed distance (approximate away from the wires, exact in the limit of thin wires) from
     /// `p` to the stent, voxels.
     fn stent_distance(&self, p: DVec3, centre: DVec3) -> f64 {
@@ -110,14 +131,6 @@ pub fn vessel(options: &PhantomOptions) -> (Volume, Vessel) {
             })
             .collect(),
     };
-    let volume = rasterize(dims, options, |p| {
-        let (r, _) = cylindrical(p, centre, DVec3::Z);
-        let mut hu = paint(FAT_HU, r - truth.wall_radius_vox, TISSUE_HU);
-        hu = paint(hu, r - truth.lumen_radius_vox, LUMEN_CONTRAST_HU);
-        for ball in &truth.calcifications {
-            hu = paint(hu, ball.signed_distance(p), CALCIFICATION_HU);
-        }
-        paint(hu, truth.stent_distance(p, centre), STENT_HU)
-    });
+    let volume = rasterize(dims, options, &|p| truth.hu_at(p, centre));
     (volume, truth)
 }
