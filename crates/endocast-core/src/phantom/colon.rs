@@ -521,19 +521,26 @@ mod tests {
         );
     }
 
-    /// Generation time at paper size; run with `cargo test --release -p endocast-core -- --ignored`.
+    /// Generation time at paper size, without and with noise; run with
+    /// `cargo test --release -p endocast-core -- --ignored --nocapture`.
     #[test]
     #[ignore = "timing at paper size (125 M voxels): run in release"]
     fn paper_size_generation_time() {
-        let options = PhantomOptions {
-            size: 512,
-            ..Default::default()
-        };
-        let start = std::time::Instant::now();
-        let (volume, _) = colon(&options);
-        let seconds = start.elapsed().as_secs_f64();
-        eprintln!("colon {:?} generated in {seconds:.2} s", volume.dims());
-        assert_eq!(volume.dims(), [512, 512, 478]);
-        assert!(seconds < 10.0, "{seconds:.2} s");
+        for noise_hu in [0.0, 20.0] {
+            let options = PhantomOptions {
+                size: 512,
+                noise_hu,
+                ..Default::default()
+            };
+            let start = std::time::Instant::now();
+            let (volume, _) = colon(&options);
+            let seconds = start.elapsed().as_secs_f64();
+            eprintln!(
+                "colon {:?}, noise {noise_hu} HU: {seconds:.2} s",
+                volume.dims()
+            );
+            assert_eq!(volume.dims(), [512, 512, 478]);
+            assert!(seconds < 10.0, "{seconds:.2} s");
+        }
     }
 }

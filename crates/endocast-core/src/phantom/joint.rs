@@ -72,3 +72,48 @@ pub fn joint(options: &PhantomOptions) -> (Volume, Joint) {
     let volume = rasterize(dims, options, &|p| truth.hu_at(p));
     (volume, truth)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{iso_crossing, small};
+    use super::*;
+
+    #[test]
+    fn contrast_layer_lies_between_the_bone_surfaces() {
+        let (volume, joint) = joint(&small(64));
+        let c = joint.centre_vox;
+        let bone_contrast = 0.5 * (BONE_HU + JOINT_CONTRAST_HU);
+        let mut worst: f64 = 0.0;
+        for dj in -4..=4 {
+            for di in -4..=4 {
+                let i = (c.x + 5.0 * f64::from(di)).round();
+                let j = (c.y + 5.0 * f64::from(dj)).round();
+                if (i - c.x).hypot(j - c.y) > 0.8 * joint.radius_vox {
+                    continue;
+                }
+                let (lower, upper) = (joint.lower_surface_k(i, j), joint.upper_surface_k(i, j));
+                let mid = 0.5 * (lower + upper);
+                let at = |k: f64| volume.sample_physical(DVec3::new(i, j, k)).unwrap();
+                // The layer's plateau is only half a voxel wide, so trilinear samples between
+                // voxel centres mix in some bone; the voxels themselves hold the contrast.
+                let nearest = volume.physical(i as usize, j as usize, mid.round() as usize);
+                assert!(at(mid) < bone_contrast - 25.0, "{} HU mid-gap", at(mid));
+                assert!(nearest.unwrap() < bone_contrast - 25.0);
+                assert_eq!(at(lower - 2.0), BONE_HU);
+                assert_eq!(at(upper + 2.0), BONE_HU);
+                let column = DVec3::new(i, j, 0.0);
+                let found_lower =
+                    iso_crossing(&volume, column, DVec3::Z, (lower - 2.0, mid), bone_contrast);
+                let found_upper =
+                    iso_crossing(&volume, column, DVec3::Z, (mid, upper + 2.0), bone_contrast);
+                worst = worst
+                    .max((found_lower - lower).abs())
+                    .max((found_upper - upper).abs());
+            }
+        }
+        assert!(worst < 0.02, "worst surface error {worst} voxel");
+        // Beyond the bones' radius there is only soft tissue.
+        let outside = DVec3::new(c.x + joint.radius_vox + 2.0, c.y, c.z);
+        assert_eq!(volume.sample_physical(outside), Some(TISSUE_HU));
+    }
+}

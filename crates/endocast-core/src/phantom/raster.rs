@@ -35,31 +35,30 @@ pub(crate) fn rasterize(dims: [usize; 3], options: &PhantomOptions, field: &impl
     let [nx, ny, nz] = dims;
     let sigma = options.noise_sigma_hu();
     let seed = options.seed;
-    let noisy = |hu: f64, index: usize| {
-        if sigma > 0.0 {
-            quantize(hu + sigma * noise::gaussian(seed, index as u64))
-        } else {
-            quantize(hu)
-        }
-    };
     let mut voxels = vec![0u16; nx * ny * nz];
     voxels
         .par_chunks_mut(nx * ny)
         .enumerate()
         .for_each(|(k, slice)| {
+            let mut noise_row = vec![0.0; if sigma > 0.0 { nx } else { 0 }];
             for (j, row) in slice.chunks_exact_mut(nx).enumerate() {
-                let row_start = (k * ny + j) * nx;
+                if sigma > 0.0 {
+                    noise::fill(seed, ((k * ny + j) * nx) as u64, &mut noise_row);
+                }
+                let noisy = |hu: f64, i: usize| match noise_row.get(i) {
+                    Some(g) => quantize(hu + sigma * g),
+                    None => quantize(hu),
+                };
                 let mut i = 0;
                 while i < nx {
                     if let Some((end, hu)) = field.uniform_run(i, j, k) {
                         let end = end.clamp(i + 1, nx);
                         for (n, voxel) in row[i..end].iter_mut().enumerate() {
-                            *voxel = noisy(hu, row_start + i + n);
+                            *voxel = noisy(hu, i + n);
                         }
                         i = end;
                     } else {
-                        let hu = field.hu_at(DVec3::new(i as f64, j as f64, k as f64));
-                        row[i] = noisy(hu, row_start + i);
+                        row[i] = noisy(field.hu_at(DVec3::new(i as f64, j as f64, k as f64)), i);
                         i += 1;
                     }
                 }

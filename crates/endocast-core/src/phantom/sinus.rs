@@ -130,3 +130,99 @@ pub fn sinus(options: &PhantomOptions) -> (Volume, Sinus) {
     let volume = rasterize(options.cube(), options, &|p| truth.hu_at(p));
     (volume, truth)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::small;
+    use super::*;
+    use std::collections::VecDeque;
+
+    /// Voxels 6-connected to `seed` whose value is below `threshold_hu`.
+    fn flood(volume: &Volume, seed: DVec3, threshold_hu: f64) -> Vec<bool> {
+        let [nx, ny, nz] = volume.dims();
+        let mut inside = vec![false; nx * ny * nz];
+        let start = seed.round();
+        let start = [start.x as usize, start.y as usize, start.z as usize];
+        let mut queue = VecDeque::from([start]);
+        inside[volume.index(start[0], start[1], start[2])] = true;
+        while let Some([i, j, k]) = queue.pop_front() {
+            let neighbours = [
+                [i.wrapping_sub(1), j, k],
+                [i + 1, j, k],
+                [i, j.wrapping_sub(1), k],
+                [i, j + 1, k],
+                [i, j, k.wrapping_sub(1)],
+                [i, j, k + 1],
+            ];
+            for [a, b, c] in neighbours {
+                if volume.physical(a, b, c).is_some_and(|hu| hu < threshold_hu) {
+                    let index = volume.index(a, b, c);
+                    if !inside[index] {
+                        inside[index] = true;
+                        queue.push_back([a, b, c]);
+                    }
+                }
+            }
+        }
+        inside
+    }
+
+    #[test]
+    fn septa_split_each_cavity_into_separate_air_cells() {
+        let (volume, sinus) = sinus(&small(64));
+        // The most permissive threshold a user would pick for this air–bone boundary.
+        let threshold = 0.5 * (AIR_HU + BONE_HU);
+        let voxel = |p: DVec3| {
+            volume.index(
+                p.x.round() as usize,
+                p.y.round() as usize,
+                p.z.round() as usize,
+            )
+        };
+        for septum in &sinus.septa {
+            let cavity = sinus.cavities[septum.cavity];
+            let (a, b) = (
+                septum.point_vox + septum.normal * 2.5,
+                septum.point_vox - septum.normal * 2.5,
+            );
+            for p in [a, b] {
+                assert!(cavity.signed_distance(p) < -1.0);
+                assert_eq!(volume.sample_physical(p.round()), Some(AIR_HU));
+            }
+            let cell = flood(&volume, a, threshold);
+            assert!(cell.iter().filter(|&&v| v).count() > 50);
+            assert!(!cell[voxel(b)], "septum in cavity {} leaks", septum.cavity);
+        }
+        // The ethmoid's middle cell reaches neither outer cell; the cavities are apart.
+        let ethmoid = sinus.cavities[2];
+        let middle = flood(&volume, ethmoid.centre_vox, threshold);
+        let offset = DVec3::Y * (0.5 * ethmoid.half_extent_vox.y + 2.0);
+        assert!(!middle[voxel(ethmoid.centre_vox + offset)]);
+        assert!(!middle[voxel(ethmoid.centre_vox - offset)]);
+        assert!(!middle[voxel(sinus.cavities[0].centre_vox)]);
+    }
+
+    #[test]
+    fn cavity_walls_are_bone_and_exact() {
+        let (volume, sinus) = sinus(&small(64));
+        let cavity = sinus.cavities[1];
+        // Straight down from the centre of the left maxillary cavity, below its septum.
+        let face = cavity.centre_vox.z - cavity.half_extent_vox.z;
+        let from = DVec3::new(cavity.centre_vox.x, cavity.centre_vox.y, face + 4.0);
+        let r = super::super::tests::iso_crossing(
+            &volume,
+            from,
+            -DVec3::Z,
+            (0.0, 5.5),
+            0.5 * (AIR_HU + BONE_HU),
+        );
+        assert!(
+            (from.z - r - face).abs() < 0.02,
+            "air–bone surface at {}",
+            from.z - r
+        );
+        let in_wall = DVec3::new(from.x, from.y, face - 0.5 * sinus.wall_thickness_vox - 0.5);
+        assert!(volume.sample_physical(in_wall).unwrap() > 0.5 * (BONE_HU + TISSUE_HU));
+        assert_eq!(volume.physical(0, 0, 0), Some(TISSUE_HU));
+    }
+}

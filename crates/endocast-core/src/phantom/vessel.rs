@@ -134,3 +134,84 @@ pub fn vessel(options: &PhantomOptions) -> (Volume, Vessel) {
     let volume = rasterize(dims, options, &|p| truth.hu_at(p, centre));
     (volume, truth)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{iso_crossing, small};
+    use super::*;
+
+    #[test]
+    fn materials_sit_at_their_radii() {
+        let (volume, vessel) = vessel(&small(64));
+        let axis = vessel.axis.point_at(5.0);
+        assert_eq!(volume.sample_physical(axis), Some(LUMEN_CONTRAST_HU));
+        assert_eq!(volume.physical(0, 0, 0), Some(FAT_HU));
+        // Below the stent and away from plaque, the lumen–wall and wall–fat surfaces are exact.
+        for angle in [0.0, 1.0, 2.0] {
+            let dir = DVec3::new(f64::cos(angle), f64::sin(angle), 0.0);
+            let lumen = vessel.lumen_radius_vox;
+            let wall = vessel.wall_radius_vox;
+            let mid = 0.5 * (LUMEN_CONTRAST_HU + TISSUE_HU);
+            let r = iso_crossing(&volume, axis, dir, (lumen - 1.2, lumen + 1.2), mid);
+            assert!(
+                (r - lumen).abs() < 0.02,
+                "lumen radius {r}, expected {lumen}"
+            );
+            let mid = 0.5 * (TISSUE_HU + FAT_HU);
+            let r = iso_crossing(&volume, axis, dir, (wall - 1.2, wall + 1.2), mid);
+            assert!((r - wall).abs() < 0.02, "wall radius {r}, expected {wall}");
+        }
+    }
+
+    #[test]
+    fn stent_voxels_lie_on_the_stent_and_its_wires_are_bright() {
+        let (volume, vessel) = vessel(&small(96));
+        let stent = vessel.stent;
+        let centre = vessel.axis.point_at(0.0);
+        let [nx, ny, nz] = volume.dims();
+        let mut bright = 0;
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    if volume.physical(i, j, k).unwrap() < 0.5 * (STENT_HU + CALCIFICATION_HU) {
+                        continue;
+                    }
+                    bright += 1;
+                    let p = DVec3::new(i as f64, j as f64, k as f64);
+                    let (r, _) = cylindrical(p, centre, DVec3::Z);
+                    assert!((r - stent.radius_vox).abs() <= stent.wire_radius_vox + 1.0);
+                    let (k0, k1) = stent.k_range;
+                    assert!(p.z >= k0 - 1.0 && p.z <= k1 + 1.0, "metal at k = {k}");
+                }
+            }
+        }
+        assert!(bright > 1000, "{bright} metal voxels");
+        // Along one right-handed wire, every point is metal.
+        let (k0, k1) = stent.k_range;
+        for n in 0..200 {
+            let z = k0 + 1.0 + (k1 - k0 - 2.0) * f64::from(n) / 200.0;
+            let angle = TAU * z / stent.pitch_vox;
+            let p = centre + DVec3::new(angle.cos(), angle.sin(), 0.0) * stent.radius_vox;
+            let hu = volume.sample_physical(DVec3::new(p.x, p.y, z)).unwrap();
+            assert!(
+                hu > 0.5 * (STENT_HU + LUMEN_CONTRAST_HU),
+                "{hu} HU on a wire at k = {z}"
+            );
+        }
+    }
+
+    #[test]
+    fn calcifications_are_bright_at_their_centres() {
+        let (volume, vessel) = vessel(&small(64));
+        assert_eq!(vessel.calcifications.len(), 4);
+        for ball in &vessel.calcifications {
+            let hu = volume.sample_physical(ball.centre_vox).unwrap();
+            assert!(
+                hu > 0.5 * (CALCIFICATION_HU + TISSUE_HU),
+                "{hu} HU at {ball:?}"
+            );
+            let (r, _) = cylindrical(ball.centre_vox, vessel.axis.point_at(0.0), DVec3::Z);
+            assert!(r > vessel.lumen_radius_vox && r < vessel.wall_radius_vox);
+        }
+    }
+}
