@@ -80,8 +80,8 @@ pub struct Fold {
     pub depth_vox: f64,
 }
 
-/// Truth of the colon phantom. The lumen is the set of points whose distance to the centreline
-/// is below [`Colon::radius_vox_at`] the arc length of their closest centreline point, minus the
+/// Truth of the colon phantom. The lumen is the set of points closer to the centreline than the
+/// radius ([`Colon::radius_vox_at`]) at the arc length of their closest centreline point, less the
 /// folds and the polyps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Colon {
@@ -179,7 +179,8 @@ impl Colon {
 struct Segment {
     start: DVec3,
     delta: DVec3,
-    inv_len2: f64,
+    length: f64,
+    inv_length2: f64,
     arc_start: f64,
 }
 
@@ -187,9 +188,9 @@ impl Segment {
     /// Squared distance from `p` to the segment, and the arc length of the closest point.
     #[inline]
     fn closest(&self, p: DVec3) -> (f64, f64) {
-        let t = ((p - self.start).dot(self.delta) * self.inv_len2).clamp(0.0, 1.0);
+        let t = ((p - self.start).dot(self.delta) * self.inv_length2).clamp(0.0, 1.0);
         let d2 = p.distance_squared(self.start + self.delta * t);
-        (d2, self.arc_start + t * self.delta.length())
+        (d2, self.arc_start + t * self.length)
     }
 }
 
@@ -202,8 +203,39 @@ struct ColonField<'a> {
 }
 
 impl Field for ColonField<'_> {
+    /// The noiseless value at `p`: the lumen around the closest segment, then folds and polyps.
     fn hu_at(&self, p: DVec3) -> f64 {
-        self.value(p)
+        let near = self.bins.near(p);
+        if near.is_empty() {
+            return TISSUE_HU;
+        }
+        let n_seg = self.segments.len();
+        let n_fold = self.colon.folds.len();
+        let first_fold = near.partition_point(|&id| (id as usize) < n_seg);
+        let first_polyp = near.partition_point(|&id| (id as usize) < n_seg + n_fold);
+        let (mut best_d2, mut best_s) = (f64::INFINITY, 0.0);
+        for &id in &near[..first_fold] {
+            let (d2, s) = self.segments[id as usize].closest(p);
+            if d2 < best_d2 {
+                (best_d2, best_s) = (d2, s);
+            }
+        }
+        let mut hu = if best_d2.is_finite() {
+            let d = best_d2.sqrt() - self.colon.radius_vox_at(best_s);
+            ramp(d, AIR_HU, TISSUE_HU)
+        } else {
+            TISSUE_HU
+        };
+        for &id in &near[first_fold..first_polyp] {
+            let f = &self.colon.folds[id as usize - n_seg];
+            let d = torus(p, f.centre_vox, f.axis, f.ring_radius_vox, f.depth_vox);
+            hu = paint(hu, d, TISSUE_HU);
+        }
+        for &id in &near[first_polyp..] {
+            let ball = &self.colon.polyps[id as usize - n_seg - n_fold];
+            hu = paint(hu, ball.signed_distance(p), TISSUE_HU);
+        }
+        hu
     }
 
     fn uniform_run(&self, i: usize, j: usize, k: usize) -> Option<(usize, f64)> {
@@ -221,11 +253,17 @@ impl<'a> ColonField<'a> {
         let segments: Vec<Segment> = points
             .windows(2)
             .zip(colon.centreline.arc_vox())
-            .map(|(pair, &arc_start)| Segment {
-                start: pair[0],
-                delta: pair[1] - pair[0],
-                inv_len2: 1.0 / pair[0].distance_squared(pair[1]),
-                arc_start,
+            .map(|(pair, &arc_start)| {
+                // Consecutive centreline points are distinct: a resampling step apart, the
+                // last pair at least a quarter step.
+                let length = pair[0].distance(pair[1]);
+                Segment {
+                    start: pair[0],
+                    delta: pair[1] - pair[0],
+                    length,
+                    inv_length2: 1.0 / (length * length),
+                    arc_start,
+                }
             })
             .collect();
         let bins = Self::bin(colon, &segments, dims);
@@ -298,41 +336,6 @@ impl<'a> ColonField<'a> {
                 d <= REACH_VOX + ball.radius
             }));
         })
-    }
-
-    /// The noiseless value at `p`.
-    fn value(&self, p: DVec3) -> f64 {
-        let near = self.bins.near(p);
-        if near.is_empty() {
-            return TISSUE_HU;
-        }
-        let n_seg = self.segments.len();
-        let n_fold = self.colon.folds.len();
-        let first_fold = near.partition_point(|&id| (id as usize) < n_seg);
-        let first_polyp = near.partition_point(|&id| (id as usize) < n_seg + n_fold);
-        let (mut best_d2, mut best_s) = (f64::INFINITY, 0.0);
-        for &id in &near[..first_fold] {
-            let (d2, s) = self.segments[id as usize].closest(p);
-            if d2 < best_d2 {
-                (best_d2, best_s) = (d2, s);
-            }
-        }
-        let mut hu = if best_d2.is_finite() {
-            let d = best_d2.sqrt() - self.colon.radius_vox_at(best_s);
-            ramp(d, AIR_HU, TISSUE_HU)
-        } else {
-            TISSUE_HU
-        };
-        for &id in &near[first_fold..first_polyp] {
-            let f = &self.colon.folds[id as usize - n_seg];
-            let d = torus(p, f.centre_vox, f.axis, f.ring_radius_vox, f.depth_vox);
-            hu = paint(hu, d, TISSUE_HU);
-        }
-        for &id in &near[first_polyp..] {
-            let ball = &self.colon.polyps[id as usize - n_seg - n_fold];
-            hu = paint(hu, ball.signed_distance(p), TISSUE_HU);
-        }
-        hu
     }
 }
 
