@@ -12,8 +12,8 @@ use dicom_core::value::DicomValueType;
 use dicom_core::{DicomValue, PrimitiveValue};
 use dicom_dictionary_std::tags;
 use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
-use dicom_object::OpenFileOptions;
-use dicom_pixeldata::PixelDecoder;
+use dicom_object::{DefaultDicomObject, OpenFileOptions};
+use dicom_pixeldata::{DecodedPixelData, PixelDecoder};
 use dicom_transfer_syntax_registry::TransferSyntaxRegistry;
 use rayon::prelude::*;
 use std::path::Path;
@@ -263,10 +263,10 @@ pub(super) fn decode_file(
         DicomValue::PixelSequence(_) => frames
             .into_par_iter()
             .map(|(frame, out)| {
-                let decoded = object.decode_pixel_data_frame(frame).map_err(|e| {
+                let decoded = decode_frame_guarded(&object, frame).map_err(|cause| {
                     ReadError::format(
                         path,
-                        format!("cannot decode frame {frame} ({ts_name}): {}", chain(&e)),
+                        format!("cannot decode frame {frame} ({ts_name}): {cause}"),
                     )
                 })?;
                 let bytes = decoded.data();
@@ -281,6 +281,23 @@ pub(super) fn decode_file(
             path,
             "expected PixelData to hold samples, found a sequence of items",
         )),
+    }
+}
+
+/// Decodes one compressed frame. Third-party decoders have been seen to panic on corrupt data
+/// (dicom-rs 0.10's RLE decoder indexes past its buffer), so a panic there is caught and becomes
+/// an error about the file instead of taking the program down.
+fn decode_frame_guarded(
+    object: &DefaultDicomObject,
+    frame: u32,
+) -> std::result::Result<DecodedPixelData<'_>, String> {
+    let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        object.decode_pixel_data_frame(frame)
+    }));
+    match attempt {
+        Ok(Ok(decoded)) => Ok(decoded),
+        Ok(Err(e)) => Err(chain(&e)),
+        Err(_) => Err("the decoder failed on corrupt data".into()),
     }
 }
 

@@ -1,6 +1,7 @@
 //! Finding DICOM files and reading their headers (everything before the pixel data), in
 //! parallel, into plain structs the later stages can reason about without the DICOM object.
 
+use super::lengths;
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
 use crate::samples::Rescale;
@@ -140,6 +141,9 @@ pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
         Ok(true) => {}
         Ok(false) => return Scanned::NotDicom,
         Err(e) => return Scanned::Unreadable(e),
+    }
+    if let Err(e) = lengths::check_element_lengths(path) {
+        return Scanned::Unreadable(e);
     }
     let object = match OpenFileOptions::new()
         .read_until(tags::PIXEL_DATA)

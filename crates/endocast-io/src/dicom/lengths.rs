@@ -1,0 +1,241 @@
+//! A pre-flight walk over a DICOM file's element headers that refuses any element whose declared
+//! length runs past the end of the file.
+//!
+//! dicom-rs reserves the declared length of an element before reading it, so one flipped byte in
+//! a length field makes it ask for gigabytes. Walking the headers first (seeking over values,
+//! descending into sequences and items) costs a few hundred small reads per file and keeps every
+//! allocation bounded by the file's real size.
+
+use crate::error::{ReadError, Result};
+use std::fs::File;
+use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::path::Path;
+
+/// The "undefined length" marker of sequences, items and encapsulated pixel data.
+const UNDEFINED: u32 = 0xFFFF_FFFF;
+/// Explicit-VR value representations with a 2-byte reserved field and a 4-byte length.
+const LONG_VRS: [&[u8; 2]; 13] = [
+    b"OB", b"OD", b"OF", b"OL", b"OV", b"OW", b"SQ", b"SV", b"UC", b"UN", b"UR", b"UT", b"UV",
+];
+
+/// Every value representation of the standard; an explicit-VR element with any other is corrupt
+/// (and its length field cannot even be located).
+const KNOWN_VRS: [&[u8; 2]; 34] = [
+    b"AE", b"AS", b"AT", b"CS", b"DA", b"DS", b"DT", b"FL", b"FD", b"IS", b"LO", b"LT", b"OB",
+    b"OD", b"OF", b"OL", b"OV", b"OW", b"PN", b"SH", b"SL", b"SQ", b"SS", b"ST", b"SV", b"TM",
+    b"UC", b"UI", b"UL", b"UN", b"UR", b"US", b"UT", b"UV",
+];
+
+/// How the data set after the file meta group is encoded.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Encoding {
+    ExplicitLittle,
+    ImplicitLittle,
+    ExplicitBig,
+}
+
+struct Walker {
+    reader: BufReader<File>,
+    pos: u64,
+    len: u64,
+}
+
+/// Checks that every defined element, item and fragment length in the file at `path` fits in the
+/// bytes that follow it. Deflated data sets are not walked (their lengths refer to inflated data).
+pub(super) fn check_element_lengths(path: &Path) -> Result<()> {
+    let file = File::open(path).map_err(|e| ReadError::io(path, e))?;
+    let len = file.metadata().map_err(|e| ReadError::io(path, e))?.len();
+    let mut w = Walker {
+        reader: BufReader::with_capacity(4096, file),
+        pos: 0,
+        len,
+    };
+    let io = |e| ReadError::io(path, e);
+    let mut magic = [0u8; 4];
+    w.seek_to(128).map_err(io)?;
+    w.read_exact(&mut magic).map_err(io)?;
+    if &magic != b"DICM" {
+        w.seek_to(0).map_err(io)?;
+        w.read_exact(&mut magic).map_err(io)?;
+        if &magic != b"DICM" {
+            w.seek_to(0).map_err(io)?;
+        }
+    }
+    w.walk().map_err(|message| ReadError::format(path, message))
+}
+
+impl Walker {
+    fn seek_to(&mut self, pos: u64) -> std::io::Result<()> {
+        self.reader.seek(SeekFrom::Start(pos))?;
+        self.pos = pos;
+        Ok(())
+    }
+
+    fn read_exact(&mut self, buf: &mut [u8]) -> std::io::Result<()> {
+        self.reader.read_exact(buf)?;
+        self.pos += buf.len() as u64;
+        Ok(())
+    }
+
+    /// Reads `N` bytes, or `None` at the end of the file.
+    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
+        let mut buf = [0u8; N];
+        self.read_exact(&mut buf).ok()?;
+        Some(buf)
+    }
+
+    fn skip(&mut self, length: u64) -> Result<(), String> {
+        self.reader
+            .seek_relative(length as i64)
+            .map_err(|e| e.to_string())?;
+        self.pos += length;
+        Ok(())
+    }
+
+    fn check(&self, tag: (u16, u16), length: u32) -> Result<(), String> {
+        let remaining = self.len - self.pos.min(self.len);
+        if u64::from(length) > remaining {
+            return Err(format!(
+                "element ({:04X},{:04X}) claims {length} bytes but only {remaining} remain in the file",
+                tag.0, tag.1
+            ));
+        }
+        Ok(())
+    }
+
+    /// Walks the meta group (always explicit little endian), then the data set.
+    fn walk(&mut self) -> Result<(), String> {
+        let mut encoding = Encoding::ExplicitLittle;
+        let mut in_meta = true;
+        let mut in_fragments = false;
+        while self.pos + 8 <= self.len {
+            let Some(head) = self.take::<8>() else { break };
+            let group_le = u16::from_le_bytes([head[0], head[1]]);
+            in_meta &= group_le == 0x0002;
+            let current = if in_meta {
+                Encoding::ExplicitLittle
+            } else {
+                encoding
+            };
+            let (tag, length, vr) = self.element_header(head, current)?;
+            if tag.0 == 0xFFFE {
+                in_fragments = self.item(tag, length, in_fragments)?;
+                continue;
+            }
+            if length == UNDEFINED {
+                in_fragments |= tag == (0x7FE0, 0x0010);
+                continue; // a sequence (or encapsulated pixel data): its items follow inline
+            }
+            self.check(tag, length)?;
+            if tag == (0x0002, 0x0010) {
+                match self.transfer_syntax(length)? {
+                    Some(e) => encoding = e,
+                    None => return Ok(()),
+                }
+            } else if vr != Some(*b"SQ") && !self.starts_with_item(length, current)? {
+                self.skip(u64::from(length))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Tag, length and (explicit VR only) the VR of the element whose first 8 bytes are `head`.
+    #[allow(clippy::type_complexity)]
+    fn element_header(
+        &mut self,
+        head: [u8; 8],
+        encoding: Encoding,
+    ) -> Result<((u16, u16), u32, Option<[u8; 2]>), String> {
+        let big = encoding == Encoding::ExplicitBig;
+        let u16_at = |i: usize| {
+            let b = [head[i], head[i + 1]];
+            if big {
+                u16::from_be_bytes(b)
+            } else {
+                u16::from_le_bytes(b)
+            }
+        };
+        let tag = (u16_at(0), u16_at(2));
+        let u32_of = |b: [u8; 4]| {
+            if big {
+                u32::from_be_bytes(b)
+            } else {
+                u32::from_le_bytes(b)
+            }
+        };
+        if tag.0 == 0xFFFE || encoding == Encoding::ImplicitLittle {
+            return Ok((tag, u32_of([head[4], head[5], head[6], head[7]]), None));
+        }
+        let vr = [head[4], head[5]];
+        if !KNOWN_VRS.contains(&&vr) {
+            return Err(format!(
+                "element ({:04X},{:04X}) has an unknown value representation {:?}",
+                tag.0,
+                tag.1,
+                String::from_utf8_lossy(&vr)
+            ));
+        }
+        if LONG_VRS.contains(&&vr) {
+            let long = self
+                .take::<4>()
+                .ok_or("the file ends inside an element header")?;
+            Ok((tag, u32_of(long), Some(vr)))
+        } else {
+            Ok((tag, u32::from(u16_at(6)), Some(vr)))
+        }
+    }
+
+    /// Handles an item or delimiter; returns whether we are still among pixel-data fragments.
+    fn item(&mut self, tag: (u16, u16), length: u32, in_fragments: bool) -> Result<bool, String> {
+        match tag.1 {
+            0xE000 if in_fragments => {
+                if length == UNDEFINED {
+                    return Err("a pixel-data fragment has an undefined length".into());
+                }
+                self.check(tag, length)?;
+                self.skip(u64::from(length))?;
+                Ok(true)
+            }
+            0xE000 => {
+                if length != UNDEFINED {
+                    self.check(tag, length)?;
+                }
+                Ok(false) // the item's elements follow inline
+            }
+            0xE0DD => Ok(false),
+            _ => Ok(in_fragments),
+        }
+    }
+
+    /// Whether a defined-length value begins with an item tag (a sequence whose VR we cannot see,
+    /// in implicit VR or as UN): then we descend into it instead of skipping it.
+    fn starts_with_item(&mut self, length: u32, encoding: Encoding) -> Result<bool, String> {
+        if length < 8 {
+            return Ok(false);
+        }
+        let start = self.pos;
+        let Some(head) = self.take::<4>() else {
+            return Ok(false);
+        };
+        self.seek_to(start).map_err(|e| e.to_string())?;
+        let item = if encoding == Encoding::ExplicitBig {
+            [0xFF, 0xFE, 0xE0, 0x00]
+        } else {
+            [0xFE, 0xFF, 0x00, 0xE0]
+        };
+        Ok(head == item)
+    }
+
+    /// Reads the transfer syntax UID value; `None` for a deflated data set (not walked).
+    fn transfer_syntax(&mut self, length: u32) -> Result<Option<Encoding>, String> {
+        let mut value = vec![0u8; length as usize];
+        self.read_exact(&mut value).map_err(|e| e.to_string())?;
+        let uid = String::from_utf8_lossy(&value);
+        Ok(match uid.trim_end_matches(['\0', ' ']) {
+            "1.2.840.10008.1.2" => Some(Encoding::ImplicitLittle),
+            "1.2.840.10008.1.2.2" => Some(Encoding::ExplicitBig),
+            "1.2.840.10008.1.2.1.99" => None,
+            _ => Some(Encoding::ExplicitLittle),
+        })
+    }
+}
