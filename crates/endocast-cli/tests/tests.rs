@@ -1,5 +1,7 @@
 //! End-to-end tests of the `endocast` binary, one module per topic, one test binary.
 
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
+
 mod bad_input;
 mod common;
 mod info_shared_data;

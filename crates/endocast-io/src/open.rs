@@ -165,9 +165,10 @@ fn sniff(path: &Path) -> Result<Format> {
         Ok(Format::Dicom)
     } else if head.starts_with(b"NRRD000") {
         Ok(Format::Nrrd)
-    } else if head.starts_with(&[0x1f, 0x8b]) {
-        Ok(Format::Nifti)
-    } else if head.len() >= 348 && (&head[344..348] == b"n+1\0" || &head[4..8] == b"n+2\0") {
+    } else if head.starts_with(&[0x1f, 0x8b])
+        || (head.len() >= 348 && (&head[344..348] == b"n+1\0" || &head[4..8] == b"n+2\0"))
+    {
+        // A gzip stream without a telling name is most likely a .nii.gz.
         Ok(Format::Nifti)
     } else if head.starts_with(b"ObjectType") || head.starts_with(b"NDims") {
         Ok(Format::MetaImage)

@@ -200,23 +200,20 @@ fn read_exact_or_truncated(
 }
 
 fn decode_wide(bytes: &[u8], ty: ElementType, endian: Endian) -> f64 {
-    macro_rules! num {
-        ($t:ty, $n:literal) => {{
-            let mut a = [0u8; $n];
-            a.copy_from_slice(bytes);
-            match endian {
-                Endian::Little => <$t>::from_le_bytes(a) as f64,
-                Endian::Big => <$t>::from_be_bytes(a) as f64,
-            }
-        }};
+    let mut le = [0u8; 8];
+    le[..bytes.len()].copy_from_slice(bytes);
+    if endian == Endian::Big {
+        le[..bytes.len()].reverse();
     }
+    let le4 = [le[0], le[1], le[2], le[3]];
     match ty {
-        ElementType::U32 => num!(u32, 4),
-        ElementType::I32 => num!(i32, 4),
-        ElementType::F32 => num!(f32, 4),
-        ElementType::U64 => num!(u64, 8),
-        ElementType::I64 => num!(i64, 8),
-        ElementType::F64 => num!(f64, 8),
+        ElementType::U32 => f64::from(u32::from_le_bytes(le4)),
+        ElementType::I32 => f64::from(i32::from_le_bytes(le4)),
+        ElementType::F32 => f64::from(f32::from_le_bytes(le4)),
+        // 64-bit integers beyond 2^53 round to the nearest f64; they are quantised anyway.
+        ElementType::U64 => u64::from_le_bytes(le) as f64,
+        ElementType::I64 => i64::from_le_bytes(le) as f64,
+        ElementType::F64 => f64::from_le_bytes(le),
         _ => unreachable!("decode_wide is only called for 32- and 64-bit types"),
     }
 }

@@ -8,6 +8,7 @@
 //! only the reader under test.
 
 #![allow(unsafe_code)] // the counting allocator; it only forwards to the system allocator
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
 use endocast_core::{Geometry, Modality, ValueMap, Volume};
 use endocast_io::{open, Limits, OpenOptions};

@@ -1,5 +1,7 @@
 //! Integration tests of the readers and writers, one module per topic, one test binary.
 
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
+
 mod common;
 mod dicom;
 mod metaimage;

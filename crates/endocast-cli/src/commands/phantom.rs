@@ -46,10 +46,11 @@ pub fn run(args: &PhantomArgs) -> Result<()> {
             args.noise
         );
     }
-    let mut options = PhantomOptions::default();
-    options.size = args.size;
-    options.noise_hu = args.noise;
-    options.seed = args.seed;
+    let options = PhantomOptions {
+        size: args.size,
+        noise_hu: args.noise,
+        seed: args.seed,
+    };
     let volume = phantom.build(&options);
     endocast_io::write(&args.output, &volume).context("cannot write the phantom")?;
     let [nx, ny, nz] = volume.dims();
