@@ -17,6 +17,10 @@ pub struct InputArgs {
     /// Refuse volumes with more voxels than this (default: half the memory at 2 bytes a voxel).
     #[arg(long, value_name = "N")]
     pub max_voxels: Option<u64>,
+    /// For files that declare no patient orientation (raw, NRRD without a space): where the
+    /// index axes point, e.g. LPI for slices stored from the top of the head down.
+    #[arg(long, value_name = "CODE")]
+    pub orientation: Option<String>,
     /// Raw input: dimensions X,Y,Z (makes the file be read as headerless samples).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_dims)]
     pub raw_dims: Option<[usize; 3]>,
@@ -43,6 +47,7 @@ impl InputArgs {
             options.limits = Limits::with_max_voxels(max);
         }
         options.raw = self.raw_spec()?;
+        options.orientation.clone_from(&self.orientation);
         endocast_io::open(&self.path, &options).context("cannot read the scan")
     }
 

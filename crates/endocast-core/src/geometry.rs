@@ -159,6 +159,33 @@ impl Geometry {
         .collect()
     }
 
+    /// The same grid with other direction cosines (spacing and origin kept).
+    pub fn with_direction(&self, direction: DMat3) -> Result<Self, GeometryError> {
+        Self::new(self.dims, self.spacing_mm, self.origin_mm, direction)
+    }
+
+    /// The axis-aligned direction matrix an orientation code names, the inverse of
+    /// [`Geometry::orientation_code`]: `"LPS"` is the identity, `"LPI"` a stack running from the
+    /// head down, `"RAS"` the NIfTI convention. Each of the three letters (L/R, P/A, S/I) must name
+    /// a different patient axis; anything else is `None`.
+    pub fn direction_from_code(code: &str) -> Option<DMat3> {
+        let letters: Vec<char> = code.trim().to_ascii_uppercase().chars().collect();
+        let [a, b, c] = letters.as_slice() else {
+            return None;
+        };
+        let axis = |letter: char| match letter {
+            'L' => Some(DVec3::X),
+            'R' => Some(-DVec3::X),
+            'P' => Some(DVec3::Y),
+            'A' => Some(-DVec3::Y),
+            'S' => Some(DVec3::Z),
+            'I' => Some(-DVec3::Z),
+            _ => None,
+        };
+        let m = DMat3::from_cols(axis(*a)?, axis(*b)?, axis(*c)?);
+        (m.determinant().abs() > 0.5).then_some(m)
+    }
+
     /// World-space axis-aligned bounds (min, max) of the voxel centres.
     pub fn world_bounds(&self) -> (DVec3, DVec3) {
         let last = DVec3::new(
@@ -236,6 +263,18 @@ mod tests {
         )
         .unwrap();
         assert_eq!(ras.orientation_code(), "RAS");
+    }
+
+    #[test]
+    fn orientation_codes_round_trip() {
+        for code in ["LPS", "RAS", "LPI", "ASL", "IRP"] {
+            let d = Geometry::direction_from_code(code).unwrap();
+            let g = Geometry::new([2, 2, 2], DVec3::ONE, DVec3::ZERO, d).unwrap();
+            assert_eq!(g.orientation_code(), code);
+        }
+        for bad in ["", "LP", "LLS", "LRS", "XYZ", "LPSI"] {
+            assert!(Geometry::direction_from_code(bad).is_none(), "{bad}");
+        }
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
 use crate::{dicom, metaimage, nifti, nrrd, raw};
-use endocast_core::Volume;
+use endocast_core::{Geometry, Volume};
 use std::io::Read;
 use std::path::Path;
 
@@ -63,6 +63,11 @@ pub struct OpenOptions {
     pub series: Option<String>,
     /// Raw: how to interpret a headerless file. Default: none (raw files are not guessed).
     pub raw: Option<raw::RawSpec>,
+    /// For files that declare no patient orientation (raw, NRRD without an anatomical space):
+    /// the orientation code of their index axes, e.g. `"LPI"` for slices stored from the top of
+    /// the head down. Giving it for a file that declares its own orientation is an error.
+    /// Default: none (such files are read as axis-aligned LPS, with a warning).
+    pub orientation: Option<String>,
 }
 
 /// One DICOM series found in a directory.
@@ -90,6 +95,10 @@ pub struct SourceInfo {
     pub series_uid: Option<String>,
     /// DICOM: every series found, largest first.
     pub series_found: Vec<SeriesSummary>,
+    /// Whether the file states where its axes point in the patient. Raw files and NRRD files
+    /// without an anatomical `space` do not; they are read as axis-aligned LPS unless
+    /// [`OpenOptions::orientation`] says otherwise.
+    pub orientation_declared: bool,
 }
 
 impl SourceInfo {
@@ -100,6 +109,7 @@ impl SourceInfo {
             stored_type: stored_type.into(),
             series_uid: None,
             series_found: Vec::new(),
+            orientation_declared: true,
         }
     }
 }
@@ -132,13 +142,51 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
             None => sniff(path)?,
         }
     };
-    match format {
+    let loaded = match format {
         Format::Dicom => dicom::read(path, options),
         Format::Nifti => nifti::read(path, options),
         Format::Nrrd => nrrd::read(path, options),
         Format::MetaImage => metaimage::read(path, options),
         Format::Raw => raw::read(path, options),
+    }?;
+    apply_orientation(path, loaded, options.orientation.as_deref())
+}
+
+/// Gives an undeclared orientation the code the user named (see [`OpenOptions::orientation`]).
+fn apply_orientation(path: &Path, mut loaded: Loaded, code: Option<&str>) -> Result<Loaded> {
+    let Some(code) = code else {
+        return Ok(loaded);
+    };
+    if loaded.source.orientation_declared {
+        return Err(ReadError::inconsistent(
+            path,
+            format!(
+                "the file declares its own orientation ({}); an assumed orientation ({code}) \
+                 applies only to files that declare none",
+                loaded.volume.geometry().orientation_code()
+            ),
+        ));
     }
+    let direction = Geometry::direction_from_code(code).ok_or_else(|| {
+        ReadError::format(
+            path,
+            format!("orientation {code:?} is not three of L/R, P/A, S/I naming different axes"),
+        )
+    })?;
+    let geometry = loaded
+        .volume
+        .geometry()
+        .with_direction(direction)
+        .map_err(|e| ReadError::format(path, e.to_string()))?;
+    let volume = loaded.volume;
+    let (map, modality) = (volume.value_map(), volume.modality().clone());
+    loaded.volume = Volume::new(geometry, volume.into_voxels(), map, modality)
+        .map_err(|e| ReadError::format(path, e.to_string()))?;
+    loaded.warnings.push(format!(
+        "{}: orientation {code} assumed, as asked",
+        path.display()
+    ));
+    Ok(loaded)
 }
 
 /// Writes `volume` to `path` atomically, in the format its extension names

@@ -68,9 +68,11 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         Endian::Little => "little-endian",
         Endian::Big => "big-endian",
     };
+    let mut source = SourceInfo::new(Format::Raw, format!("{} {endian}", spec.element.name()));
+    source.orientation_declared = false;
     Ok(Loaded {
         volume,
-        source: SourceInfo::new(Format::Raw, format!("{} {endian}", spec.element.name())),
+        source,
         warnings,
     })
 }

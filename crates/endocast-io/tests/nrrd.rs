@@ -65,7 +65,7 @@ fn stanford_cthead_slices_follow_the_pattern() {
     // The header declares no space, only `spacings`, so the grid is read axis-aligned with k
     // running towards +z: CThead.1 (the top of the head, says the README) gets the SMALLEST
     // world z, i.e. it ends up inferior. The header, not the reader, lacks the orientation;
-    // `cthead_with_declared_orientation_puts_the_vertex_on_top` shows the header that fixes it.
+    // `cthead_with_an_assumed_orientation_puts_the_vertex_on_top` shows the option that fixes it.
     let g = volume.geometry();
     let z_first = g.world_of(DVec3::new(128.0, 128.0, 0.0)).z;
     let z_last = g.world_of(DVec3::new(128.0, 128.0, 112.0)).z;
@@ -73,32 +73,43 @@ fn stanford_cthead_slices_follow_the_pattern() {
 }
 
 #[test]
-fn cthead_with_declared_orientation_puts_the_vertex_on_top() {
+fn cthead_with_an_assumed_orientation_puts_the_vertex_on_top() {
     let Some(dir) = shared_data("head-ct-stanford-cthead") else {
         return;
     };
-    let tmp = tempfile::tempdir().unwrap();
-    let header = tmp.path().join("CThead_lps.nhdr");
-    let pattern = dir.join("CThead.%d");
-    std::fs::write(
-        &header,
-        format!(
-            "NRRD0004\ntype: short\ndimension: 3\nsizes: 256 256 113\nendian: big\n\
-             encoding: raw\nspace: left-posterior-superior\n\
-             space directions: (1,0,0) (0,1,0) (0,0,-2)\nspace origin: (0,0,224)\n\
-             data file: {} 1 113 1\n",
-            pattern.display()
-        ),
-    )
-    .unwrap();
-    let loaded = read(&header);
-    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
-    let g = loaded.volume.geometry();
-    let z_of_k = |k: f64| g.world_of(DVec3::new(128.0, 128.0, k)).z;
-    // CThead.1 is k = 0: the most superior slice in LPS.
-    assert!((0..113).all(|k| z_of_k(0.0) >= z_of_k(f64::from(k))));
-    assert_eq!(z_of_k(0.0), 224.0);
+    let path = dir.join("CThead.nhdr");
+    assert!(read(&path)
+        .warnings
+        .iter()
+        .any(|w| w.contains("declares no patient orientation")));
+    let mut options = OpenOptions::default();
+    options.orientation = Some("LPI".into());
+    let loaded = endocast_io::open(&path, &options).unwrap();
+    let volume = &loaded.volume;
+    // The README's landmark, seen in the voxels: CThead.1 (k = 0) is the vertex, a small cap of
+    // skull and scalp, while a slice through the middle of the head is full of tissue.
+    let tissue = |k: usize| {
+        let [nx, ny, _] = volume.dims();
+        (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| (i, j)))
+            .filter(|&(i, j)| volume.physical(i, j, k).unwrap() > 550.0)
+            .count()
+    };
+    assert!(
+        tissue(0) * 4 < tissue(56),
+        "{} vs {}",
+        tissue(0),
+        tissue(56)
+    );
+    // With the orientation given, that slice is the most superior one in LPS.
+    let g = volume.geometry();
     assert_eq!(g.orientation_code(), "LPI");
+    let z_of_k = |k: f64| g.world_of(DVec3::new(128.0, 128.0, k)).z;
+    assert!(z_of_k(0.0) > z_of_k(112.0));
+    // A file that declares its orientation refuses an assumed one.
+    if let Some(flair) = shared_data("brain-mri-flair-nrrd") {
+        assert!(endocast_io::open(&flair.join("FLAIR.nrrd"), &options).is_err());
+    }
 }
 
 #[test]
@@ -122,7 +133,8 @@ fn vtk_headsq_with_and_without_the_forbidden_space_line() {
     assert_eq!(original.volume.value_map(), clean.volume.value_map());
     assert_eq!(original.warnings.len(), 1, "{:?}", original.warnings);
     assert!(original.warnings[0].contains("spacings"));
-    assert!(clean.warnings.is_empty(), "{:?}", clean.warnings);
+    assert_eq!(clean.warnings.len(), 1, "{:?}", clean.warnings);
+    assert!(clean.warnings[0].contains("no patient orientation"));
     // Little-endian slice files: voxel (32, 32) of quarter.1.
     let bytes = std::fs::read(dir.join("quarter.1")).unwrap();
     let at = 2 * (32 * 64 + 32);

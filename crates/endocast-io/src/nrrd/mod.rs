@@ -41,9 +41,12 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         data::read_samples(path, &header, count, endian, &options.limits, &mut warnings)?;
     let volume = Volume::new(geometry, voxels, map, Modality::Unknown)
         .map_err(|e| ReadError::format(path, e.to_string()))?;
+    let mut source = SourceInfo::new(Format::Nrrd, stored_type(&header, endian));
+    source.orientation_declared = header.space_directions.is_some()
+        && matches!(header.space, Some(Space::Lps | Space::Ras | Space::Las));
     Ok(Loaded {
         volume,
-        source: SourceInfo::new(Format::Nrrd, stored_type(&header, endian)),
+        source,
         warnings,
     })
 }
@@ -171,6 +174,13 @@ fn from_spacings(
              as an axis-aligned grid",
             path.display(),
             space.name()
+        ));
+    }
+    if header.space.is_none() && header.spacings.is_some() {
+        warnings.push(format!(
+            "{}: the header declares no patient orientation (spacings without a space); read as \
+             axis-aligned LPS (give the orientation, e.g. LPI, if you know it)",
+            path.display()
         ));
     }
     let Some(spacings) = &header.spacings else {
