@@ -1,0 +1,217 @@
+//! The paper's culling structure: the minimum and maximum stored value of every 8³ brick
+//! ([`BrickGrid`], built once per volume) and which bricks matter for the current isovalues and
+//! transfer function ([`Activity`], re-classified in about a millisecond whenever they change).
+
+use super::transfer::TfTable;
+use crate::Volume;
+use rayon::prelude::*;
+
+/// Edge of a brick in voxels. 8³ is the paper's choice: small enough to hug a lumen wall a few
+/// millimetres thick, large enough that the brick walk costs little next to the samples.
+pub const BRICK_VOX: usize = 8;
+
+/// Minimum and maximum stored value per brick. Brick `b` along an axis covers the positions
+/// `[8b, 8b + 8]` in voxel index space, so its range is taken over voxels `8b ..= 8b + 8`: the
+/// extra voxel is the trilinear footprint of the positions next to the upper face, so no value a
+/// sample inside the brick can take (no isosurface crossing) lies outside `[min, max]`.
+#[derive(Debug, Clone)]
+pub struct BrickGrid {
+    bricks: [usize; 3],
+    min: Vec<u16>,
+    max: Vec<u16>,
+}
+
+impl BrickGrid {
+    /// Scans the volume once, slabs of bricks in parallel.
+    pub fn new(volume: &Volume) -> Self {
+        let dims = volume.dims();
+        let bricks = dims.map(bricks_along);
+        let voxels = volume.voxels();
+        let slab = bricks[0] * bricks[1];
+        let mut min = vec![0u16; slab * bricks[2]];
+        let mut max = vec![0u16; slab * bricks[2]];
+        min.par_chunks_mut(slab)
+            .zip(max.par_chunks_mut(slab))
+            .enumerate()
+            .for_each(|(bk, (min_slab, max_slab))| {
+                for bj in 0..bricks[1] {
+                    for bi in 0..bricks[0] {
+                        let (lo, hi) = brick_range(voxels, dims, [bi, bj, bk]);
+                        min_slab[bi + bricks[0] * bj] = lo;
+                        max_slab[bi + bricks[0] * bj] = hi;
+                    }
+                }
+            });
+        Self { bricks, min, max }
+    }
+
+    /// Number of bricks along `i`, `j`, `k`.
+    pub fn bricks(&self) -> [usize; 3] {
+        self.bricks
+    }
+
+    /// Total number of bricks.
+    pub fn len(&self) -> usize {
+        self.min.len()
+    }
+
+    /// Always false: a volume has at least one voxel, hence one brick.
+    pub fn is_empty(&self) -> bool {
+        self.min.is_empty()
+    }
+
+    /// Smallest stored value a sample in brick `index` can take.
+    #[inline]
+    pub fn min(&self, index: usize) -> u16 {
+        self.min[index]
+    }
+
+    /// Largest stored value a sample in brick `index` can take.
+    #[inline]
+    pub fn max(&self, index: usize) -> u16 {
+        self.max[index]
+    }
+
+    /// Linear index of brick `(bi, bj, bk)` (`bi` fastest).
+    #[inline]
+    pub fn index(&self, brick: [usize; 3]) -> usize {
+        brick[0] + self.bricks[0] * (brick[1] + self.bricks[1] * brick[2])
+    }
+}
+
+/// Bricks needed along an axis of `n` voxels: positions run over `[0, n − 1]`.
+fn bricks_along(n: usize) -> usize {
+    (n.saturating_sub(1)).div_ceil(BRICK_VOX).max(1)
+}
+
+/// Min and max over voxels `8b ..= 8b + 8` (clamped to the grid) of brick `b`.
+fn brick_range(voxels: &[u16], dims: [usize; 3], brick: [usize; 3]) -> (u16, u16) {
+    let span = |axis: usize| {
+        let start = brick[axis] * BRICK_VOX;
+        start..=(start + BRICK_VOX).min(dims[axis] - 1)
+    };
+    let (mut lo, mut hi) = (u16::MAX, u16::MIN);
+    for k in span(2) {
+        for j in span(1) {
+            let row = dims[0] * (j + dims[1] * k);
+            let i = span(0);
+            for &v in &voxels[row + i.start()..=row + i.end()] {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+    }
+    (lo, hi)
+}
+
+/// A bit per brick.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct BitSet {
+    words: Vec<u64>,
+}
+
+impl BitSet {
+    /// Bits `index` for which `is_set(index)`, for `index < len`.
+    fn from_fn(len: usize, is_set: impl Fn(usize) -> bool + Sync) -> Self {
+        let words = (0..len.div_ceil(64))
+            .into_par_iter()
+            .map(|w| {
+                (0..64)
+                    .map(|b| w * 64 + b)
+                    .take_while(|&i| i < len)
+                    .fold(0u64, |word, i| word | (u64::from(is_set(i)) << (i % 64)))
+            })
+            .collect();
+        Self { words }
+    }
+
+    /// Whether bit `index` is set (false past the end).
+    #[inline]
+    pub fn get(&self, index: usize) -> bool {
+        self.words
+            .get(index / 64)
+            .is_some_and(|w| w >> (index % 64) & 1 == 1)
+    }
+
+    /// Number of set bits.
+    pub fn count(&self) -> usize {
+        self.words.iter().map(|w| w.count_ones() as usize).sum()
+    }
+}
+
+/// The paper's two bit arrays (§3.2): bricks a sample of which can cross one of the isovalues,
+/// and bricks a sample of which has non-zero opacity under the transfer function.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Activity {
+    /// Active for an isosurface: `min ≤ iso ≤ max` for one of the isovalues.
+    pub iso: BitSet,
+    /// Active for the transfer function: some value in `[min, max]` is not transparent.
+    pub tf: BitSet,
+}
+
+impl Activity {
+    /// Classifies every brick against isovalues given in stored units and a lookup table.
+    /// Half a stored unit of margin absorbs the rounding of `f32` trilinear samples.
+    pub fn classify(grid: &BrickGrid, isovalues_stored: &[f32], table: &TfTable) -> Self {
+        const MARGIN: f32 = 0.5;
+        let iso = BitSet::from_fn(grid.len(), |b| {
+            let (lo, hi) = (f32::from(grid.min(b)), f32::from(grid.max(b)));
+            isovalues_stored
+                .iter()
+                .any(|&iso| lo - MARGIN <= iso && iso <= hi + MARGIN)
+        });
+        let tf = BitSet::from_fn(grid.len(), |b| table.any_opacity(grid.min(b), grid.max(b)));
+        Self { iso, tf }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::transfer::TransferFunction;
+    use super::*;
+    use crate::{Geometry, Modality, ValueMap};
+    use glam::DVec3;
+
+    fn ramp_volume(dims: [usize; 3]) -> Volume {
+        let g = Geometry::axis_aligned(dims, DVec3::ONE, DVec3::ZERO).unwrap();
+        let voxels = (0..dims[0] * dims[1] * dims[2])
+            .map(|n| (n % dims[0]) as u16)
+            .collect();
+        Volume::new(g, voxels, ValueMap::IDENTITY, Modality::Unknown).unwrap()
+    }
+
+    #[test]
+    fn ranges_cover_the_trilinear_footprint() {
+        // Value = i: brick 0 spans voxels 0..=8, brick 1 voxels 8..=16, brick 2 16..=19.
+        let grid = BrickGrid::new(&ramp_volume([20, 3, 1]));
+        assert_eq!(grid.bricks(), [3, 1, 1]);
+        assert_eq!((grid.min(0), grid.max(0)), (0, 8));
+        assert_eq!((grid.min(1), grid.max(1)), (8, 16));
+        assert_eq!((grid.min(2), grid.max(2)), (16, 19));
+        // 17 voxels: positions [0, 16] fit two bricks exactly.
+        assert_eq!(BrickGrid::new(&ramp_volume([17, 1, 1])).bricks(), [2, 1, 1]);
+        assert_eq!(BrickGrid::new(&ramp_volume([1, 1, 1])).bricks(), [1, 1, 1]);
+    }
+
+    #[test]
+    fn classification_follows_isovalues_and_the_transfer_function() {
+        let volume = ramp_volume([20, 3, 1]);
+        let grid = BrickGrid::new(&volume);
+        let tf = TransferFunction::from_points(
+            &[(0.0, 0.0), (17.0, 0.0), (18.0, 1.0)],
+            &[(0.0, [1.0; 3])],
+        )
+        .unwrap();
+        let table = TfTable::new(&tf, volume.value_map(), volume.stored_range(), 1.0);
+        let activity = Activity::classify(&grid, &[12.0], &table);
+        let bits = |set: &BitSet| (0..3).map(|b| set.get(b)).collect::<Vec<_>>();
+        assert_eq!(bits(&activity.iso), [false, true, false]);
+        // Brick 1 reaches 16; with one stored unit of margin the table is read up to 17, which
+        // is still transparent.
+        assert_eq!(bits(&activity.tf), [false, false, true]);
+        assert_eq!(activity.iso.count(), 1);
+        let both = Activity::classify(&grid, &[8.0, 30.0], &table);
+        assert_eq!(bits(&both.iso), [true, true, false]);
+        assert!(!both.iso.get(1000));
+    }
+}

@@ -1,0 +1,359 @@
+//! The integrators: one small function per render mode, each a composition of the shared
+//! pieces — [`Integrator::first_hit`] (the isosurface search of §3.3), [`Integrator::surface`]
+//! (gradient, normal, Blinn-Phong), [`Integrator::composite`] (front-to-back DVR with early
+//! termination) — over a [`RayMarch`].
+
+use super::bricks::{Activity, BrickGrid};
+use super::march::{Flow, Line, RayMarch, Sample};
+use super::sample::{Accum, Sampler, Shader};
+use super::settings::{Crossing, Mode};
+use super::transfer::TfTable;
+use glam::Vec3;
+use std::cell::Cell;
+
+/// Receives every sample an integrator composites or tests (the `--debug-pixel` trace). `()`
+/// ignores them at no cost.
+pub(crate) trait Probe {
+    /// A sample at `t` mm of stored value `value`; `alpha` is the opacity accumulated after it.
+    fn sample(&mut self, t: f32, value: f32, alpha: f32);
+}
+
+impl Probe for () {
+    #[inline]
+    fn sample(&mut self, _t: f32, _value: f32, _alpha: f32) {}
+}
+
+/// An isosurface as the integrators need it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Surface {
+    /// Isovalue, stored units.
+    pub iso: f32,
+    /// Opacity, 0–1.
+    pub opacity: f32,
+    /// Colour before shading.
+    pub color: Vec3,
+}
+
+/// The numbers derived from the settings that the integrators read.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Params {
+    pub mode: Mode,
+    pub lower: Surface,
+    pub upper: Surface,
+    pub crossing: Crossing,
+    pub early_termination: f32,
+    pub refine_steps: u32,
+    pub shade_dvr: bool,
+    pub skip_empty: bool,
+}
+
+/// What a ray produced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PixelOut {
+    /// Premultiplied colour and opacity.
+    pub accum: Accum,
+    /// Distance to the first isosurface hit, mm (NaN where none).
+    pub depth_mm: f32,
+    /// Extreme stored value of MIP/MinIP (NaN otherwise or where no sample was taken).
+    pub value: f32,
+    /// Whether early termination stopped the ray.
+    pub terminated: bool,
+}
+
+impl Default for PixelOut {
+    fn default() -> Self {
+        Self {
+            accum: Accum::default(),
+            depth_mm: f32::NAN,
+            value: f32::NAN,
+            terminated: false,
+        }
+    }
+}
+
+/// A refined isosurface hit.
+#[derive(Debug, Clone, Copy)]
+struct Hit {
+    t: f32,
+}
+
+/// The per-frame context of the integrators.
+pub(crate) struct Integrator<'a> {
+    pub sampler: Sampler<'a>,
+    pub grid: &'a BrickGrid,
+    pub activity: &'a Activity,
+    pub table: &'a TfTable,
+    pub shader: Shader,
+    pub params: Params,
+}
+
+impl Integrator<'_> {
+    /// Renders one ray in the configured mode; `dir_world` is its unit world direction.
+    pub fn run(&self, march: &mut RayMarch, dir_world: Vec3, probe: &mut impl Probe) -> PixelOut {
+        match self.params.mode {
+            Mode::Iso => self.iso(march, dir_world, probe, false),
+            Mode::Hybrid => self.iso(march, dir_world, probe, true),
+            Mode::Dvr => {
+                let mut out = PixelOut::default();
+                self.composite(march, &mut out, dir_world, self.params.shade_dvr, probe);
+                out
+            }
+            Mode::TwoIso => self.two_iso(march, dir_world, probe),
+            Mode::Mip => self.extreme(march, probe, |a, b| a > b),
+            Mode::Minip => self.extreme(march, probe, |a, b| a < b),
+        }
+    }
+
+    /// Whether brick `b` can hold an isosurface crossing.
+    #[inline]
+    fn iso_active(&self, b: u32) -> bool {
+        !self.params.skip_empty || self.activity.iso.get(b as usize)
+    }
+
+    /// Whether brick `b` can hold a visible DVR sample.
+    #[inline]
+    fn tf_active(&self, b: u32) -> bool {
+        !self.params.skip_empty || self.activity.tf.get(b as usize)
+    }
+
+    /// Iso and hybrid: the first hit, the shaded surface weighted by its opacity, then (hybrid)
+    /// unshaded DVR behind it from that opacity on (§3.3).
+    fn iso(
+        &self,
+        march: &mut RayMarch,
+        dir_world: Vec3,
+        probe: &mut impl Probe,
+        volume_behind: bool,
+    ) -> PixelOut {
+        let mut out = PixelOut::default();
+        let surface = self.params.lower;
+        let Some(hit) = self.first_hit(march, surface.iso, probe) else {
+            return out;
+        };
+        out.depth_mm = hit.t;
+        let lit = self.surface(march.line().at(hit.t), surface.color, dir_world);
+        out.accum.under_surface(lit, surface.opacity);
+        if volume_behind {
+            self.composite(march, &mut out, dir_world, false, probe);
+        }
+        out
+    }
+
+    /// Whether the value rises through `iso` at the surface, for a ray starting at `march`.
+    fn rising(&self, march: &RayMarch, iso: f32) -> bool {
+        match self.params.crossing {
+            Crossing::Rising => true,
+            Crossing::Falling => false,
+            Crossing::Auto => self.sampler.value(march.line().at(march.t_start())) < iso,
+        }
+    }
+
+    /// The first crossing of `iso` in iso-active bricks, refined; the march is left so that the
+    /// next walk starts with the first sample past the crossing.
+    fn first_hit(&self, march: &mut RayMarch, iso: f32, probe: &mut impl Probe) -> Option<Hit> {
+        let rising = self.rising(march, iso);
+        let mut previous = (0.0f32, 0.0f32);
+        let mut hit = None;
+        march.walk(
+            &self.sampler,
+            true,
+            |b| self.iso_active(b),
+            |s: Sample| {
+                probe.sample(s.t, s.value, 0.0);
+                if !s.fresh && crosses(previous.1, s.value, iso, rising) {
+                    hit = Some(previous.0);
+                    previous = (s.t, s.value);
+                    return Flow::StopBefore;
+                }
+                previous = (s.t, s.value);
+                Flow::Continue
+            },
+        );
+        let t_before = hit?;
+        let t = self.refine(march.line(), iso, rising, (t_before, previous.0));
+        Some(Hit { t })
+    }
+
+    /// Bisection of the bracket `(t_before, t_after)` around a crossing, then linear
+    /// interpolation inside the final bracket (no refinement: the sample after the crossing).
+    fn refine(&self, line: Line, iso: f32, rising: bool, (mut a, mut b): (f32, f32)) -> f32 {
+        if self.params.refine_steps == 0 {
+            return b;
+        }
+        let value = |t: f32| self.sampler.value(line.at(t));
+        let (mut va, mut vb) = (value(a), value(b));
+        for _ in 0..self.params.refine_steps {
+            let m = 0.5 * (a + b);
+            let vm = value(m);
+            if (vm >= iso) == rising {
+                (b, vb) = (m, vm);
+            } else {
+                (a, va) = (m, vm);
+            }
+        }
+        let span = vb - va;
+        let f = if span != 0.0 {
+            ((iso - va) / span).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        a + (b - a) * f
+    }
+
+    /// The shaded colour of a surface of base colour `color` at voxel position `p`.
+    fn surface(&self, p: Vec3, color: Vec3, dir_world: Vec3) -> Vec3 {
+        let normal = self.shader.normal(self.sampler.gradient(p));
+        self.shader.shade(color, normal, dir_world)
+    }
+
+    /// Composites one DVR sample through the transfer function, shaded on request.
+    #[inline]
+    fn add_sample(&self, acc: &mut Accum, line: Line, s: Sample, dir_world: Vec3, shade: bool) {
+        let [r, g, b, alpha] = self.table.lookup(s.value);
+        if alpha <= 0.0 {
+            return;
+        }
+        let mut rgb = Vec3::new(r, g, b);
+        if shade {
+            rgb = self.surface(line.at(s.t), rgb / alpha, dir_world) * alpha;
+        }
+        acc.under(rgb, alpha);
+    }
+
+    /// Front-to-back DVR in TF-active bricks onto `out`, until early termination.
+    fn composite(
+        &self,
+        march: &mut RayMarch,
+        out: &mut PixelOut,
+        dir_world: Vec3,
+        shade: bool,
+        probe: &mut impl Probe,
+    ) {
+        let stop = self.params.early_termination;
+        if out.accum.alpha >= stop {
+            out.terminated = true;
+            return;
+        }
+        let acc = &mut out.accum;
+        let line = march.line();
+        let terminated = march.walk(
+            &self.sampler,
+            false,
+            |b| self.tf_active(b),
+            |s: Sample| {
+                self.add_sample(acc, line, s, dir_world, shade);
+                probe.sample(s.t, s.value, acc.alpha);
+                if acc.alpha >= stop {
+                    Flow::Stop
+                } else {
+                    Flow::Continue
+                }
+            },
+        );
+        out.terminated = terminated;
+    }
+
+    /// Two surfaces and DVR outside both: every sample is tested for a crossing of either
+    /// isovalue since the previous one (surfaces composited in depth order), then composited by
+    /// the transfer function if it lies outside the band between the isovalues.
+    fn two_iso(&self, march: &mut RayMarch, dir_world: Vec3, probe: &mut impl Probe) -> PixelOut {
+        let (lower, upper) = (self.params.lower, self.params.upper);
+        let stop = self.params.early_termination;
+        let mut out = PixelOut::default();
+        let mut previous = (0.0f32, 0.0f32);
+        let line = march.line();
+        let acc = &mut out.accum;
+        let depth = &mut out.depth_mm;
+        let terminated = march.walk(
+            &self.sampler,
+            true,
+            |b| self.iso_active(b) || self.tf_active(b),
+            |s: Sample| {
+                if !s.fresh {
+                    let mut hits = [lower, upper].map(|surface| {
+                        let rising = previous.1 < surface.iso;
+                        crosses(previous.1, s.value, surface.iso, rising).then(|| {
+                            let t = self.refine(line, surface.iso, rising, (previous.0, s.t));
+                            (t, surface)
+                        })
+                    });
+                    if let [Some(a), Some(b)] = &hits {
+                        if b.0 < a.0 {
+                            hits.swap(0, 1);
+                        }
+                    }
+                    for (t, surface) in hits.into_iter().flatten() {
+                        if depth.is_nan() {
+                            *depth = t;
+                        }
+                        let lit = self.surface(line.at(t), surface.color, dir_world);
+                        acc.under_surface(lit, surface.opacity);
+                    }
+                }
+                if s.value < lower.iso || s.value > upper.iso {
+                    self.add_sample(acc, line, s, dir_world, self.params.shade_dvr);
+                }
+                previous = (s.t, s.value);
+                probe.sample(s.t, s.value, acc.alpha);
+                if acc.alpha >= stop {
+                    Flow::Stop
+                } else {
+                    Flow::Continue
+                }
+            },
+        );
+        out.terminated = terminated;
+        out
+    }
+
+    /// MIP (`better = >`) or MinIP (`better = <`): the extreme sample; bricks whose range cannot
+    /// beat the current extreme are skipped.
+    fn extreme(
+        &self,
+        march: &mut RayMarch,
+        probe: &mut impl Probe,
+        better: impl Fn(f32, f32) -> bool,
+    ) -> PixelOut {
+        let best = Cell::new(f32::NAN);
+        let maximum = better(1.0, 0.0);
+        march.walk(
+            &self.sampler,
+            false,
+            |b| {
+                let bound = if maximum {
+                    self.grid.max(b as usize)
+                } else {
+                    self.grid.min(b as usize)
+                };
+                !self.params.skip_empty
+                    || best.get().is_nan()
+                    || better(f32::from(bound), best.get())
+            },
+            |s: Sample| {
+                if best.get().is_nan() || better(s.value, best.get()) {
+                    best.set(s.value);
+                }
+                probe.sample(s.t, s.value, 0.0);
+                Flow::Continue
+            },
+        );
+        let mut out = PixelOut::default();
+        let value = best.get();
+        if !value.is_nan() {
+            out.value = value;
+            out.accum
+                .under_surface(Vec3::from(self.table.color(value)), 1.0);
+        }
+        out
+    }
+}
+
+/// Whether the value goes from `before` to `after` across `iso` in the given direction.
+#[inline]
+fn crosses(before: f32, after: f32, iso: f32, rising: bool) -> bool {
+    if rising {
+        before < iso && after >= iso
+    } else {
+        before >= iso && after < iso
+    }
+}

@@ -1,0 +1,368 @@
+//! The perspective ray caster of Scharsach et al., "Perspective Isosurface and Direct Volume
+//! Rendering for Virtual Endoscopy Applications" (EuroVis 2006), on the CPU.
+//!
+//! Three objects with three lifetimes (as in Open VKL):
+//! - [`Renderer`]: the volume and its [`BrickGrid`] (min/max per 8³ brick), built once;
+//! - [`Prepared`]: what the settings imply — the transfer function's [`TfTable`] and the
+//!   brick [`Activity`] — rebuilt in milliseconds whenever an isovalue or the TF changes;
+//! - [`Camera`]: one per frame.
+//!
+//! Each pixel's ray is moved into voxel space, starts on the near plane (eye inside the volume)
+//! or where it enters the volume, walks the brick grid ([`traverse`]), samples only in active
+//! bricks on a fixed per-ray sample grid, and is integrated by its mode's small function
+//! (`integrate`). Tiles of pixels are rendered in parallel; every pixel is a pure function of
+//! its index, so the image does not depend on the thread count.
+//!
+//! ```
+//! use endocast_core::phantom::{self, PhantomOptions};
+//! use endocast_core::render::{Camera, Mode, RenderSettings, Renderer};
+//! use glam::DVec3;
+//!
+//! let (volume, shell) = phantom::sphere_shell(&PhantomOptions { size: 32, ..Default::default() });
+//! let centre_mm = volume.geometry().world_of(shell.centre_vox);
+//! let renderer = Renderer::new(volume);
+//! let mut settings = RenderSettings::default();
+//! settings.mode = Mode::Iso;
+//! let prepared = renderer.prepare(&settings).unwrap();
+//! let camera = Camera::look_at(centre_mm, centre_mm + DVec3::Z, DVec3::Y, 90.0, [16, 16]).unwrap();
+//! let frame = prepared.render(&camera);
+//! // From the centre every ray hits the inner wall at its radius (1 mm voxels).
+//! assert!(frame.depth_mm.iter().all(|d| (d - shell.inner_radius_vox as f32).abs() < 0.05));
+//! ```
+
+mod bricks;
+mod camera;
+mod frame;
+mod integrate;
+mod march;
+mod sample;
+mod settings;
+mod transfer;
+pub mod traverse;
+
+#[cfg(test)]
+mod tests;
+
+pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
+pub use camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
+pub use frame::{Frame, RenderStats};
+pub use sample::{Accum, Lighting, Sampler, Shader};
+pub use settings::{Crossing, Mode, RenderSettings, SettingsError};
+pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
+
+use frame::to_u8;
+use glam::{DAffine3, DVec3, Vec3};
+use integrate::{Integrator, Params, PixelOut, Probe, Surface};
+use march::RayMarch;
+use rayon::prelude::*;
+use std::time::Instant;
+use traverse::VoxelRay;
+
+use crate::Volume;
+
+/// Edge of the square pixel tiles rendered as one task.
+const TILE: usize = 16;
+
+/// A volume ready for rendering: the volume and its brick grid (built once).
+#[derive(Debug, Clone)]
+pub struct Renderer {
+    volume: Volume,
+    grid: BrickGrid,
+}
+
+impl Renderer {
+    /// Builds the brick grid of `volume` (one parallel pass over the voxels).
+    pub fn new(volume: Volume) -> Self {
+        let grid = BrickGrid::new(&volume);
+        Self { volume, grid }
+    }
+
+    /// The volume.
+    pub fn volume(&self) -> &Volume {
+        &self.volume
+    }
+
+    /// The brick grid.
+    pub fn grid(&self) -> &BrickGrid {
+        &self.grid
+    }
+
+    /// Gives the volume back.
+    pub fn into_volume(self) -> Volume {
+        self.volume
+    }
+
+    /// Classifies the bricks and tabulates the transfer function for `settings` (cheap: about a
+    /// millisecond for a 512³ volume). Fails when a setting is out of range.
+    pub fn prepare(&self, settings: &RenderSettings) -> Result<Prepared<'_>, SettingsError> {
+        settings.validate()?;
+        let geometry = self.volume.geometry();
+        let map = self.volume.value_map();
+        let step_mm = settings.step_mm(geometry.spacing_mm().min_element());
+        let mut table = TfTable::new(&settings.tf, map, self.volume.stored_range(), step_mm);
+        let stored = |hu: f64| map.stored_from_physical(hu) as f32;
+        // A negative scale turns the order of stored values around; keep "lower" lower.
+        let (lower_hu, upper_hu) = if map.scale() > 0.0 {
+            (settings.iso_hu, settings.iso2_hu)
+        } else {
+            (settings.iso2_hu, settings.iso_hu)
+        };
+        let mut isovalues = vec![stored(settings.iso_hu)];
+        if settings.mode == Mode::TwoIso {
+            table.make_transparent_between(stored(lower_hu), stored(upper_hu));
+            isovalues.push(stored(settings.iso2_hu));
+        }
+        let activity = Activity::classify(&self.grid, &isovalues, &table);
+        let surface = |iso_hu: f64, opacity: f32, color: [f32; 3]| Surface {
+            iso: stored(iso_hu),
+            opacity,
+            color: Vec3::from(color),
+        };
+        let params = Params {
+            mode: settings.mode,
+            lower: surface(settings.iso_hu, settings.iso_opacity, settings.iso_color),
+            upper: surface(settings.iso2_hu, settings.iso2_opacity, settings.iso2_color),
+            crossing: settings.crossing,
+            early_termination: settings.early_termination,
+            refine_steps: settings.refine_steps,
+            shade_dvr: settings.shade_dvr,
+            skip_empty: settings.skip_empty,
+        };
+        let shader = Shader::new(geometry.world_from_voxel().matrix3, settings.lighting);
+        Ok(Prepared {
+            renderer: self,
+            settings: settings.clone(),
+            table,
+            activity,
+            params,
+            shader,
+            step_mm,
+            voxel_from_world: geometry.voxel_from_world(),
+        })
+    }
+}
+
+/// A renderer with its settings applied: renders frames for any camera.
+#[derive(Debug)]
+pub struct Prepared<'a> {
+    renderer: &'a Renderer,
+    settings: RenderSettings,
+    table: TfTable,
+    activity: Activity,
+    params: Params,
+    shader: Shader,
+    step_mm: f64,
+    voxel_from_world: DAffine3,
+}
+
+/// One sample of a traced pixel (see [`Prepared::trace_pixel`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceSample {
+    /// Distance from the eye, mm.
+    pub t_mm: f32,
+    /// Interpolated physical value.
+    pub value: f64,
+    /// Opacity accumulated after this sample.
+    pub alpha: f32,
+}
+
+/// Everything about one pixel's ray: set-up, every sample, and the result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PixelTrace {
+    /// The ray in voxel space (mm parametrisation).
+    pub ray: VoxelRay,
+    /// The ray's part inside the volume, mm from the eye; `None` when it misses.
+    pub range_mm: Option<(f64, f64)>,
+    /// Distance between samples, mm.
+    pub step_mm: f64,
+    /// Offset of the sample grid from the start, in steps (0.5 without jitter).
+    pub offset: f32,
+    /// Every sample the integrator looked at, in order.
+    pub samples: Vec<TraceSample>,
+    /// Final colour (over the background).
+    pub rgb: [u8; 3],
+    /// Final opacity.
+    pub alpha: f32,
+    /// Distance to the first isosurface hit, mm (NaN where none).
+    pub depth_mm: f32,
+}
+
+impl Probe for Vec<TraceSample> {
+    fn sample(&mut self, t: f32, value: f32, alpha: f32) {
+        self.push(TraceSample {
+            t_mm: t,
+            value: f64::from(value),
+            alpha,
+        });
+    }
+}
+
+impl Prepared<'_> {
+    /// The settings in force.
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// The brick classification in force.
+    pub fn activity(&self) -> &Activity {
+        &self.activity
+    }
+
+    /// The transfer function's lookup table in force.
+    pub fn table(&self) -> &TfTable {
+        &self.table
+    }
+
+    /// Distance between samples, mm.
+    pub fn step_mm(&self) -> f64 {
+        self.step_mm
+    }
+
+    fn integrator(&self) -> Integrator<'_> {
+        Integrator {
+            sampler: Sampler::new(&self.renderer.volume),
+            grid: &self.renderer.grid,
+            activity: &self.activity,
+            table: &self.table,
+            shader: self.shader,
+            params: self.params,
+        }
+    }
+
+    /// Renders one frame, tiles in parallel on the current rayon pool.
+    pub fn render(&self, camera: &Camera) -> Frame {
+        let start = Instant::now();
+        let [width, height] = camera.size();
+        let integrator = self.integrator();
+        let mut pixels = vec![PixelOut::default(); width * height];
+        let stats = pixels
+            .par_chunks_mut(width * TILE)
+            .enumerate()
+            .map(|(band, rows)| {
+                let mut stats = RenderStats::default();
+                for x0 in (0..width).step_by(TILE) {
+                    let x1 = (x0 + TILE).min(width);
+                    for (dy, row) in rows.chunks_mut(width).enumerate() {
+                        let y = band * TILE + dy;
+                        for (x, out) in (x0..x1).zip(&mut row[x0..x1]) {
+                            *out = self.pixel(&integrator, camera, x, y, &mut stats, &mut ());
+                        }
+                    }
+                }
+                stats
+            })
+            .reduce(RenderStats::default, |mut a, b| {
+                a.add(&b);
+                a
+            });
+        let mut frame = self.finish(width, height, &pixels, stats);
+        frame.stats.time = start.elapsed();
+        frame
+    }
+
+    /// Traces pixel `(x, y)` of `camera` and returns every sample (the `--debug-pixel` aid).
+    pub fn trace_pixel(&self, camera: &Camera, x: usize, y: usize) -> PixelTrace {
+        let integrator = self.integrator();
+        let mut samples = Vec::new();
+        let mut stats = RenderStats::default();
+        let out = self.pixel(&integrator, camera, x, y, &mut stats, &mut samples);
+        let (ray, range_mm) = self.ray(camera, x, y);
+        let map = self.renderer.volume.value_map();
+        for s in &mut samples {
+            s.value = s.value * map.scale() + map.offset();
+        }
+        PixelTrace {
+            ray,
+            range_mm,
+            step_mm: self.step_mm,
+            offset: self.offset(x, y),
+            samples,
+            rgb: self.display(&out.accum),
+            alpha: out.accum.alpha,
+            depth_mm: out.depth_mm,
+        }
+    }
+
+    /// The voxel-space ray of pixel `(x, y)` and its part inside the volume.
+    fn ray(&self, camera: &Camera, x: usize, y: usize) -> (VoxelRay, Option<(f64, f64)>) {
+        let dir = camera.pixel_direction(x, y);
+        let ray = VoxelRay::new(&self.voxel_from_world, camera.eye_mm(), dir);
+        let dims = self.renderer.volume.dims();
+        let extent = DVec3::from(dims.map(|n| (n - 1) as f64));
+        (ray, ray.clip(extent, camera.near_distance_along(dir)))
+    }
+
+    /// The sample grid's offset for pixel `(x, y)`: mid-step, or a per-pixel hash with jitter.
+    fn offset(&self, x: usize, y: usize) -> f32 {
+        if self.settings.jitter {
+            pixel_hash(x, y)
+        } else {
+            0.5
+        }
+    }
+
+    fn pixel(
+        &self,
+        integrator: &Integrator<'_>,
+        camera: &Camera,
+        x: usize,
+        y: usize,
+        stats: &mut RenderStats,
+        probe: &mut impl Probe,
+    ) -> PixelOut {
+        let (ray, range) = self.ray(camera, x, y);
+        let Some(range) = range else {
+            return PixelOut::default();
+        };
+        let bricks = self.renderer.grid.bricks();
+        let mut march = RayMarch::new(&ray, range, bricks, self.step_mm as f32, self.offset(x, y));
+        let dir_world = camera.pixel_direction(x, y).as_vec3();
+        let out = integrator.run(&mut march, dir_world, probe);
+        stats.rays += 1;
+        stats.samples += march.stats.samples;
+        stats.bricks_visited += march.stats.bricks_visited;
+        stats.bricks_skipped += march.stats.bricks_skipped;
+        stats.terminated_early += u64::from(out.terminated);
+        stats.iso_hits += u64::from(!out.depth_mm.is_nan());
+        out
+    }
+
+    /// A composited pixel over the background, as 8-bit colour.
+    fn display(&self, accum: &Accum) -> [u8; 3] {
+        let background = Vec3::from(self.settings.background);
+        let c = accum.rgb + background * (1.0 - accum.alpha);
+        [to_u8(c.x), to_u8(c.y), to_u8(c.z)]
+    }
+
+    fn finish(
+        &self,
+        width: usize,
+        height: usize,
+        pixels: &[PixelOut],
+        stats: RenderStats,
+    ) -> Frame {
+        let map = self.renderer.volume.value_map();
+        let physical = |v: f32| (f64::from(v) * map.scale() + map.offset()) as f32;
+        Frame {
+            width,
+            height,
+            rgb: pixels.iter().flat_map(|p| self.display(&p.accum)).collect(),
+            alpha: pixels.iter().map(|p| p.accum.alpha).collect(),
+            depth_mm: pixels.iter().map(|p| p.depth_mm).collect(),
+            value: pixels.iter().map(|p| physical(p.value)).collect(),
+            stats,
+        }
+    }
+}
+
+/// A deterministic value in [0, 1) per pixel (a 32-bit integer hash), the sample-grid offset
+/// with jitter: the same on every run and thread count.
+fn pixel_hash(x: usize, y: usize) -> f32 {
+    let mut h = (x as u32).wrapping_mul(0x9E37_79B1) ^ (y as u32).wrapping_mul(0x85EB_CA77);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846C_A68B);
+    h ^= h >> 16;
+    (h >> 8) as f32 / (1u32 << 24) as f32
+}
