@@ -21,6 +21,7 @@ pub mod atomic;
 pub mod dicom;
 mod encode;
 pub mod error;
+pub mod image_out;
 pub mod limits;
 pub mod metaimage;
 pub mod nifti;
@@ -30,6 +31,7 @@ pub mod raw;
 pub mod samples;
 
 pub use error::{ReadError, Result};
+pub use image_out::{write_npy_f32, write_png_rgb8, write_png_rgba8};
 pub use limits::Limits;
 pub use open::{open, write, Format, Loaded, OpenOptions, SeriesSummary, SourceInfo};
 pub use samples::{ElementType, Endian, Rescale};

@@ -5,6 +5,7 @@
 mod common;
 mod cross_format;
 mod dicom;
+mod image_out;
 mod metaimage;
 mod nifti;
 mod nrrd;
