@@ -29,9 +29,11 @@ pub mod nrrd;
 mod open;
 pub mod raw;
 pub mod samples;
+pub mod transfer_json;
 
 pub use error::{ReadError, Result};
 pub use image_out::{write_npy_f32, write_png_rgb8, write_png_rgba8};
 pub use limits::Limits;
 pub use open::{open, write, Format, Loaded, OpenOptions, SeriesSummary, SourceInfo};
 pub use samples::{ElementType, Endian, Rescale};
+pub use transfer_json::{read_transfer_json, TfPoints};

@@ -10,3 +10,4 @@ mod metaimage;
 mod nifti;
 mod nrrd;
 mod test_volumes;
+mod transfer_json;
