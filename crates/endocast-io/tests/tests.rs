@@ -5,7 +5,9 @@
 mod common;
 mod cross_format;
 mod dicom;
+mod image_out;
 mod metaimage;
 mod nifti;
 mod nrrd;
 mod test_volumes;
+mod transfer_json;

@@ -1,0 +1,145 @@
+//! Writers for rendered images: 8-bit PNG (RGB or RGBA, tagged sRGB) and single-channel float
+//! images as NumPy `.npy` files (e.g. a depth image in millimetres with NaN where no ray hit).
+//!
+//! Both take pixels row by row, row 0 at the top of the image, left to right within a row, and
+//! write through [`write_file`] so a failed write never leaves a half file behind.
+
+use crate::atomic::write_file;
+use crate::error::{ReadError, Result};
+use std::path::Path;
+
+/// Writes an 8-bit RGB PNG: `pixels` holds `width·height·3` bytes, row 0 at the top.
+pub fn write_png_rgb8(path: &Path, width: u32, height: u32, pixels: &[u8]) -> Result<()> {
+    write_png(path, width, height, png::ColorType::Rgb, pixels)
+}
+
+/// Writes an 8-bit RGBA PNG (straight, not premultiplied, alpha): `pixels` holds
+/// `width·height·4` bytes, row 0 at the top.
+pub fn write_png_rgba8(path: &Path, width: u32, height: u32, pixels: &[u8]) -> Result<()> {
+    write_png(path, width, height, png::ColorType::Rgba, pixels)
+}
+
+/// Writes a `height × width` float32 image as a NumPy `.npy` file (format 1.0, little-endian,
+/// C order, so `numpy.load(path)[row, column]` with row 0 at the top). `values` holds
+/// `width·height` samples; NaN and infinities are stored as they are.
+pub fn write_npy_f32(path: &Path, width: u32, height: u32, values: &[f32]) -> Result<()> {
+    check_len(path, width, height, 1, values.len())?;
+    let header = npy_header(width, height);
+    write_file(path, |w| {
+        w.write_all(&header)?;
+        // Converted in rows so a large image does not need a second full-size byte buffer.
+        let mut row = Vec::with_capacity(values.len().min(1 << 16) * 4);
+        for chunk in values.chunks(1 << 16) {
+            row.clear();
+            row.extend(chunk.iter().flat_map(|v| v.to_le_bytes()));
+            w.write_all(&row)?;
+        }
+        Ok(())
+    })
+}
+
+/// The 8 bytes every `.npy` file starts with: the magic string and format version 1.0.
+const NPY_MAGIC: &[u8; 8] = b"\x93NUMPY\x01\x00";
+
+/// The `.npy` 1.0 preamble for a little-endian float32 `(height, width)` array: magic, header
+/// length (u16 LE), then the Python dict literal padded with spaces and ended by a newline so
+/// that the data starts at a multiple of 64 bytes, as the format asks for aligned reads.
+fn npy_header(width: u32, height: u32) -> Vec<u8> {
+    let dict =
+        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({height}, {width}), }}");
+    // magic (8) + length field (2) + dict + at least the newline, rounded up to 64.
+    let unpadded = NPY_MAGIC.len() + 2 + dict.len() + 1;
+    let total = unpadded.div_ceil(64) * 64;
+    let header_len = total - NPY_MAGIC.len() - 2;
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(NPY_MAGIC);
+    // Two u32 dimensions print in at most ~70 characters, so the length fits a u16 easily.
+    out.extend_from_slice(&(header_len as u16).to_le_bytes());
+    out.extend_from_slice(dict.as_bytes());
+    out.resize(total - 1, b' ');
+    out.push(b'\n');
+    out
+}
+
+/// Encodes `pixels` as an 8-bit PNG of `color` (RGB or RGBA) tagged as sRGB.
+fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    pixels: &[u8],
+) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(ReadError::format(
+            path,
+            format!("a PNG needs at least one pixel, the image is {width}×{height}"),
+        ));
+    }
+    check_len(path, width, height, color.samples(), pixels.len())?;
+    write_file(path, |w| {
+        let mut encoder = png::Encoder::new(w, width, height);
+        encoder.set_color(color);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        let mut writer = encoder.write_header().map_err(png_to_io)?;
+        writer.write_image_data(pixels).map_err(png_to_io)?;
+        writer.finish().map_err(png_to_io)
+    })
+}
+
+/// Fails unless `len` equals `width·height·channels` (computed without overflow).
+fn check_len(path: &Path, width: u32, height: u32, channels: usize, len: usize) -> Result<()> {
+    let expected = usize::try_from(width)
+        .ok()
+        .zip(usize::try_from(height).ok())
+        .and_then(|(w, h)| w.checked_mul(h)?.checked_mul(channels));
+    if expected == Some(len) {
+        return Ok(());
+    }
+    let wanted = expected.map_or_else(|| "more than memory holds".to_owned(), |n| n.to_string());
+    Err(ReadError::inconsistent(
+        path,
+        format!(
+            "a {width}×{height} image with {channels} value(s) per pixel needs {wanted} values, \
+             the buffer holds {len}"
+        ),
+    ))
+}
+
+/// The PNG encoder's errors as I/O errors, so [`write_file`] reports them with the path.
+fn png_to_io(e: png::EncodingError) -> std::io::Error {
+    match e {
+        png::EncodingError::IoError(io) => io,
+        other => std::io::Error::other(other),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_header_is_exact_and_aligned() {
+        let h = npy_header(640, 480);
+        let dict = b"{'descr': '<f4', 'fortran_order': False, 'shape': (480, 640), }";
+        assert_eq!(h.len(), 128);
+        assert_eq!(&h[..8], NPY_MAGIC);
+        assert_eq!(u16::from_le_bytes([h[8], h[9]]), 118);
+        assert_eq!(&h[10..10 + dict.len()], dict);
+        assert!(h[10 + dict.len()..127].iter().all(|&b| b == b' '));
+        assert_eq!(h[127], b'\n');
+        // NumPy's own writer also pads the smallest shape to 128 bytes.
+        assert_eq!(npy_header(1, 1).len(), 128);
+    }
+
+    #[test]
+    fn wrong_buffer_length_names_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.png");
+        let err = write_png_rgb8(&p, 2, 2, &[0; 11]).unwrap_err().to_string();
+        assert!(err.contains("x.png") && err.contains("needs 12"), "{err}");
+        assert!(!p.exists());
+        assert!(write_png_rgb8(&p, 0, 2, &[]).is_err());
+        assert!(write_npy_f32(&dir.path().join("d.npy"), 3, 1, &[0.0; 2]).is_err());
+    }
+}
