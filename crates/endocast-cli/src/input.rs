@@ -1,5 +1,6 @@
 //! The options every command that reads a scan shares: series choice, limits, raw layout.
 
+use crate::parse::{parse_dims, parse_spacing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_io::raw::RawSpec;
@@ -71,36 +72,4 @@ impl InputArgs {
             header_bytes: self.raw_header_bytes,
         }))
     }
-}
-
-fn parse_triple<T: std::str::FromStr>(text: &str) -> Result<[T; 3], String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let [a, b, c] = parts.as_slice() else {
-        return Err(format!(
-            "expected three comma-separated numbers, found {text:?}"
-        ));
-    };
-    let parse = |s: &str| {
-        s.parse::<T>()
-            .map_err(|_| format!("{s:?} is not a valid number"))
-    };
-    Ok([parse(a)?, parse(b)?, parse(c)?])
-}
-
-fn parse_dims(text: &str) -> Result<[usize; 3], String> {
-    let dims = parse_triple::<usize>(text)?;
-    if dims.contains(&0) {
-        return Err("dimensions must be positive".into());
-    }
-    Ok(dims)
-}
-
-fn parse_spacing(text: &str) -> Result<[f64; 3], String> {
-    let spacing = parse_triple::<f64>(text)?;
-    if spacing.iter().any(|s| !s.is_finite() || *s <= 0.0) {
-        return Err(format!(
-            "spacing must be finite and positive, found {text:?}"
-        ));
-    }
-    Ok(spacing)
 }

@@ -2,6 +2,7 @@
 
 mod commands;
 mod input;
+mod parse;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -22,6 +23,8 @@ enum Command {
     Phantom(commands::phantom::PhantomArgs),
     /// Convert a scan to another format (.nii, .nii.gz, .nrrd or .mha).
     Convert(commands::convert::ConvertArgs),
+    /// Render one endoscopic (or outside) view of a scan to PNG.
+    Render(Box<commands::render::RenderArgs>),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +33,7 @@ fn main() -> ExitCode {
         Command::Info(args) => commands::info::run(&args),
         Command::Phantom(args) => commands::phantom::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
+        Command::Render(args) => commands::render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,3 +6,4 @@ mod bad_input;
 mod common;
 mod info_shared_data;
 mod phantom_convert;
+mod render;

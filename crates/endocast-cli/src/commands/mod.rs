@@ -3,3 +3,4 @@
 pub mod convert;
 pub mod info;
 pub mod phantom;
+pub mod render;
