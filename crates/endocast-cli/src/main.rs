@@ -2,6 +2,7 @@
 
 mod commands;
 mod input;
+mod look;
 mod parse;
 
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ enum Command {
     Convert(commands::convert::ConvertArgs),
     /// Render one endoscopic (or outside) view of a scan to PNG.
     Render(Box<commands::render::RenderArgs>),
+    /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
+    Bench(Box<commands::bench::BenchArgs>),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +37,7 @@ fn main() -> ExitCode {
         Command::Phantom(args) => commands::phantom::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
         Command::Render(args) => commands::render::run(&args),
+        Command::Bench(args) => commands::bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

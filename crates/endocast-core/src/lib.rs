@@ -12,6 +12,7 @@
 
 pub mod geometry;
 pub mod phantom;
+pub mod pose;
 pub mod render;
 pub mod volume;
 

@@ -1,16 +1,15 @@
 //! `endocast render`: one view of a scan, from inside (endoscopic) or framing it from outside.
 
 use crate::input::InputArgs;
+use crate::look::{in_pool, LookArgs};
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::render::{
-    Camera, Frame, Mode, Prepared, RenderSettings, Renderer, TransferFunction,
-};
+use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
 use endocast_core::Geometry;
 use glam::DVec3;
 use serde_json::json;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `endocast render`.
 #[derive(Args, Debug)]
@@ -20,26 +19,8 @@ pub struct RenderArgs {
     /// Output PNG (8-bit sRGB).
     #[arg(short, long)]
     output: PathBuf,
-    /// Clinical defaults: colonoscopy, bronchoscopy, angioscopy, sinus, ventricles (also the
-    /// benchmark TFs ramp, complex). Options given explicitly override the preset.
-    #[arg(long)]
-    preset: Option<String>,
-    /// iso, dvr, hybrid, two-iso, mip or minip (default: the preset's, else hybrid).
-    #[arg(long)]
-    mode: Option<String>,
-    /// Isovalue of the lumen wall, physical units (HU for CT).
-    #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
-    iso: Option<f64>,
-    /// Upper isovalue for two-iso (stent, calcification), physical units.
-    #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
-    iso2: Option<f64>,
-    /// Opacity of the isosurface, 0–1 (hybrid: 1 hides everything behind the wall).
-    #[arg(long, value_name = "ALPHA")]
-    iso_opacity: Option<f32>,
-    /// Transfer function: a JSON file ({"opacity": [[v, a]..], "color": [[v, r, g, b]..]},
-    /// opacity per mm) or a preset name.
-    #[arg(long, value_name = "FILE|NAME")]
-    tf: Option<String>,
+    #[command(flatten)]
+    look: LookArgs,
     /// Eye position, world mm (LPS, as `endocast info` reports). Without it the view frames the
     /// whole volume from the front.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -59,24 +40,12 @@ pub struct RenderArgs {
     /// Image size in pixels.
     #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
     size: [usize; 2],
-    /// Sample step as a fraction of the smallest voxel spacing.
-    #[arg(long, value_name = "VOXELS")]
-    step: Option<f64>,
-    /// Jitter each pixel's samples by a deterministic per-pixel offset.
-    #[arg(long)]
-    jitter: bool,
-    /// Skip empty bricks (the image is the same either way, only slower without).
-    #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "true|false")]
-    skip_empty: bool,
     /// Also write the depth image: float32 .npy, mm from the eye to the first hit, NaN where none.
     #[arg(long, value_name = "FILE.npy")]
     depth_out: Option<PathBuf>,
     /// Print the frame's statistics as JSON.
     #[arg(long)]
     json: bool,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
     /// Trace one pixel and print every sample along its ray.
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
     debug_pixel: Option<[usize; 2]>,
@@ -84,7 +53,7 @@ pub struct RenderArgs {
 
 /// Runs `endocast render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let settings = settings(args)?;
+    let settings = args.look.settings()?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
@@ -97,7 +66,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
     }
-    let frame = in_pool(args.threads, || prepared.render(&camera))?;
+    let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
     let [w, h] = [frame.width as u32, frame.height as u32];
     endocast_io::image_out::write_png_rgb8(&args.output, w, h, &frame.rgb)
         .context("cannot write the image")?;
@@ -121,69 +90,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The preset (or defaults), overridden by every option given.
-fn settings(args: &RenderArgs) -> Result<RenderSettings> {
-    let mut s = match &args.preset {
-        Some(name) => RenderSettings::preset(name).with_context(|| {
-            format!(
-                "unknown preset {name:?}; choose one of {}",
-                TransferFunction::PRESETS.join(", ")
-            )
-        })?,
-        None => RenderSettings::default(),
-    };
-    if let Some(mode) = &args.mode {
-        s.mode = Mode::from_name(mode).with_context(|| {
-            format!("unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip or minip")
-        })?;
-    }
-    if let Some(iso) = args.iso {
-        s.iso_hu = finite("--iso", iso)?;
-    }
-    if let Some(iso2) = args.iso2 {
-        s.iso2_hu = finite("--iso2", iso2)?;
-    }
-    if let Some(alpha) = args.iso_opacity {
-        if !(0.0..=1.0).contains(&alpha) {
-            bail!("--iso-opacity must be between 0 and 1, not {alpha}");
-        }
-        s.iso_opacity = alpha;
-    }
-    if let Some(tf) = &args.tf {
-        s.tf = transfer_function(tf)?;
-    }
-    if let Some(step) = args.step {
-        s.step_vox = finite("--step", step)?;
-    }
-    s.jitter = args.jitter;
-    s.skip_empty = args.skip_empty;
-    Ok(s)
-}
-
-fn finite(name: &str, value: f64) -> Result<f64> {
-    if !value.is_finite() {
-        bail!("{name} must be a finite number, not {value}");
-    }
-    Ok(value)
-}
-
-/// A transfer function from a JSON file, or a preset by name.
-fn transfer_function(spec: &str) -> Result<TransferFunction> {
-    let path = Path::new(spec);
-    if path.exists() || spec.ends_with(".json") {
-        let points = endocast_io::transfer_json::read_transfer_json(path)
-            .context("cannot read the transfer function")?;
-        return TransferFunction::from_points(&points.opacity, &points.color)
-            .with_context(|| format!("{}: not a usable transfer function", path.display()));
-    }
-    TransferFunction::preset(spec).with_context(|| {
-        format!(
-            "--tf {spec:?} is neither a file nor a preset ({})",
-            TransferFunction::PRESETS.join(", ")
-        )
-    })
 }
 
 /// The camera the options describe, or one framing the whole volume from the front.
@@ -220,19 +126,6 @@ fn framing_eye(geometry: &Geometry, fov_deg: f64) -> (DVec3, DVec3) {
     let half_fov = (fov_deg.clamp(10.0, 170.0) / 2.0).to_radians();
     let distance = radius / half_fov.sin();
     (centre - DVec3::Y * distance, centre)
-}
-
-/// Runs `work` on a pool of `threads` workers (all cores when `None`).
-fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T> {
-    match threads {
-        None => Ok(work()),
-        Some(0) => bail!("--threads must be at least 1"),
-        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .context("cannot start the worker threads")?
-            .install(work)),
-    }
 }
 
 fn print_trace(prepared: &Prepared<'_>, camera: &Camera, x: usize, y: usize) -> Result<()> {

@@ -1,0 +1,122 @@
+//! The options that decide how a scan looks (preset, mode, isovalues, transfer function,
+//! sampling) and how many threads render it; shared by `render` and `bench`.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use endocast_core::render::{Mode, RenderSettings, TransferFunction};
+use std::path::Path;
+
+/// How a scan is rendered.
+#[derive(Args, Debug, Clone)]
+pub struct LookArgs {
+    /// Clinical defaults: colonoscopy, bronchoscopy, angioscopy, sinus, ventricles (also the
+    /// benchmark TFs ramp, complex). Options given explicitly override the preset.
+    #[arg(long)]
+    preset: Option<String>,
+    /// iso, dvr, hybrid, two-iso, mip or minip (default: the preset's, else hybrid).
+    #[arg(long)]
+    mode: Option<String>,
+    /// Isovalue of the lumen wall, physical units (HU for CT).
+    #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
+    iso: Option<f64>,
+    /// Upper isovalue for two-iso (stent, calcification), physical units.
+    #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
+    iso2: Option<f64>,
+    /// Opacity of the isosurface, 0–1 (hybrid: 1 hides everything behind the wall).
+    #[arg(long, value_name = "ALPHA")]
+    iso_opacity: Option<f32>,
+    /// Transfer function: a JSON file ({"opacity": [[v, a]..], "color": [[v, r, g, b]..]},
+    /// opacity per mm) or a preset name.
+    #[arg(long, value_name = "FILE|NAME")]
+    tf: Option<String>,
+    /// Sample step as a fraction of the smallest voxel spacing.
+    #[arg(long, value_name = "VOXELS")]
+    step: Option<f64>,
+    /// Jitter each pixel's samples by a deterministic per-pixel offset.
+    #[arg(long)]
+    jitter: bool,
+    /// Skip empty bricks (the image is the same either way, only slower without).
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "true|false")]
+    skip_empty: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+impl LookArgs {
+    /// The preset (or defaults), overridden by every option given.
+    pub fn settings(&self) -> Result<RenderSettings> {
+        let mut s = match &self.preset {
+            Some(name) => RenderSettings::preset(name).with_context(|| {
+                format!(
+                    "unknown preset {name:?}; choose one of {}",
+                    TransferFunction::PRESETS.join(", ")
+                )
+            })?,
+            None => RenderSettings::default(),
+        };
+        if let Some(mode) = &self.mode {
+            s.mode = Mode::from_name(mode).with_context(|| {
+                format!("unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip or minip")
+            })?;
+        }
+        if let Some(iso) = self.iso {
+            s.iso_hu = finite("--iso", iso)?;
+        }
+        if let Some(iso2) = self.iso2 {
+            s.iso2_hu = finite("--iso2", iso2)?;
+        }
+        if let Some(alpha) = self.iso_opacity {
+            if !(0.0..=1.0).contains(&alpha) {
+                bail!("--iso-opacity must be between 0 and 1, not {alpha}");
+            }
+            s.iso_opacity = alpha;
+        }
+        if let Some(tf) = &self.tf {
+            s.tf = transfer_function(tf)?;
+        }
+        if let Some(step) = self.step {
+            s.step_vox = finite("--step", step)?;
+        }
+        s.jitter = self.jitter;
+        s.skip_empty = self.skip_empty;
+        Ok(s)
+    }
+}
+
+fn finite(name: &str, value: f64) -> Result<f64> {
+    if !value.is_finite() {
+        bail!("{name} must be a finite number, not {value}");
+    }
+    Ok(value)
+}
+
+/// A transfer function from a JSON file, or a preset by name.
+fn transfer_function(spec: &str) -> Result<TransferFunction> {
+    let path = Path::new(spec);
+    if path.exists() || spec.ends_with(".json") {
+        let points = endocast_io::transfer_json::read_transfer_json(path)
+            .context("cannot read the transfer function")?;
+        return TransferFunction::from_points(&points.opacity, &points.color)
+            .with_context(|| format!("{}: not a usable transfer function", path.display()));
+    }
+    TransferFunction::preset(spec).with_context(|| {
+        format!(
+            "--tf {spec:?} is neither a file nor a preset ({})",
+            TransferFunction::PRESETS.join(", ")
+        )
+    })
+}
+
+/// Runs `work` on a pool of `threads` workers (all cores when `None`).
+pub fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T> {
+    match threads {
+        None => Ok(work()),
+        Some(0) => bail!("--threads must be at least 1"),
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(work)),
+    }
+}
