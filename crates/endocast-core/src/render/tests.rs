@@ -579,7 +579,11 @@ fn timing_reclassification_on_the_paper_size_colon() {
 #[test]
 #[ignore = "timing: run with --release -- --ignored --nocapture"]
 fn timing_fly_through_the_paper_size_colon() {
-    let (volume, colon) = phantom::colon(&options(512));
+    // ENDOCAST_TIMING_SIZE (default 512) and ENDOCAST_TIMING_MODES (a comma list of the labels'
+    // first words, default all) shorten profiling runs.
+    let size = std::env::var("ENDOCAST_TIMING_SIZE").map_or(512, |s| s.parse().unwrap_or(512));
+    let only = std::env::var("ENDOCAST_TIMING_MODES").unwrap_or_default();
+    let (volume, colon) = phantom::colon(&options(size));
     let start = Instant::now();
     let renderer = Renderer::new(volume);
     println!("brick grid: {:.1} ms", start.elapsed().as_secs_f64() * 1e3);
@@ -602,6 +606,10 @@ fn timing_fly_through_the_paper_size_colon() {
         ("hybrid 0% complex", Mode::Hybrid, "complex", 0.0),
         ("dvr colonoscopy", Mode::Dvr, "colonoscopy", 1.0),
     ] {
+        let first_word = label.split(' ').next().unwrap_or_default();
+        if !only.is_empty() && !only.split(',').any(|m| m == first_word) {
+            continue;
+        }
         let s = RenderSettings {
             mode,
             iso_opacity: opacity,
@@ -630,4 +638,25 @@ fn timing_fly_through_the_paper_size_colon() {
                 / (total.bricks_skipped + total.bricks_visited).max(1) as f64,
         );
     }
+}
+
+#[test]
+#[ignore = "timing: run with --release -- --ignored --nocapture"]
+fn timing_trilinear_sample() {
+    let (volume, _) = phantom::sphere_shell(&options(64));
+    let sampler = Sampler::new(&volume);
+    let mut p = glam::Vec3::new(10.3, 20.7, 30.1);
+    let step = glam::Vec3::new(0.31, 0.17, 0.23);
+    let start = Instant::now();
+    let mut sum = 0.0;
+    let n = 20_000_000;
+    for _ in 0..n {
+        sum += sampler.value(p);
+        p += step;
+        if p.x > 60.0 || p.y > 60.0 || p.z > 60.0 {
+            p -= glam::Vec3::splat(50.0);
+        }
+    }
+    let ns = start.elapsed().as_secs_f64() * 1e9 / f64::from(n);
+    println!("trilinear: {ns:.2} ns/sample (checksum {sum})");
 }
