@@ -20,7 +20,7 @@ fn bench_transfer_functions_read() {
     assert_eq!(ramp.color.len(), 5);
     assert_eq!(ramp.color[2], (-300.0, [0.93, 0.72, 0.62]));
     let complex = read_transfer_json(&bench_tf("colon_complex.json")).unwrap();
-    assert_eq!(complex.opacity.len(), 12);
+    assert_eq!(complex.opacity.len(), 13);
     assert_eq!(complex.opacity[2], (-520.0, 0.15));
     assert_eq!(complex.color.len(), 7);
 }
