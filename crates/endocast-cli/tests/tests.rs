@@ -6,4 +6,5 @@ mod bad_input;
 mod common;
 mod info_shared_data;
 mod phantom_convert;
+mod real_scans;
 mod render;
