@@ -28,7 +28,9 @@ pub fn fly_through(
     ahead_mm: f64,
 ) -> Option<Vec<Pose>> {
     let (first, last) = (ahead_mm, length_mm - 2.0 * ahead_mm);
-    if frames < 2 || !(ahead_mm > 0.0) || !(last > first) {
+    // Written so that NaN lengths fail too.
+    let usable = ahead_mm > 0.0 && last > first;
+    if frames < 2 || !usable {
         return None;
     }
     let world = |s: f64| geometry.world_of(point_vox(s));
