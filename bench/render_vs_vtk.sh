@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The renderer benchmark of issue 3 in one run: endocast and the VTK peer
+# (vtkFixedPointVolumeRayCastMapper) on the SAME frames — the colon phantom at the paper's size
+# (512×512×478), FRAMES cameras along its centreline, 512×512, vertical FOV 90°, step 0.5 mm,
+# the same ramp and complex transfer functions (bench/tf/, opacity per mm).
+#
+# Usage (repository root, ../shared/peers beside it, VTK from ../shared/peers/install_vtk.sh):
+#   bench/render_vs_vtk.sh [FRAMES]
+# Prints endocast's table (paper protocol + the DVR runs on the peer's path), then the peer's.
+set -euo pipefail
+frames=${1:-60}
+out=${OUT:-bench/out}
+mkdir -p "$out"
+cargo build --release -p endocast-cli -p endocast-io --example colon_path >/dev/null 2>&1 ||
+  cargo build --release -p endocast-cli >/dev/null
+cargo build --release -p endocast-io --example colon_path >/dev/null
+bin=target/release/endocast
+nii=$out/colon512.nii.gz
+[ -f "$nii" ] || target/release/examples/colon_path --size 512 --frames "$frames" --out-dir "$out"
+target/release/examples/colon_path --size 512 --frames "$frames" --out-dir "$out" --path-only
+path=$out/colon512_path_lps.json
+rm -f "$out/endocast.jsonl"
+
+echo "== endocast: the paper's protocol (Tables 1 and 2) on the colon phantom"
+$bin bench --size 512 --frames "$frames" --json "$out/endocast.jsonl"
+echo "== endocast: the peer's runs, same path and transfer functions"
+for tf in ramp complex; do
+  $bin bench "$nii" --path "$path" --mode dvr --tf "bench/tf/colon_$tf.json" --json "$out/endocast.jsonl"
+done
+$bin bench "$nii" --path "$path" --mode iso --iso -500 --json "$out/endocast.jsonl"
+$bin bench "$nii" --path "$path" --mode mip --json "$out/endocast.jsonl"
+echo "== VTK fixed-point CPU ray caster, same frames"
+bash bench/vtk_peer.sh "$frames"
