@@ -11,8 +11,7 @@ set -euo pipefail
 frames=${1:-60}
 out=${OUT:-bench/out}
 mkdir -p "$out"
-cargo build --release -p endocast-cli -p endocast-io --example colon_path >/dev/null 2>&1 ||
-  cargo build --release -p endocast-cli >/dev/null
+cargo build --release -p endocast-cli >/dev/null
 cargo build --release -p endocast-io --example colon_path >/dev/null
 bin=target/release/endocast
 nii=$out/colon512.nii.gz
