@@ -19,14 +19,12 @@
 //! phantom (1 mm voxels, identity direction, grid centre at world 0) that is
 //! `p_vtk = p_lps + (dims − 1) / 2`: a pure translation, no axis flips.
 //!
-//! The path: `--frames` eye points evenly spaced in arc length along the centreline, from
-//! `--ahead` mm after its start to `2·--ahead` mm before its end; each looks at the centreline
-//! point `--ahead` mm further on. The up vector is carried along the centreline in 0.5 mm steps
-//! by projecting the previous up onto the plane normal to the new view direction (a discrete
-//! rotation-minimising frame), so it never turns about the view axis needlessly and never becomes
-//! parallel to the view direction.
+//! The path is [`endocast_core::pose::fly_through`] along the centreline, the same one
+//! `endocast bench` flies: `--frames` eyes evenly spaced in arc length, each looking `--ahead` mm
+//! further along, with a rotation-minimising up vector.
 
-use endocast_core::phantom::{self, Colon, PhantomOptions};
+use endocast_core::phantom::{self, PhantomOptions};
+use endocast_core::pose::{fly_through, Pose};
 use endocast_core::Geometry;
 use glam::DVec3;
 use serde_json::json;
@@ -42,13 +40,6 @@ struct Settings {
     path_only: bool,
 }
 
-/// One camera in our world frame (LPS mm).
-struct Camera {
-    eye: DVec3,
-    look_at: DVec3,
-    up: DVec3,
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let settings = parse_args()?;
     std::fs::create_dir_all(&settings.out_dir)?;
@@ -59,7 +50,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let (volume, colon) = phantom::colon(&options);
     let geometry = volume.geometry();
-    let cameras = fly_path(&colon, geometry, settings.frames, settings.ahead_mm)?;
+    let line = &colon.centreline;
+    let cameras = fly_through(
+        geometry,
+        |s| line.point_at(s),
+        line.length_vox(),
+        settings.frames,
+        settings.ahead_mm,
+    )
+    .ok_or("the centreline is too short for these --frames and --ahead")?;
     let stem = format!("colon{}", settings.size);
     let json_path = settings.out_dir.join(format!("{stem}_path_lps.json"));
     let vtk_path = settings.out_dir.join(format!("{stem}_path_vtk.txt"));
@@ -112,59 +111,14 @@ fn parse_args() -> Result<Settings, Box<dyn std::error::Error>> {
     Ok(s)
 }
 
-/// The fly-through (see the module doc). Centreline arc lengths are in voxels, which are 1 mm
-/// at every phantom size.
-fn fly_path(
-    colon: &Colon,
-    geometry: &Geometry,
-    frames: usize,
-    ahead: f64,
-) -> Result<Vec<Camera>, String> {
-    let line = &colon.centreline;
-    let (first, last) = (ahead, line.length_vox() - 2.0 * ahead);
-    if last <= first {
-        return Err(format!(
-            "the centreline ({:.0} mm) is too short for --ahead {ahead}",
-            line.length_vox()
-        ));
-    }
-    let world = |s: f64| geometry.world_of(line.point_at(s));
-    let view = |s: f64| (world(s + ahead) - world(s)).normalize();
-    // Start with the world axis least aligned with the first view direction, made orthogonal.
-    let d0 = view(first);
-    let seed = [DVec3::X, DVec3::Y, DVec3::Z]
-        .into_iter()
-        .min_by(|a, b| a.dot(d0).abs().total_cmp(&b.dot(d0).abs()))
-        .unwrap_or(DVec3::Z);
-    let mut up = (seed - d0 * seed.dot(d0)).normalize();
-    let mut s = first;
-    let step = (last - first) / (frames - 1) as f64;
-    let mut cameras = Vec::with_capacity(frames);
-    for n in 0..frames {
-        let target = first + step * n as f64;
-        // Carry the up vector in small steps so the view direction turns little between them.
-        while s < target {
-            s = (s + 0.5).min(target);
-            let d = view(s);
-            up = (up - d * up.dot(d)).normalize();
-        }
-        cameras.push(Camera {
-            eye: world(target),
-            look_at: world(target + ahead),
-            up,
-        });
-    }
-    Ok(cameras)
-}
-
 /// The cameras as a JSON list of `{eye, look_at, up}` in world LPS mm.
-fn lps_json(cameras: &[Camera]) -> serde_json::Result<String> {
+fn lps_json(cameras: &[Pose]) -> serde_json::Result<String> {
     let list: Vec<_> = cameras
         .iter()
         .map(|c| {
             json!({
-                "eye": c.eye.to_array(),
-                "look_at": c.look_at.to_array(),
+                "eye": c.eye_mm.to_array(),
+                "look_at": c.look_at_mm.to_array(),
                 "up": c.up.to_array(),
             })
         })
@@ -174,14 +128,14 @@ fn lps_json(cameras: &[Camera]) -> serde_json::Result<String> {
 
 /// The cameras in VTK's frame, one `px py pz fx fy fz ux uy uz` line each, after a `#` header
 /// (which `vtk_render.py` skips).
-fn vtk_lines(cameras: &[Camera], geometry: &Geometry) -> String {
+fn vtk_lines(cameras: &[Pose], geometry: &Geometry) -> String {
     let to_vtk = |p: DVec3| geometry.voxel_from_world().transform_point3(p) * geometry.spacing_mm();
     let mut text = String::from(
         "# px py pz fx fy fz ux uy uz in VTK's NIfTI frame: voxel (i,j,k) at (i*sx, j*sy, k*sz) mm\n",
     );
     for c in cameras {
-        let (eye, focal) = (to_vtk(c.eye), to_vtk(c.look_at));
-        let up = (to_vtk(c.eye + c.up) - eye).normalize();
+        let (eye, focal) = (to_vtk(c.eye_mm), to_vtk(c.look_at_mm));
+        let up = (to_vtk(c.eye_mm + c.up) - eye).normalize();
         let numbers: Vec<String> = [eye, focal, up]
             .iter()
             .flat_map(|v| v.to_array())
