@@ -106,7 +106,10 @@ impl RayMarch {
     /// The first sample index at or after `t`.
     #[inline]
     fn index_at(&self, t: f32) -> i32 {
-        ((t - self.t_start) / self.step - self.offset).ceil() as i32
+        // A ceiling without libm's `ceilf` (a call on baseline x86-64); `as` saturates.
+        let x = (t - self.t_start) / self.step - self.offset;
+        let truncated = x as i32;
+        truncated + i32::from((truncated as f32) < x)
     }
 
     /// Distance of sample `n` from the eye, mm.

@@ -23,6 +23,7 @@
 //! let renderer = Renderer::new(volume);
 //! let mut settings = RenderSettings::default();
 //! settings.mode = Mode::Iso;
+//! settings.iso_hu = -480.0; // the phantom's air/tissue mid-value lies on its surface
 //! let prepared = renderer.prepare(&settings).unwrap();
 //! let camera = Camera::look_at(centre_mm, centre_mm + DVec3::Z, DVec3::Y, 90.0, [16, 16]).unwrap();
 //! let frame = prepared.render(&camera);
