@@ -1,7 +1,7 @@
 //! Endoscopic renders from inside four real scans (poses in `bench/scenes.json`): the lumen wall
 //! must close around the view — nearly every ray hits it, at depths a lumen of that organ allows.
 
-use crate::common::{endocast, shared_data};
+use crate::common::{endocast, read_npy, shared_data};
 use std::path::PathBuf;
 
 /// The scenes file, with paths relative to the repository root.
@@ -80,13 +80,8 @@ fn the_lumen_wall_surrounds_the_endoscope_in_every_real_scan() {
             hits >= 0.95 * rays,
             "{name}: only {hits} of {rays} rays hit the wall"
         );
-        let bytes = std::fs::read(&depth).unwrap();
-        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-        let mut depths: Vec<f32> = bytes[10 + header_len..]
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .filter(|d| d.is_finite())
-            .collect();
+        let (_, values) = read_npy(&depth);
+        let mut depths: Vec<f32> = values.into_iter().filter(|d| d.is_finite()).collect();
         depths.sort_by(f32::total_cmp);
         let median = depths[depths.len() / 2];
         // From inside a trachea, aorta, nasal cavity or ventricle the wall is millimetres to a

@@ -1,28 +1,6 @@
 //! `endocast render` end to end: a phantom with a known answer, outputs, and bad options.
 
-use crate::common::endocast;
-
-/// Reads a little-endian float32 .npy written by `--depth-out`: (shape, values).
-fn read_npy(path: &std::path::Path) -> ((usize, usize), Vec<f32>) {
-    let bytes = std::fs::read(path).unwrap();
-    assert_eq!(&bytes[..6], b"\x93NUMPY");
-    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
-    assert!(header.contains("'descr': '<f4'"), "{header}");
-    let shape = header.split("'shape': (").nth(1).unwrap();
-    let dims: Vec<usize> = shape
-        .split(')')
-        .next()
-        .unwrap()
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect();
-    let values = bytes[10 + header_len..]
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    ((dims[0], dims[1]), values)
-}
+use crate::common::{endocast, read_npy};
 
 #[test]
 fn from_the_centre_of_a_sphere_shell_every_depth_is_the_radius() {
