@@ -161,7 +161,7 @@ impl Integrator<'_> {
             |s: Sample| {
                 probe.sample(s.t, s.value, 0.0);
                 if !s.fresh && crosses(previous.1, s.value, iso, rising) {
-                    hit = Some(previous.0);
+                    hit = Some(previous);
                     previous = (s.t, s.value);
                     return Flow::StopBefore;
                 }
@@ -169,19 +169,26 @@ impl Integrator<'_> {
                 Flow::Continue
             },
         );
-        let t_before = hit?;
-        let t = self.refine(march.line(), iso, rising, (t_before, previous.0));
+        let before = hit?;
+        let t = self.refine(march.line(), iso, rising, before, previous);
         Some(Hit { t })
     }
 
-    /// Bisection of the bracket `(t_before, t_after)` around a crossing, then linear
-    /// interpolation inside the final bracket (no refinement: the sample after the crossing).
-    fn refine(&self, line: Line, iso: f32, rising: bool, (mut a, mut b): (f32, f32)) -> f32 {
+    /// Bisection of the bracket `(t, value)` before and after a crossing (the two samples the
+    /// march took, so their values are not fetched again), then linear interpolation inside the
+    /// final bracket (no refinement: the sample after the crossing).
+    fn refine(
+        &self,
+        line: Line,
+        iso: f32,
+        rising: bool,
+        (mut a, mut va): (f32, f32),
+        (mut b, mut vb): (f32, f32),
+    ) -> f32 {
         if self.params.refine_steps == 0 {
             return b;
         }
         let value = |t: f32| self.sampler.value(line.at(t));
-        let (mut va, mut vb) = (value(a), value(b));
         for _ in 0..self.params.refine_steps {
             let m = 0.5 * (a + b);
             let vm = value(m);
@@ -273,7 +280,8 @@ impl Integrator<'_> {
                     let mut hits = [lower, upper].map(|surface| {
                         let rising = previous.1 < surface.iso;
                         crosses(previous.1, s.value, surface.iso, rising).then(|| {
-                            let t = self.refine(line, surface.iso, rising, (previous.0, s.t));
+                            let t =
+                                self.refine(line, surface.iso, rising, previous, (s.t, s.value));
                             (t, surface)
                         })
                     });

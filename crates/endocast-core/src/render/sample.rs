@@ -2,17 +2,21 @@
 //! world-space normals, Blinn-Phong shading with a headlight, and front-to-back compositing.
 
 use crate::Volume;
-use glam::{DMat3, Mat3, Vec3};
+use glam::{DMat3, Mat3, Vec3, Vec4};
 
 /// Trilinear reconstruction of a volume's stored values, in `f32`, with positions clamped to the
 /// voxel centres' hull (so a gradient stencil at the border reads the border value).
+///
+/// The sample loop's hot spot: everything constant is precomputed here, cell indices are `i32`
+/// (a cheap conversion from `f32`, unlike `usize`), and the eight corners are read from one
+/// bounds-checked slice of the cell's span.
 #[derive(Debug, Clone, Copy)]
 pub struct Sampler<'a> {
     voxels: &'a [u16],
     /// Largest position per axis (`n − 1`).
     extent: Vec3,
     /// Largest base index per axis of the 2×2×2 cell (`n − 2`, or 0 for a single voxel).
-    max_base: [usize; 3],
+    max_base: [i32; 3],
     /// Memory strides to the next voxel per axis; 0 along an axis of one voxel.
     stride: [usize; 3],
 }
@@ -22,35 +26,54 @@ impl<'a> Sampler<'a> {
     pub fn new(volume: &'a Volume) -> Self {
         let [nx, ny, nz] = volume.dims();
         let step = |n: usize, s: usize| if n > 1 { s } else { 0 };
+        // Volumes are limited far below 2³¹ voxels per axis; saturate rather than wrap anyway.
+        let max_base = [nx, ny, nz].map(|n| i32::try_from(n.saturating_sub(2)).unwrap_or(i32::MAX));
         Self {
             voxels: volume.voxels(),
             extent: Vec3::new((nx - 1) as f32, (ny - 1) as f32, (nz - 1) as f32),
-            max_base: [nx, ny, nz].map(|n| n.saturating_sub(2)),
+            max_base,
             stride: [step(nx, 1), step(ny, nx), step(nz, nx * ny)],
         }
     }
 
     /// The trilinearly interpolated stored value at voxel position `p`.
-    #[inline]
+    #[inline(always)]
     pub fn value(&self, p: Vec3) -> f32 {
         let p = p.clamp(Vec3::ZERO, self.extent);
-        let base = [
-            (p.x as usize).min(self.max_base[0]),
-            (p.y as usize).min(self.max_base[1]),
-            (p.z as usize).min(self.max_base[2]),
-        ];
-        let f = p - Vec3::new(base[0] as f32, base[1] as f32, base[2] as f32);
-        let [sx, sy, sz] = self.stride;
-        let index = base[0] + base[1] * sy + base[2] * sz;
-        // One bounds check for the whole 2×2×2 cell, then plain indexing inside it.
-        let cell = &self.voxels[index..=index + sx + sy + sz];
-        let at = |offset: usize| f32::from(cell[offset]);
+        // p ≥ 0, so truncation is the floor; `as i32` saturates and maps NaN to 0.
+        let bx = (p.x as i32).min(self.max_base[0]);
+        let by = (p.y as i32).min(self.max_base[1]);
+        let bz = (p.z as i32).min(self.max_base[2]);
+        let (fx, fy, fz) = (p.x - bx as f32, p.y - by as f32, p.z - bz as f32);
+        let [_, sy, sz] = self.stride;
+        // bx, by, bz lie in [0, max_base]: the casts are exact.
+        let index = bx as usize + by as usize * sy + bz as usize * sz;
+        let [low, high] = self.corners(index);
+        // The four lerps along x at once (SIMD lanes: the same IEEE operations as one by one),
+        // giving [c00, c10, c01, c11] (c_yz); then y, then z.
+        let c = low + (high - low) * fx;
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let c00 = lerp(at(0), at(sx), f.x);
-        let c10 = lerp(at(sy), at(sy + sx), f.x);
-        let c01 = lerp(at(sz), at(sz + sx), f.x);
-        let c11 = lerp(at(sz + sy), at(sz + sy + sx), f.x);
-        lerp(lerp(c00, c10, f.y), lerp(c01, c11, f.y), f.z)
+        lerp(lerp(c.x, c.y, fy), lerp(c.z, c.w, fy), fz)
+    }
+
+    /// The 2×2×2 cell whose lowest corner is voxel `index`: the four corners at x and the four
+    /// at x + 1, each ordered (y, z) = (0, 0), (1, 0), (0, 1), (1, 1).
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn corners(&self, index: usize) -> [Vec4; 2] {
+        let [sx, sy, sz] = self.stride;
+        // One bounds check for the whole cell (it panics like indexing would).
+        let cell = &self.voxels[index..=index + sx + sy + sz];
+        let at = |offset: usize| {
+            debug_assert!(offset < cell.len());
+            // SAFETY: every offset used below is a sum of a subset of {sx, sy, sz}, so it is at
+            // most sx + sy + sz = cell.len() − 1 (the slice above is that long, and the sum did
+            // not overflow or the slice would have been refused).
+            f32::from(unsafe { *cell.get_unchecked(offset) })
+        };
+        let low = Vec4::new(at(0), at(sy), at(sz), at(sz + sy));
+        let high = Vec4::new(at(sx), at(sy + sx), at(sz + sx), at(sz + sy + sx));
+        [low, high]
     }
 
     /// Gradient of the stored value by central differences one voxel apart, stored units per
