@@ -250,11 +250,7 @@ impl Integrator<'_> {
             |s: Sample| {
                 self.add_sample(acc, line, s, dir_world, shade);
                 probe.sample(s.t, s.value, acc.alpha);
-                if acc.alpha >= stop {
-                    Flow::Stop
-                } else {
-                    Flow::Continue
-                }
+                until_opaque(acc.alpha, stop)
             },
         );
         out.terminated = terminated;
@@ -303,11 +299,7 @@ impl Integrator<'_> {
                 }
                 previous = (s.t, s.value);
                 probe.sample(s.t, s.value, acc.alpha);
-                if acc.alpha >= stop {
-                    Flow::Stop
-                } else {
-                    Flow::Continue
-                }
+                until_opaque(acc.alpha, stop)
             },
         );
         out.terminated = terminated;
@@ -363,5 +355,15 @@ fn crosses(before: f32, after: f32, iso: f32, rising: bool) -> bool {
         before < iso && after >= iso
     } else {
         before >= iso && after < iso
+    }
+}
+
+/// Stop the march once the accumulated opacity reaches the early-termination threshold.
+#[inline]
+fn until_opaque(alpha: f32, stop: f32) -> Flow {
+    if alpha >= stop {
+        Flow::Stop
+    } else {
+        Flow::Continue
     }
 }
