@@ -15,7 +15,7 @@
 
 use super::lumen::Lumen;
 use crate::Geometry;
-use glam::{DAffine3, DMat3, DVec3};
+use glam::{DAffine3, DVec3};
 use rayon::prelude::*;
 
 /// Distance to the wall (mm) of every voxel of a lumen's bounding box (0 outside the lumen).
@@ -27,6 +27,7 @@ pub struct DistanceField {
     values_mm: Vec<f32>,
     world_from_voxel: DAffine3,
     voxel_from_world: DAffine3,
+    spacing_mm: DVec3,
     max_mm: f64,
     max_voxel: [usize; 3],
 }
@@ -64,6 +65,7 @@ impl DistanceField {
             values_mm,
             world_from_voxel: geometry.world_from_voxel(),
             voxel_from_world: geometry.voxel_from_world(),
+            spacing_mm: geometry.spacing_mm(),
             max_mm: f64::from(max_mm),
             max_voxel: [0, 1, 2].map(|a| (local[a] as isize + origin[a]) as usize),
         }
@@ -119,9 +121,15 @@ impl DistanceField {
         self.voxel_from_world.transform_point3(p_mm)
     }
 
-    /// The linear map from voxel index steps to world mm (direction × spacing).
-    pub fn world_from_voxel_linear(&self) -> DMat3 {
-        self.world_from_voxel.matrix3
+    /// The smallest voxel spacing, mm.
+    pub fn min_spacing_mm(&self) -> f64 {
+        self.spacing_mm.min_element()
+    }
+
+    /// Length of the diagonal of the field's box, mm: no path inside the lumen is straighter.
+    pub fn diagonal_mm(&self) -> f64 {
+        let d = self.dims.map(|n| n as f64);
+        (DVec3::new(d[0], d[1], d[2]) * self.spacing_mm).length()
     }
 
     /// Bytes held by the distance values.

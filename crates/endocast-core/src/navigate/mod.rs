@@ -18,12 +18,14 @@
 //! Units: points are world millimetres (LPS) unless a name says `voxel`; voxel indices are
 //! `[usize; 3]` of the volume, `i` first.
 
+mod collision;
 mod distance;
 mod error;
 mod lumen;
 #[cfg(test)]
 mod test_util;
 
+pub use collision::Collider;
 pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
