@@ -296,6 +296,49 @@ impl Lumen {
     }
 }
 
+/// A dense numbering of a lumen's voxels, `0..voxel_count` in linear order (the order of
+/// [`Lumen::voxels`]), so per-voxel work arrays hold lumen voxels only, not the whole box: one
+/// count per 64 voxels of the box.
+pub(crate) struct LumenNumbering<'a> {
+    lumen: &'a Lumen,
+    /// Lumen voxels before each 64-bit word of the mask.
+    before: Vec<usize>,
+}
+
+impl<'a> LumenNumbering<'a> {
+    pub(crate) fn new(lumen: &'a Lumen) -> Self {
+        let mut total = 0;
+        let before = lumen
+            .mask
+            .words
+            .iter()
+            .map(|w| {
+                let here = total;
+                total += w.count_ones() as usize;
+                here
+            })
+            .collect();
+        Self { lumen, before }
+    }
+
+    /// The lumen numbered.
+    pub(crate) fn lumen(&self) -> &'a Lumen {
+        self.lumen
+    }
+
+    /// The number of voxel `v` (volume index), or `None` when it is not in the lumen.
+    #[inline]
+    pub(crate) fn number(&self, v: [usize; 3]) -> Option<usize> {
+        if !self.lumen.contains(v) {
+            return None;
+        }
+        let rel = [0, 1, 2].map(|a| v[a] - self.lumen.lo[a]);
+        let n = self.lumen.mask.index(rel);
+        let below = self.lumen.mask.words[n >> 6] & ((1u64 << (n & 63)) - 1);
+        Some(self.before[n >> 6] + below.count_ones() as usize)
+    }
+}
+
 /// Scanline flood fill from `seed` (a lumen voxel not yet visited) over 6-connected lumen
 /// voxels, marking them in `visited`. Each stack entry starts a run along `i`; the stack holds
 /// at most a few entries per run of the component, never one per voxel.

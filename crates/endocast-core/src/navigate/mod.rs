@@ -18,6 +18,7 @@
 //! Units: points are world millimetres (LPS) unless a name says `voxel`; voxel indices are
 //! `[usize; 3]` of the volume, `i` first.
 
+mod centreline;
 mod collision;
 mod distance;
 mod error;
@@ -25,6 +26,7 @@ mod lumen;
 #[cfg(test)]
 mod test_util;
 
+pub use centreline::{centreline, CentrelinePath, PathEnd, SNAP_RADIUS_MM};
 pub use collision::Collider;
 pub use distance::DistanceField;
 pub use error::NavError;
