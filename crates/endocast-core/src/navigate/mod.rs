@@ -25,9 +25,11 @@ mod error;
 mod lumen;
 #[cfg(test)]
 mod test_util;
+mod viewpoint;
 
 pub use centreline::{centreline, CentrelinePath, PathEnd, SNAP_RADIUS_MM};
 pub use collision::Collider;
 pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
+pub use viewpoint::default_viewpoint;
