@@ -12,8 +12,8 @@
 //! middle of any lumen, whatever its size. Lumen voxels have `d` of at least a voxel, so the
 //! cost is finite.
 //!
-//! Work arrays hold one entry per lumen voxel (not per voxel of its box): 9 bytes each, plus the
-//! heap.
+//! Work arrays hold one entry per lumen voxel (not per voxel of its box): 9 bytes each (13 when
+//! looking for the farthest point), plus the costs (4 bytes) and the heap.
 
 use super::distance::DistanceField;
 use super::error::NavError;
@@ -201,11 +201,11 @@ impl Snapper<'_> {
 /// in mm, and each voxel's centring cost.
 struct Graph<'a> {
     numbering: LumenNumbering<'a>,
-    field: &'a DistanceField,
     dims: [usize; 3],
     /// Index offset and length (mm) of each of the 26 neighbour steps.
     steps: Vec<([isize; 3], f64)>,
-    voxels: usize,
+    /// Cost per mm of each lumen voxel, by number (see the module doc).
+    cost: Vec<f32>,
 }
 
 impl<'a> Graph<'a> {
@@ -220,19 +220,19 @@ impl<'a> Graph<'a> {
                 (o, mm.length())
             })
             .collect();
+        let cost = lumen
+            .voxels()
+            .map(|v| {
+                let d = field.distance_at_voxel(v).max(1e-6);
+                (field.max_mm() / d).powi(COST_EXPONENT) as f32
+            })
+            .collect();
         Self {
             numbering: LumenNumbering::new(lumen),
-            field,
             dims: volume.dims(),
             steps,
-            voxels: lumen.voxel_count(),
+            cost,
         }
-    }
-
-    /// Cost per mm at voxel `v` (see the module doc).
-    fn cost(&self, v: [usize; 3]) -> f64 {
-        let d = self.field.distance_at_voxel(v).max(1e-6);
-        (self.field.max_mm() / d).powi(COST_EXPONENT)
     }
 
     /// The neighbour of `v` by step `s`, when inside the volume.
@@ -245,9 +245,9 @@ impl<'a> Graph<'a> {
     /// Dijkstra from `start`, stopping when `goal` (if any) is settled.
     fn search(&self, start: [usize; 3], goal: Option<[usize; 3]>) -> Search {
         let mut search = Search {
-            cost: vec![f32::INFINITY; self.voxels],
-            came_by: vec![NONE; self.voxels],
-            length_mm: vec![0.0; if goal.is_none() { self.voxels } else { 0 }],
+            cost: vec![f32::INFINITY; self.cost.len()],
+            came_by: vec![NONE; self.cost.len()],
+            length_mm: vec![0.0; if goal.is_none() { self.cost.len() } else { 0 }],
         };
         let Some(first) = self.numbering.number(start) else {
             return search;
@@ -263,7 +263,7 @@ impl<'a> Graph<'a> {
             if Some(v) == goal {
                 break;
             }
-            let cost_v = self.cost(v);
+            let cost_v = self.cost[here];
             for s in 0..self.steps.len() {
                 let Some(w) = self.neighbour(v, s) else {
                     continue;
@@ -271,7 +271,7 @@ impl<'a> Graph<'a> {
                 let Some(there) = self.numbering.number(w) else {
                     continue;
                 };
-                let edge = self.steps[s].1 * 0.5 * (cost_v + self.cost(w));
+                let edge = self.steps[s].1 * 0.5 * f64::from(cost_v + self.cost[there]);
                 let total = (f64::from(search.cost[here]) + edge) as f32;
                 if total < search.cost[there] {
                     search.cost[there] = total;
