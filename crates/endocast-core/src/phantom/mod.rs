@@ -30,6 +30,7 @@
 mod bins;
 mod centreline;
 mod colon;
+mod curved_tube;
 mod joint;
 mod noise;
 pub mod profile;
@@ -42,6 +43,7 @@ mod vessel;
 
 pub use centreline::Centreline;
 pub use colon::{colon, Colon, Fold};
+pub use curved_tube::{curved_tube, CurvedTube};
 pub use joint::{joint, Joint};
 pub use shape::Ball;
 pub use sinus::{sinus, Cavity, Septum, Sinus};
@@ -58,6 +60,8 @@ pub enum Phantom {
     SphereShell,
     /// An air-filled cylinder along `k` through tissue ([`straight_tube`]).
     StraightTube,
+    /// An air-filled tube bent through 270° along a circular arc ([`curved_tube`]).
+    CurvedTube,
     /// A colon-like air tube along a winding 3-D curve, with folds and polyps ([`colon`]).
     Colon,
     /// A contrast-filled vessel with a stent and calcifications ([`vessel`]).
@@ -70,20 +74,22 @@ pub enum Phantom {
 
 impl Phantom {
     /// Every phantom, in a fixed order.
-    pub const ALL: [Phantom; 6] = [
+    pub const ALL: [Phantom; 7] = [
         Self::SphereShell,
         Self::StraightTube,
+        Self::CurvedTube,
         Self::Colon,
         Self::Vessel,
         Self::Joint,
         Self::Sinus,
     ];
 
-    /// The kebab-case name (`sphere-shell`, `straight-tube`, `colon`, `vessel`, `joint`, `sinus`).
+    /// The kebab-case name (`sphere-shell`, `straight-tube`, `curved-tube`, `colon`, `vessel`, `joint`, `sinus`).
     pub fn name(self) -> &'static str {
         match self {
             Self::SphereShell => "sphere-shell",
             Self::StraightTube => "straight-tube",
+            Self::CurvedTube => "curved-tube",
             Self::Colon => "colon",
             Self::Vessel => "vessel",
             Self::Joint => "joint",
@@ -103,6 +109,9 @@ impl Phantom {
         match self {
             Self::SphereShell => "tissue shell with air inside and outside: depth to a sphere",
             Self::StraightTube => "air cylinder along k through tissue: the simplest lumen",
+            Self::CurvedTube => {
+                "air tube bent through 270 degrees along an arc: paths around a bend"
+            }
             Self::Colon => "winding air tube with haustral folds and polyps: fly-through",
             Self::Vessel => "contrast-filled vessel with a metal stent and calcifications",
             Self::Joint => "two bone surfaces around a thin bright contrast layer: two isosurfaces",
@@ -115,6 +124,7 @@ impl Phantom {
         match self {
             Self::SphereShell => sphere_shell(options).0,
             Self::StraightTube => straight_tube(options).0,
+            Self::CurvedTube => curved_tube(options).0,
             Self::Colon => colon(options).0,
             Self::Vessel => vessel(options).0,
             Self::Joint => joint(options).0,

@@ -1,0 +1,88 @@
+//! [`NavError`]: why a lumen, a distance field or a path could not be made.
+
+use super::lumen::LumenSide;
+use thiserror::Error;
+
+/// A navigation request that cannot be served: each variant says what was expected and what
+/// was found.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum NavError {
+    /// A threshold, radius or coordinate is NaN or infinite (or a radius not positive).
+    #[error("{what} must be a finite number{extra}, found {value}")]
+    BadNumber {
+        /// What the number is (e.g. `"threshold (HU)"`).
+        what: &'static str,
+        /// Further requirement, e.g. `" greater than 0"`, or empty.
+        extra: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A seed voxel index lies outside the volume.
+    #[error("seed voxel {seed:?} lies outside the volume of {dims:?} voxels")]
+    SeedOutside {
+        /// The seed, voxel index.
+        seed: [usize; 3],
+        /// The volume's dimensions.
+        dims: [usize; 3],
+    },
+    /// A seed voxel is not on the lumen side of the threshold.
+    #[error(
+        "seed voxel {seed:?} is in the wall: its value {value:.1} is not {side} the threshold \
+         {threshold:.1}"
+    )]
+    SeedInWall {
+        /// The seed, voxel index.
+        seed: [usize; 3],
+        /// The seed's physical value (HU for CT).
+        value: f64,
+        /// Which side of the threshold the lumen lies on.
+        side: LumenSide,
+        /// The threshold, physical units.
+        threshold: f64,
+    },
+    /// A point (world mm) lies outside the volume.
+    #[error("point {point_mm:?} mm lies outside the volume")]
+    PointOutside {
+        /// The point, world mm (LPS).
+        point_mm: [f64; 3],
+    },
+    /// A point lies in the wall (or right against it) and no lumen voxel clear of the wall is
+    /// near enough to snap to.
+    #[error(
+        "point {point_mm:?} mm is in the wall: no lumen voxel at least one voxel from the wall \
+         lies within {radius_mm} mm of it"
+    )]
+    PointInWall {
+        /// The point, world mm (LPS).
+        point_mm: [f64; 3],
+        /// How far the snap looked, mm.
+        radius_mm: f64,
+    },
+    /// The start and end of a path lie in lumens that are not connected.
+    #[error("the start {start_mm:?} mm and the end {end_mm:?} mm lie in disconnected lumens")]
+    Disconnected {
+        /// The start, world mm (LPS).
+        start_mm: [f64; 3],
+        /// The end, world mm (LPS).
+        end_mm: [f64; 3],
+    },
+}
+
+/// `Ok(value)` when finite (and, with `positive`, greater than 0), else [`NavError::BadNumber`].
+pub(crate) fn check_finite(
+    what: &'static str,
+    value: f64,
+    positive: bool,
+) -> Result<f64, NavError> {
+    // Written so that NaN fails both tests.
+    if value.is_finite() && (!positive || value > 0.0) {
+        Ok(value)
+    } else {
+        Err(NavError::BadNumber {
+            what,
+            extra: if positive { " greater than 0" } else { "" },
+            value,
+        })
+    }
+}

@@ -1,0 +1,522 @@
+//! The lumen: the 6-connected region of voxels around a seed whose value lies on the lumen side
+//! of a threshold (air in a colon or airway, contrast in a vessel, CSF in a ventricle).
+//!
+//! A [`Lumen`] keeps one bit per voxel of its own bounding box, not of the volume: a colon in a
+//! 512 × 512 × 478 abdomen needs about 4 MB. The flood fill that finds it is a scanline fill
+//! (one stack entry per run of voxels along `i`, not per voxel) with a one-bit-per-voxel visited
+//! set over the volume, so its memory is bounded by `voxels / 8` bytes plus the stack of runs.
+
+use super::error::{check_finite, NavError};
+use crate::{ValueMap, Volume};
+use std::fmt;
+
+/// Which side of the threshold the lumen lies on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LumenSide {
+    /// The lumen is darker than the wall: air in CT, CSF in T1 MRI.
+    Below,
+    /// The lumen is brighter than the wall: contrast-filled vessels, CSF in T2 MRI.
+    Above,
+}
+
+impl LumenSide {
+    /// True when `value` lies strictly on this side of `threshold` (a voxel exactly at the
+    /// threshold is wall, like the renderer's isosurface).
+    #[inline]
+    pub fn holds(self, value: f64, threshold: f64) -> bool {
+        match self {
+            Self::Below => value < threshold,
+            Self::Above => value > threshold,
+        }
+    }
+}
+
+impl fmt::Display for LumenSide {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Below => "below",
+            Self::Above => "above",
+        })
+    }
+}
+
+/// One bit per voxel of a box, `i` fastest.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct BitGrid {
+    dims: [usize; 3],
+    words: Vec<u64>,
+}
+
+impl BitGrid {
+    pub(crate) fn new(dims: [usize; 3]) -> Self {
+        let n = dims[0] * dims[1] * dims[2];
+        Self {
+            dims,
+            words: vec![0; n.div_ceil(64)],
+        }
+    }
+
+    #[inline]
+    fn index(&self, [i, j, k]: [usize; 3]) -> usize {
+        i + self.dims[0] * (j + self.dims[1] * k)
+    }
+
+    /// The bit of voxel `v` (which must lie in the box).
+    #[inline]
+    pub(crate) fn get(&self, v: [usize; 3]) -> bool {
+        let n = self.index(v);
+        self.words[n >> 6] >> (n & 63) & 1 == 1
+    }
+
+    #[inline]
+    fn set(&mut self, v: [usize; 3]) {
+        let n = self.index(v);
+        self.words[n >> 6] |= 1 << (n & 63);
+    }
+}
+
+/// Which stored values lie on the lumen side: a table over all 65 536 `u16` values, so the fill
+/// compares nothing and any value map (even a negative scale) is handled alike.
+struct ValueTest {
+    table: Vec<bool>,
+}
+
+impl ValueTest {
+    fn new(map: ValueMap, threshold: f64, side: LumenSide) -> Self {
+        let table = (0..=u16::MAX)
+            .map(|s| side.holds(map.physical(s), threshold))
+            .collect();
+        Self { table }
+    }
+
+    #[inline]
+    fn holds(&self, stored: u16) -> bool {
+        self.table[usize::from(stored)]
+    }
+}
+
+/// What one flood fill found: its seed, size and inclusive bounding box.
+#[derive(Debug, Clone, Copy)]
+struct Component {
+    seed: [usize; 3],
+    count: usize,
+    lo: [usize; 3],
+    hi: [usize; 3],
+}
+
+impl Component {
+    fn touches_border(&self, dims: [usize; 3]) -> bool {
+        (0..3).any(|a| self.lo[a] == 0 || self.hi[a] + 1 == dims[a])
+    }
+}
+
+/// The 6-connected lumen component around a seed voxel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lumen {
+    /// Lowest voxel index of the bounding box.
+    lo: [usize; 3],
+    /// The component's voxels, relative to `lo`.
+    mask: BitGrid,
+    count: usize,
+    volume_dims: [usize; 3],
+    seed: [usize; 3],
+    threshold: f64,
+    side: LumenSide,
+}
+
+impl Lumen {
+    /// The component of voxels 6-connected to `seed` whose physical value lies on `side` of
+    /// `threshold` (HU for CT). Errors: a NaN/infinite threshold, a seed outside the volume, a
+    /// seed whose own value is on the wall side.
+    pub fn from_seed(
+        volume: &Volume,
+        seed: [usize; 3],
+        threshold: f64,
+        side: LumenSide,
+    ) -> Result<Self, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let dims = volume.dims();
+        let value = volume
+            .physical(seed[0], seed[1], seed[2])
+            .ok_or(NavError::SeedOutside { seed, dims })?;
+        if !side.holds(value, threshold) {
+            return Err(NavError::SeedInWall {
+                seed,
+                value,
+                side,
+                threshold,
+            });
+        }
+        let test = ValueTest::new(volume.value_map(), threshold, side);
+        let mut visited = BitGrid::new(dims);
+        let component = fill(volume, &test, seed, &mut visited);
+        Ok(Self::from_visited(
+            &visited, component, dims, threshold, side,
+        ))
+    }
+
+    /// The largest lumen component of the volume, preferring components that do not touch the
+    /// volume's border when `prefer_interior`: in CT the air around the patient touches the
+    /// border and the colon or airways inside do not. When every component touches the border
+    /// (a tube cut by the field of view) the largest of all is taken. `Ok(None)` when no voxel
+    /// lies on the lumen side.
+    pub fn largest(
+        volume: &Volume,
+        threshold: f64,
+        side: LumenSide,
+        prefer_interior: bool,
+    ) -> Result<Option<Self>, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let dims = volume.dims();
+        let test = ValueTest::new(volume.value_map(), threshold, side);
+        let mut visited = BitGrid::new(dims);
+        let (mut best_all, mut best_inner): (Option<Component>, Option<Component>) = (None, None);
+        let bigger = |best: Option<Component>, c: Component| match best {
+            Some(b) if b.count >= c.count => Some(b),
+            _ => Some(c),
+        };
+        for (n, &stored) in volume.voxels().iter().enumerate() {
+            let v = [n % dims[0], n / dims[0] % dims[1], n / (dims[0] * dims[1])];
+            if !test.holds(stored) || visited.get(v) {
+                continue;
+            }
+            let c = fill(volume, &test, v, &mut visited);
+            best_all = bigger(best_all, c);
+            if !c.touches_border(dims) {
+                best_inner = bigger(best_inner, c);
+            }
+        }
+        let chosen = if prefer_interior {
+            best_inner.or(best_all)
+        } else {
+            best_all
+        };
+        chosen
+            .map(|c| Self::from_seed(volume, c.seed, threshold, side))
+            .transpose()
+    }
+
+    /// Copies the component's bits out of the volume-wide visited set into its bounding box.
+    fn from_visited(
+        visited: &BitGrid,
+        c: Component,
+        volume_dims: [usize; 3],
+        threshold: f64,
+        side: LumenSide,
+    ) -> Self {
+        let box_dims = [0, 1, 2].map(|a| c.hi[a] - c.lo[a] + 1);
+        let mut mask = BitGrid::new(box_dims);
+        for k in 0..box_dims[2] {
+            for j in 0..box_dims[1] {
+                for i in 0..box_dims[0] {
+                    if visited.get([c.lo[0] + i, c.lo[1] + j, c.lo[2] + k]) {
+                        mask.set([i, j, k]);
+                    }
+                }
+            }
+        }
+        Self {
+            lo: c.lo,
+            mask,
+            count: c.count,
+            volume_dims,
+            seed: c.seed,
+            threshold,
+            side,
+        }
+    }
+
+    /// True when voxel `v` belongs to the lumen (false outside the volume).
+    #[inline]
+    pub fn contains(&self, v: [usize; 3]) -> bool {
+        let rel = [0, 1, 2].map(|a| v[a].wrapping_sub(self.lo[a]));
+        (0..3).all(|a| rel[a] < self.mask.dims[a]) && self.mask.get(rel)
+    }
+
+    /// True when the voxel at `offset` from the bounding box's lowest corner belongs to the
+    /// lumen; offsets outside the box (negative ones too) are not.
+    #[inline]
+    pub(crate) fn contains_in_box(&self, offset: [isize; 3]) -> bool {
+        let inside = (0..3).all(|a| offset[a] >= 0 && (offset[a] as usize) < self.mask.dims[a]);
+        inside && self.mask.get(offset.map(|o| o as usize))
+    }
+
+    /// True when `v` is a wall-surface voxel: not in the lumen, but 6-adjacent to a lumen voxel.
+    pub fn is_wall(&self, v: [usize; 3]) -> bool {
+        if self.contains(v) {
+            return false;
+        }
+        (0..3).any(|a| {
+            let mut lower = v;
+            let mut upper = v;
+            lower[a] = lower[a].wrapping_sub(1);
+            upper[a] += 1;
+            self.contains(lower) || self.contains(upper)
+        })
+    }
+
+    /// The inclusive bounding box of the lumen's voxels: lowest and highest voxel index.
+    pub fn bounds(&self) -> ([usize; 3], [usize; 3]) {
+        let hi = [0, 1, 2].map(|a| self.lo[a] + self.mask.dims[a] - 1);
+        (self.lo, hi)
+    }
+
+    /// Number of voxels in the lumen.
+    pub fn voxel_count(&self) -> usize {
+        self.count
+    }
+
+    /// The dimensions of the volume the lumen was found in.
+    pub fn volume_dims(&self) -> [usize; 3] {
+        self.volume_dims
+    }
+
+    /// The seed voxel it was grown from.
+    pub fn seed(&self) -> [usize; 3] {
+        self.seed
+    }
+
+    /// The threshold, physical units (HU for CT).
+    pub fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    /// Which side of the threshold is lumen.
+    pub fn side(&self) -> LumenSide {
+        self.side
+    }
+
+    /// Every lumen voxel, `i` fastest (sorted by linear index).
+    pub fn voxels(&self) -> impl Iterator<Item = [usize; 3]> + '_ {
+        let [nx, ny, nz] = self.mask.dims;
+        (0..nz)
+            .flat_map(move |k| (0..ny).flat_map(move |j| (0..nx).map(move |i| [i, j, k])))
+            .filter(|&rel| self.mask.get(rel))
+            .map(|rel| [0, 1, 2].map(|a| rel[a] + self.lo[a]))
+    }
+}
+
+/// A dense numbering of a lumen's voxels, `0..voxel_count` in linear order (the order of
+/// [`Lumen::voxels`]), so per-voxel work arrays hold lumen voxels only, not the whole box: one
+/// count per 64 voxels of the box.
+pub(crate) struct LumenNumbering<'a> {
+    lumen: &'a Lumen,
+    /// Lumen voxels before each 64-bit word of the mask.
+    before: Vec<usize>,
+}
+
+impl<'a> LumenNumbering<'a> {
+    pub(crate) fn new(lumen: &'a Lumen) -> Self {
+        let mut total = 0;
+        let before = lumen
+            .mask
+            .words
+            .iter()
+            .map(|w| {
+                let here = total;
+                total += w.count_ones() as usize;
+                here
+            })
+            .collect();
+        Self { lumen, before }
+    }
+
+    /// The lumen numbered.
+    pub(crate) fn lumen(&self) -> &'a Lumen {
+        self.lumen
+    }
+
+    /// The number of voxel `v` (volume index), or `None` when it is not in the lumen.
+    #[inline]
+    pub(crate) fn number(&self, v: [usize; 3]) -> Option<usize> {
+        if !self.lumen.contains(v) {
+            return None;
+        }
+        let rel = [0, 1, 2].map(|a| v[a] - self.lumen.lo[a]);
+        let n = self.lumen.mask.index(rel);
+        let below = self.lumen.mask.words[n >> 6] & ((1u64 << (n & 63)) - 1);
+        Some(self.before[n >> 6] + below.count_ones() as usize)
+    }
+}
+
+/// Scanline flood fill from `seed` (a lumen voxel not yet visited) over 6-connected lumen
+/// voxels, marking them in `visited`. Each stack entry starts a run along `i`; the stack holds
+/// at most a few entries per run of the component, never one per voxel.
+fn fill(volume: &Volume, test: &ValueTest, seed: [usize; 3], visited: &mut BitGrid) -> Component {
+    let [nx, ny, nz] = volume.dims();
+    let voxels = volume.voxels();
+    let open = |v: [usize; 3], visited: &BitGrid| {
+        test.holds(voxels[v[0] + nx * (v[1] + ny * v[2])]) && !visited.get(v)
+    };
+    let mut c = Component {
+        seed,
+        count: 0,
+        lo: seed,
+        hi: seed,
+    };
+    let mut stack = vec![seed];
+    while let Some([i, j, k]) = stack.pop() {
+        if !open([i, j, k], visited) {
+            continue;
+        }
+        let (mut a, mut b) = (i, i);
+        while a > 0 && open([a - 1, j, k], visited) {
+            a -= 1;
+        }
+        while b + 1 < nx && open([b + 1, j, k], visited) {
+            b += 1;
+        }
+        for x in a..=b {
+            visited.set([x, j, k]);
+        }
+        c.count += b - a + 1;
+        c.lo = [c.lo[0].min(a), c.lo[1].min(j), c.lo[2].min(k)];
+        c.hi = [c.hi[0].max(b), c.hi[1].max(j), c.hi[2].max(k)];
+        let rows = [
+            (j.wrapping_sub(1), k),
+            (j + 1, k),
+            (j, k.wrapping_sub(1)),
+            (j, k + 1),
+        ];
+        for (y, z) in rows.into_iter().filter(|&(y, z)| y < ny && z < nz) {
+            // One entry per maximal run of open voxels in the neighbouring row.
+            let mut in_run = false;
+            for x in a..=b {
+                let o = open([x, y, z], visited);
+                if o && !in_run {
+                    stack.push([x, y, z]);
+                }
+                in_run = o;
+            }
+        }
+    }
+    c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::navigate::test_util::random_volume;
+    use crate::phantom::{self, PhantomOptions};
+
+    /// Brute-force 6-connected component by breadth-first search, for comparison.
+    fn reference(volume: &Volume, seed: [usize; 3], threshold: f64) -> Vec<[usize; 3]> {
+        let dims = volume.dims();
+        let lumen = |v: [usize; 3]| {
+            volume
+                .physical(v[0], v[1], v[2])
+                .is_some_and(|x| x < threshold)
+        };
+        let mut seen = std::collections::HashSet::from([seed]);
+        let mut queue = std::collections::VecDeque::from([seed]);
+        while let Some(v) = queue.pop_front() {
+            for a in 0..3 {
+                for up in [false, true] {
+                    let mut w = v;
+                    w[a] = if up { w[a] + 1 } else { w[a].wrapping_sub(1) };
+                    if w[a] < dims[a] && lumen(w) && seen.insert(w) {
+                        queue.push_back(w);
+                    }
+                }
+            }
+        }
+        let mut all: Vec<_> = seen.into_iter().collect();
+        all.sort_by_key(|v| (v[2], v[1], v[0]));
+        all
+    }
+
+    #[test]
+    fn fill_matches_breadth_first_search_on_random_volumes() {
+        for seed in 0..6 {
+            let volume = random_volume([13, 11, 9], glam::DVec3::ONE, seed, 0.6);
+            let start = volume
+                .voxels()
+                .iter()
+                .position(|&s| volume.value_map().physical(s) < 0.0)
+                .unwrap();
+            let dims = volume.dims();
+            let v = [
+                start % dims[0],
+                start / dims[0] % dims[1],
+                start / (dims[0] * dims[1]),
+            ];
+            let lumen = Lumen::from_seed(&volume, v, 0.0, LumenSide::Below).unwrap();
+            let expected = reference(&volume, v, 0.0);
+            assert_eq!(lumen.voxels().collect::<Vec<_>>(), expected);
+            assert_eq!(lumen.voxel_count(), expected.len());
+            let (lo, hi) = lumen.bounds();
+            for a in 0..3 {
+                assert_eq!(lo[a], expected.iter().map(|e| e[a]).min().unwrap());
+                assert_eq!(hi[a], expected.iter().map(|e| e[a]).max().unwrap());
+            }
+        }
+    }
+
+    #[test]
+    fn tube_lumen_wall_and_errors() {
+        let (volume, tube) = phantom::straight_tube(&PhantomOptions {
+            size: 32,
+            ..Default::default()
+        });
+        let lumen = Lumen::from_seed(&volume, [16, 16, 16], -480.0, LumenSide::Below).unwrap();
+        // Voxel centres strictly inside the analytic radius are lumen (the ramp crosses −480
+        // HU exactly on the surface).
+        let centre = tube.centreline.point_at(0.0);
+        let inside = (0..32usize)
+            .flat_map(|j| (0..32usize).map(move |i| (i, j)))
+            .filter(|&(i, j)| {
+                let d = glam::DVec2::new(i as f64 - centre.x, j as f64 - centre.y).length();
+                d < tube.radius_vox
+            })
+            .count();
+        assert_eq!(lumen.voxel_count(), inside * 32);
+        assert!(lumen.contains([16, 16, 0]) && !lumen.contains([0, 0, 0]));
+        assert!(!lumen.contains([16, 16, 32]));
+        let edge = (0..16).find(|&i| lumen.contains([i, 16, 5])).unwrap();
+        assert!(lumen.is_wall([edge - 1, 16, 5]));
+        assert!(!lumen.is_wall([edge, 16, 5]) && !lumen.is_wall([0, 0, 5]));
+        assert!(matches!(
+            Lumen::from_seed(&volume, [0, 0, 0], -480.0, LumenSide::Below),
+            Err(NavError::SeedInWall { value: 40.0, .. })
+        ));
+        let message = Lumen::from_seed(&volume, [0, 0, 0], -480.0, LumenSide::Below)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("40.0") && message.contains("-480.0"),
+            "{message}"
+        );
+        assert!(matches!(
+            Lumen::from_seed(&volume, [99, 0, 0], -480.0, LumenSide::Below),
+            Err(NavError::SeedOutside { .. })
+        ));
+        assert!(matches!(
+            Lumen::from_seed(&volume, [16, 16, 16], f64::NAN, LumenSide::Below),
+            Err(NavError::BadNumber { .. })
+        ));
+        // The tissue is the lumen when the lumen is bright.
+        let tissue = Lumen::from_seed(&volume, [0, 0, 0], -480.0, LumenSide::Above).unwrap();
+        assert_eq!(tissue.voxel_count(), 32 * 32 * 32 - lumen.voxel_count());
+    }
+
+    #[test]
+    fn largest_prefers_the_inside_of_the_body() {
+        let (volume, _) = phantom::sphere_shell(&PhantomOptions {
+            size: 32,
+            ..Default::default()
+        });
+        // Air inside and outside the shell: the outside is larger but touches the border.
+        let inner = Lumen::largest(&volume, -480.0, LumenSide::Below, true)
+            .unwrap()
+            .unwrap();
+        let outer = Lumen::largest(&volume, -480.0, LumenSide::Below, false)
+            .unwrap()
+            .unwrap();
+        assert!(inner.contains([16, 16, 16]) && !outer.contains([16, 16, 16]));
+        assert!(outer.voxel_count() > inner.voxel_count());
+        assert!(outer.contains([0, 0, 0]));
+        assert!(Lumen::largest(&volume, -5000.0, LumenSide::Below, true)
+            .unwrap()
+            .is_none());
+    }
+}

@@ -1,0 +1,35 @@
+//! Navigation through a lumen: the lumen itself ([`Lumen`]), the distance of every lumen voxel
+//! to the wall ([`DistanceField`]), a camera that slides along the wall instead of entering it
+//! ([`Collider`]), the minimal centred path between two points ([`centreline`]) and a default
+//! viewpoint for a scan ([`default_viewpoint`]).
+//!
+//! ```
+//! use endocast_core::navigate::{DistanceField, Lumen, LumenSide};
+//! use endocast_core::phantom::{self, PhantomOptions};
+//!
+//! let (volume, tube) = phantom::straight_tube(&PhantomOptions { size: 32, ..Default::default() });
+//! let lumen = Lumen::from_seed(&volume, [16, 16, 16], -480.0, LumenSide::Below)?;
+//! let field = DistanceField::new(&lumen, volume.geometry());
+//! // The widest point lies a tube radius (give or take a voxel) from the wall.
+//! assert!((field.max_mm() - tube.radius_vox).abs() < 1.0);
+//! # Ok::<(), endocast_core::navigate::NavError>(())
+//! ```
+//!
+//! Units: points are world millimetres (LPS) unless a name says `voxel`; voxel indices are
+//! `[usize; 3]` of the volume, `i` first.
+
+mod centreline;
+mod collision;
+mod distance;
+mod error;
+mod lumen;
+#[cfg(test)]
+mod test_util;
+mod viewpoint;
+
+pub use centreline::{centreline, CentrelinePath, PathEnd, SNAP_RADIUS_MM};
+pub use collision::Collider;
+pub use distance::DistanceField;
+pub use error::NavError;
+pub use lumen::{Lumen, LumenSide};
+pub use viewpoint::default_viewpoint;

@@ -1,0 +1,165 @@
+//! Where to put the camera when the user gave none: at the most central point of the largest
+//! relevant lumen, looking along it.
+
+use super::distance::DistanceField;
+use super::lumen::{Lumen, LumenSide};
+use crate::pose::Pose;
+use crate::Volume;
+use glam::{DMat3, DVec3};
+
+/// The neighbourhood whose shape gives the viewing direction, in multiples of the lumen's largest
+/// distance to the wall: three radii each way is a tube segment three times longer than wide,
+/// long enough to have a clear axis, short enough to follow a winding colon.
+const AXIS_REACH: f64 = 3.0;
+/// Power iterations for the principal axis (the ratio of the two largest eigenvalues of an
+/// elongated neighbourhood is at least 2, so 64 steps converge far below a degree).
+const POWER_STEPS: usize = 64;
+
+/// A default camera for `volume`: the eye at the most central voxel (largest distance to the
+/// wall; among voxels within half a voxel of it, the one nearest the lumen's centroid) of the
+/// largest lumen component on `side` of `threshold_hu`, looking along the lumen's local long
+/// axis (the principal axis of the lumen voxels within three wall distances of the eye), towards
+/// the longer free run, with up as near the patient's anterior (−y, LPS) as the view allows.
+///
+/// For a dark lumen ([`LumenSide::Below`]: CT air, CSF on T1) components touching the volume's
+/// border are passed over when another exists: the air around the patient touches it, the colon
+/// and airways do not. For a bright lumen (contrast, CSF on T2) the largest is taken. `None`
+/// when the threshold is not finite or no voxel lies on the lumen side.
+pub fn default_viewpoint(volume: &Volume, threshold_hu: f64, side: LumenSide) -> Option<Pose> {
+    let lumen = Lumen::largest(volume, threshold_hu, side, side == LumenSide::Below).ok()??;
+    let field = DistanceField::new(&lumen, volume.geometry());
+    let eye_voxel = most_central(&lumen, &field);
+    let eye_mm = field.world_of_voxel(eye_voxel);
+    let reach_mm = AXIS_REACH * field.max_mm();
+    let axis = principal_axis(&lumen, &field, eye_mm, reach_mm);
+    let forward = if free_run(&field, eye_mm, axis) >= free_run(&field, eye_mm, -axis) {
+        axis
+    } else {
+        -axis
+    };
+    let anterior = DVec3::NEG_Y;
+    let reference = if anterior.dot(forward).abs() < 0.9 {
+        anterior
+    } else {
+        DVec3::Z
+    };
+    let up = (reference - forward * reference.dot(forward)).normalize();
+    Some(Pose {
+        eye_mm,
+        look_at_mm: eye_mm + forward * field.max_mm().max(1.0),
+        up,
+    })
+}
+
+/// The voxel nearest the lumen's centroid among those within half a voxel of the largest
+/// distance to the wall (ties on a lattice are common: a straight tube's whole axis).
+fn most_central(lumen: &Lumen, field: &DistanceField) -> [usize; 3] {
+    let mut sum = DVec3::ZERO;
+    for v in lumen.voxels() {
+        sum += field.world_of_voxel(v);
+    }
+    let centroid = sum / lumen.voxel_count() as f64;
+    let floor = field.max_mm() - 0.5 * field.min_spacing_mm();
+    let mut best = (f64::INFINITY, field.max_voxel());
+    for v in lumen.voxels() {
+        if field.distance_at_voxel(v) >= floor {
+            let d = field.world_of_voxel(v).distance_squared(centroid);
+            if d < best.0 {
+                best = (d, v);
+            }
+        }
+    }
+    best.1
+}
+
+/// The unit principal axis (largest variance) of the lumen voxels within `reach_mm` of
+/// `centre_mm`, by power iteration on their covariance.
+fn principal_axis(lumen: &Lumen, field: &DistanceField, centre_mm: DVec3, reach_mm: f64) -> DVec3 {
+    let near: Vec<DVec3> = lumen
+        .voxels()
+        .map(|v| field.world_of_voxel(v) - centre_mm)
+        .filter(|p| p.length() <= reach_mm)
+        .collect();
+    let n = near.len().max(1) as f64;
+    let mean = near.iter().copied().sum::<DVec3>() / n;
+    let mut cov = DMat3::ZERO;
+    for &p in &near {
+        let q = p - mean;
+        cov += DMat3::from_cols(q * q.x, q * q.y, q * q.z);
+    }
+    let mut axis = DVec3::new(0.6, 0.5, 0.62).normalize();
+    for _ in 0..POWER_STEPS {
+        match (cov * axis).try_normalize() {
+            Some(next) => axis = next,
+            None => break,
+        }
+    }
+    axis
+}
+
+/// How far (mm) the eye can look from `from_mm` along unit `dir` before the distance to the wall
+/// drops below a voxel.
+fn free_run(field: &DistanceField, from_mm: DVec3, dir: DVec3) -> f64 {
+    let step = field.min_spacing_mm();
+    let limit = field.diagonal_mm();
+    let mut t = 0.0;
+    while t < limit && field.distance_mm(from_mm + dir * (t + step)) >= step {
+        t += step;
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::phantom::{self, PhantomOptions};
+
+    fn options(size: usize) -> PhantomOptions {
+        PhantomOptions {
+            size,
+            ..Default::default()
+        }
+    }
+
+    fn forward(pose: &Pose) -> DVec3 {
+        (pose.look_at_mm - pose.eye_mm).normalize()
+    }
+
+    #[test]
+    fn straight_tube_view_is_down_the_middle() {
+        let (volume, tube) = phantom::straight_tube(&options(64));
+        let pose = default_viewpoint(&volume, -480.0, LumenSide::Below).unwrap();
+        // World (0, 0, 0) is the grid's centre, on the axis.
+        assert!(pose.eye_mm.truncate().length() <= 1.0, "{}", pose.eye_mm);
+        assert!(pose.eye_mm.z.abs() < 0.25 * tube.centreline.length_vox());
+        assert!(
+            forward(&pose).z.abs() > 15f64.to_radians().cos(),
+            "{pose:?}"
+        );
+        assert!(pose.up.dot(forward(&pose)).abs() < 1e-9);
+        assert!((pose.up.length() - 1.0).abs() < 1e-9);
+        assert!(default_viewpoint(&volume, f64::NAN, LumenSide::Below).is_none());
+        assert!(default_viewpoint(&volume, -5000.0, LumenSide::Below).is_none());
+    }
+
+    #[test]
+    fn colon_view_is_well_inside_and_along_the_lumen() {
+        let (volume, colon) = phantom::colon(&options(128));
+        let pose = default_viewpoint(&volume, -480.0, LumenSide::Below).unwrap();
+        let to_vox = volume.geometry().voxel_from_world();
+        let (s, off) = colon
+            .centreline
+            .closest(to_vox.transform_point3(pose.eye_mm));
+        assert!(
+            off < 0.25 * colon.radius_vox_at(s),
+            "{off} voxel off the axis"
+        );
+        let tangent = colon.centreline.tangent_at(s);
+        let cos = forward(&pose).dot(tangent).abs();
+        assert!(
+            cos > 15f64.to_radians().cos(),
+            "{}°",
+            cos.acos().to_degrees()
+        );
+    }
+}
