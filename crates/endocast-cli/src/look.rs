@@ -44,6 +44,11 @@ pub struct LookArgs {
 }
 
 impl LookArgs {
+    /// The preset named with `--preset`, if any.
+    pub fn preset(&self) -> Option<&str> {
+        self.preset.as_deref()
+    }
+
     /// The preset (or defaults), overridden by every option given.
     pub fn settings(&self) -> Result<RenderSettings> {
         let mut s = match &self.preset {

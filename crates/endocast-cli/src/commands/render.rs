@@ -6,7 +6,9 @@ use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
-use endocast_core::Geometry;
+use endocast_core::navigate::{default_viewpoint, preset_lumen};
+use endocast_core::pose::Pose;
+use endocast_core::{Geometry, Volume};
 use glam::DVec3;
 use serde_json::json;
 use std::path::PathBuf;
@@ -21,8 +23,9 @@ pub struct RenderArgs {
     output: PathBuf,
     #[command(flatten)]
     look: LookArgs,
-    /// Eye position, world mm (LPS, as `endocast info` reports). Without it the view frames the
-    /// whole volume from the front.
+    /// Eye position, world mm (LPS, as `endocast info` reports). Without it, an endoscopic
+    /// preset looks along the largest lumen from its most central point; otherwise the view
+    /// frames the whole volume from the front.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     eye: Option<[f64; 3]>,
     /// Point looked at, world mm (needed with --eye).
@@ -58,7 +61,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
-    let camera = camera(args, loaded.volume.geometry())?;
+    let camera = camera(args, &loaded.volume, &settings)?;
     let renderer = Renderer::new(loaded.volume);
     let prepared = renderer
         .prepare(&settings)
@@ -92,19 +95,52 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The camera the options describe, or one framing the whole volume from the front.
-fn camera(args: &RenderArgs, geometry: &Geometry) -> Result<Camera> {
-    let (eye, look_at) = match (args.eye, args.look_at) {
-        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at)),
-        (None, None) => framing_eye(geometry, args.fov),
+/// The camera the options describe; without one, for an endoscopic preset, a view from inside
+/// the largest lumen along its axis, else one framing the whole volume from the front.
+fn camera(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Result<Camera> {
+    let (eye, look_at, up) = match (args.eye, args.look_at) {
+        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None),
+        (None, None) => match inside_view(args, volume, settings) {
+            Some(pose) => (pose.eye_mm, pose.look_at_mm, Some(pose.up)),
+            None => {
+                let (eye, look_at) = framing_eye(volume.geometry(), args.fov);
+                (eye, look_at, None)
+            }
+        },
         _ => bail!("--eye and --look-at go together"),
     };
     let up = args
         .up
-        .map_or_else(|| default_up(look_at - eye), DVec3::from);
+        .map(DVec3::from)
+        .or(up)
+        .unwrap_or_else(|| default_up(look_at - eye));
     Camera::look_at(eye, look_at, up, args.fov, args.size)
         .and_then(|c| c.with_near_mm(args.near))
         .context("invalid camera")
+}
+
+/// The default endoscopic view of `--preset` (see [`default_viewpoint`]), if it names a lumen
+/// and the scan has one. An `--iso` moves the lumen threshold with it (CThead stores HU + 1024).
+fn inside_view(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Option<Pose> {
+    let name = args.look.preset()?;
+    let (threshold, side) = preset_lumen(name)?;
+    let threshold = threshold + settings.iso_hu - RenderSettings::preset(name)?.iso_hu;
+    let pose = default_viewpoint(volume, threshold, side);
+    match &pose {
+        Some(p) => eprintln!(
+            "camera inside the largest lumen {side} {threshold}: --eye {} --look-at {} --up {}",
+            triple(p.eye_mm),
+            triple(p.look_at_mm),
+            triple(p.up)
+        ),
+        None => eprintln!("warning: no lumen {side} {threshold}; framing the whole volume instead"),
+    }
+    pose
+}
+
+/// `x,y,z` with two decimals, as `--eye` takes it.
+fn triple(v: DVec3) -> String {
+    format!("{:.2},{:.2},{:.2}", v.x, v.y, v.z)
 }
 
 /// Superior (+z in LPS), or posterior when looking (nearly) straight up or down.

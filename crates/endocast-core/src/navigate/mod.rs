@@ -23,6 +23,7 @@ mod collision;
 mod distance;
 mod error;
 mod lumen;
+mod preset;
 #[cfg(test)]
 mod test_util;
 mod viewpoint;
@@ -32,4 +33,5 @@ pub use collision::Collider;
 pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
+pub use preset::preset_lumen;
 pub use viewpoint::default_viewpoint;
