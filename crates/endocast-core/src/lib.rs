@@ -11,6 +11,7 @@
 //! ```
 
 pub mod geometry;
+pub mod path;
 pub mod phantom;
 pub mod pose;
 pub mod render;
