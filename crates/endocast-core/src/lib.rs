@@ -10,6 +10,7 @@
 //! assert!(lo < -500.0 && hi > 0.0);
 //! ```
 
+pub mod animation;
 pub mod geometry;
 pub mod path;
 pub mod phantom;
