@@ -28,6 +28,7 @@ pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;
 mod open;
+pub mod path_file;
 pub mod raw;
 pub mod samples;
 mod text;
