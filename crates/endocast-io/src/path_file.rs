@@ -468,4 +468,14 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn the_documented_example_reads() {
+        let doc = include_str!("../../../docs/path-format.md");
+        let start = doc.find("```json\n").unwrap() + 8;
+        let end = start + doc[start..].find("```").unwrap();
+        let d = parse(&doc[start..end]).unwrap();
+        assert_eq!((d.points_mm.len(), d.key_frames.len()), (3, 2));
+        assert_eq!(d.key_frames[0].tf.as_deref(), Some("colonoscopy"));
+    }
 }
