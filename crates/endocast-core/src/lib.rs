@@ -10,8 +10,10 @@
 //! assert!(lo < -500.0 && hi > 0.0);
 //! ```
 
+pub mod animation;
 pub mod geometry;
 pub mod navigate;
+pub mod path;
 pub mod phantom;
 pub mod pose;
 pub mod render;

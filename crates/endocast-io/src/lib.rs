@@ -23,12 +23,15 @@ mod encode;
 pub mod error;
 pub mod image_out;
 pub mod limits;
+pub mod markups;
 pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;
 mod open;
+pub mod path_file;
 pub mod raw;
 pub mod samples;
+mod text;
 pub mod transfer_json;
 
 pub use error::{ReadError, Result};

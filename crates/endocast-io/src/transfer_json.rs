@@ -15,7 +15,6 @@
 
 use crate::error::{ReadError, Result};
 use serde_json::Value;
-use std::io::Read;
 use std::path::Path;
 
 /// A transfer-function file is a few hundred bytes; refuse anything absurdly larger unread.
@@ -32,17 +31,7 @@ pub struct TfPoints {
 
 /// Reads a transfer-function JSON file (at most 1 MiB).
 pub fn read_transfer_json(path: &Path) -> Result<TfPoints> {
-    let file = std::fs::File::open(path).map_err(|e| ReadError::io(path, e))?;
-    let mut text = String::new();
-    file.take(MAX_BYTES + 1)
-        .read_to_string(&mut text)
-        .map_err(|e| ReadError::io(path, e))?;
-    if text.len() as u64 > MAX_BYTES {
-        return Err(ReadError::format(
-            path,
-            format!("a transfer function file is at most {MAX_BYTES} bytes, this one is larger"),
-        ));
-    }
+    let text = crate::text::read_text(path, MAX_BYTES, "a transfer function file")?;
     parse_transfer_json(path, &text)
 }
 
