@@ -3,6 +3,7 @@
 mod commands;
 mod input;
 mod look;
+mod lumen;
 mod parse;
 
 use clap::{Parser, Subcommand};
@@ -26,6 +27,8 @@ enum Command {
     Convert(commands::convert::ConvertArgs),
     /// Render one endoscopic (or outside) view of a scan to PNG.
     Render(Box<commands::render::RenderArgs>),
+    /// The centred flight path through a lumen, to path JSON or Slicer Markups (.mrk.json).
+    Path(Box<commands::path::PathArgs>),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
 }
@@ -38,6 +41,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => commands::convert::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
+        Command::Path(args) => commands::path::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

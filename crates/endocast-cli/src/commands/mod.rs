@@ -3,5 +3,6 @@
 pub mod bench;
 pub mod convert;
 pub mod info;
+pub mod path;
 pub mod phantom;
 pub mod render;

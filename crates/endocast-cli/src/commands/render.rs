@@ -2,6 +2,7 @@
 
 use crate::input::InputArgs;
 use crate::look::{in_pool, LookArgs};
+use crate::lumen::LumenArgs;
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -23,6 +24,8 @@ pub struct RenderArgs {
     output: PathBuf,
     #[command(flatten)]
     look: LookArgs,
+    #[command(flatten)]
+    lumen: LumenArgs,
     /// Eye position, world mm (LPS, as `endocast info` reports). Without it, an endoscopic
     /// preset looks along the largest lumen from its most central point; otherwise the view
     /// frames the whole volume from the front.
@@ -120,11 +123,16 @@ fn camera(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Resu
 }
 
 /// The default endoscopic view of `--preset` (see [`default_viewpoint`]), if it names a lumen
-/// and the scan has one. An `--iso` moves the lumen threshold with it (CThead stores HU + 1024).
+/// and the scan has one.
 fn inside_view(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Option<Pose> {
-    let name = args.look.preset()?;
-    let (threshold, side) = preset_lumen(name)?;
-    let threshold = threshold + settings.iso_hu - RenderSettings::preset(name)?.iso_hu;
+    let name = args.look.preset().filter(|name| preset_lumen(name).is_some())?;
+    let (threshold, side) = match args.lumen.resolve(Some(name), Some(settings.iso_hu)) {
+        Ok(lumen) => lumen,
+        Err(error) => {
+            eprintln!("warning: {error:#}; framing the whole volume instead");
+            return None;
+        }
+    };
     let pose = default_viewpoint(volume, threshold, side);
     match &pose {
         Some(p) => eprintln!(

@@ -67,6 +67,9 @@ pub enum NavError {
         /// The end, world mm (LPS).
         end_mm: [f64; 3],
     },
+    /// The centreline could not be made into a smooth path that stays in the lumen.
+    #[error("cannot smooth the centreline: {0}")]
+    Path(#[from] crate::path::PathError),
 }
 
 /// `Ok(value)` when finite (and, with `positive`, greater than 0), else [`NavError::BadNumber`].

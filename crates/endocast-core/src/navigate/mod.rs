@@ -23,6 +23,7 @@ mod collision;
 mod distance;
 mod error;
 mod lumen;
+mod plan;
 mod preset;
 #[cfg(test)]
 mod test_util;
@@ -33,5 +34,6 @@ pub use collision::Collider;
 pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
+pub use plan::{plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::preset_lumen;
 pub use viewpoint::default_viewpoint;

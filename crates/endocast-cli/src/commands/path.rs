@@ -1,0 +1,155 @@
+//! `endocast path`: the centred flight path through a lumen between two points (or to the
+//! farthest point), written as our path JSON or as 3D Slicer Markups (`.mrk.json`).
+
+use crate::input::InputArgs;
+use crate::lumen::LumenArgs;
+use crate::parse::parse_vec3;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use endocast_core::navigate::{plan_path, PathEnd, PlannedPath};
+use endocast_core::path::SmoothOptions;
+use endocast_core::Volume;
+use endocast_io::path_file::{write_path_json, PathDocument};
+use glam::DVec3;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Arguments of `endocast path`.
+#[derive(Args, Debug)]
+pub struct PathArgs {
+    #[command(flatten)]
+    input: InputArgs,
+    /// Start, world mm (LPS, as `endocast info` reports); must lie in the lumen.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    from: Option<[f64; 3]>,
+    /// Start as a voxel index I,J,K (instead of --from).
+    #[arg(long, value_name = "I,J,K", value_parser = parse_vec3)]
+    from_voxel: Option<[f64; 3]>,
+    /// End, world mm; without it (and --to-voxel) the path runs to the farthest lumen point.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    to: Option<[f64; 3]>,
+    /// End as a voxel index I,J,K.
+    #[arg(long, value_name = "I,J,K", value_parser = parse_vec3)]
+    to_voxel: Option<[f64; 3]>,
+    /// The lumen's preset: colonoscopy, bronchoscopy, angioscopy, sinus, ventricles.
+    #[arg(long)]
+    preset: Option<String>,
+    /// Wall isovalue, physical units (HU for CT).
+    #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
+    iso: Option<f64>,
+    #[command(flatten)]
+    lumen: LumenArgs,
+    /// Spacing of the smoothing spline's control points along the path, mm (tightened
+    /// automatically where the smooth path would leave the lumen).
+    #[arg(long, value_name = "MM", default_value_t = 5.0)]
+    smoothing: f64,
+    /// Spacing of the points written, mm.
+    #[arg(long, value_name = "MM", default_value_t = 2.0)]
+    step: f64,
+    /// Output: path JSON (docs/path-format.md), or 3D Slicer Markups when it ends in .mrk.json.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print the result as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `endocast path`.
+pub fn run(args: &PathArgs) -> Result<()> {
+    let loaded = args.input.open()?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
+    let volume = &loaded.volume;
+    let (threshold, side) = args.lumen.resolve(args.preset.as_deref(), args.iso)?;
+    let start = point(volume, args.from, args.from_voxel, "--from")?
+        .context("give the start with --from X,Y,Z (mm) or --from-voxel I,J,K")?;
+    let end = point(volume, args.to, args.to_voxel, "--to")?.map_or(PathEnd::Farthest, PathEnd::Point);
+    let options = SmoothOptions {
+        control_spacing_mm: args.smoothing,
+        step_mm: 0.5,
+        ..SmoothOptions::default()
+    };
+    let clock = Instant::now();
+    let (lumen, field, planned) = plan_path(volume, threshold, side, start, end, &options)
+        .with_context(|| format!("no path in the lumen {side} {threshold}"))?;
+    let seconds = clock.elapsed().as_secs_f64();
+    let points = resample(&planned, args.step)?;
+    write(&args.output, &points)?;
+    let summary = json!({
+        "output": args.output,
+        "points": points.len(),
+        "length_mm": planned.path.len_mm(),
+        "min_radius_mm": planned.min_radius_mm,
+        "mean_radius_mm": planned.mean_radius_mm,
+        "lumen_voxels": lumen.voxel_count(),
+        "max_radius_mm": field.max_mm(),
+        "seconds": seconds,
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        println!(
+            "{}: {} points, {:.1} mm long, radius min {:.1} mm, mean {:.1} mm ({:.1} s)",
+            args.output.display(),
+            points.len(),
+            planned.path.len_mm(),
+            planned.min_radius_mm,
+            planned.mean_radius_mm,
+            seconds
+        );
+    }
+    Ok(())
+}
+
+/// A world point from `--NAME X,Y,Z` or `--NAME-voxel I,J,K`, or `None` when neither is given.
+fn point(
+    volume: &Volume,
+    world: Option<[f64; 3]>,
+    voxel: Option<[f64; 3]>,
+    name: &str,
+) -> Result<Option<DVec3>> {
+    Ok(match (world, voxel) {
+        (Some(_), Some(_)) => bail!("give {name} or {name}-voxel, not both"),
+        (Some(p), None) => Some(DVec3::from(p)),
+        (None, Some(v)) => Some(volume.geometry().world_of(DVec3::from(v))),
+        (None, None) => None,
+    })
+}
+
+/// The smooth path's points every `step_mm` (and its last point).
+fn resample(planned: &PlannedPath, step_mm: f64) -> Result<Vec<DVec3>> {
+    let path = &planned.path;
+    if !(step_mm.is_finite() && step_mm > 0.0) {
+        bail!("--step must be a positive number of mm, not {step_mm}");
+    }
+    let count = (path.len_mm() / step_mm).ceil() as usize;
+    let mut points: Vec<DVec3> = (0..count)
+        .map(|n| path.point_at(n as f64 * step_mm))
+        .collect();
+    points.push(path.point_at(path.len_mm()));
+    Ok(points)
+}
+
+/// Writes the points as Slicer Markups (`.mrk.json`) or as our path JSON.
+fn write(output: &Path, points: &[DVec3]) -> Result<()> {
+    let name = output
+        .file_name()
+        .and_then(|n| n.to_str())
+        .map_or("path", |n| n.split('.').next().unwrap_or(n));
+    let is_markups = output
+        .to_str()
+        .is_some_and(|s| s.to_ascii_lowercase().ends_with(".mrk.json"));
+    if is_markups {
+        endocast_io::markups::write_markups_curve(output, name, points)
+    } else {
+        let document = PathDocument {
+            name: name.to_owned(),
+            points_mm: points.to_vec(),
+            key_frames: Vec::new(),
+        };
+        write_path_json(output, &document)
+    }
+    .context("cannot write the path")
+}
