@@ -14,6 +14,7 @@ pub mod geometry;
 pub mod phantom;
 pub mod pose;
 pub mod render;
+pub mod views;
 pub mod volume;
 
 pub use geometry::{Geometry, GeometryError};
