@@ -10,6 +10,7 @@
 //! assert!(lo < -500.0 && hi > 0.0);
 //! ```
 
+pub mod coverage;
 pub mod geometry;
 pub mod phantom;
 pub mod pose;
