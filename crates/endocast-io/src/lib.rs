@@ -30,6 +30,7 @@ mod open;
 pub mod raw;
 pub mod samples;
 pub mod transfer_json;
+pub mod video;
 
 pub use error::{ReadError, Result};
 pub use image_out::{write_npy_f32, write_png_rgb8, write_png_rgba8};
