@@ -149,7 +149,7 @@ impl Dashboard<'_> {
         let names = ["AXIAL", "CORONAL", "SAGITTAL"];
         for ((slice, tile), name) in self.slices.iter().zip(layout.slices).zip(names) {
             place(&mut out, slice, tile)?;
-            out.text(tile.x as i64 + 3, tile.y as i64 + 3, name, 1, TITLE_COLOR);
+            out.text_shadowed(tile.x as i64 + 3, tile.y as i64 + 3, name, 1, TITLE_COLOR);
         }
         let mut overview = self.overview.clone();
         draw_path(

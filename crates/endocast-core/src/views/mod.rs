@@ -299,6 +299,14 @@ impl Image {
         }
     }
 
+    /// Like [`Image::text`], over a black shadow one font pixel down and right, so the text
+    /// reads on light and dark backgrounds alike.
+    pub fn text_shadowed(&mut self, x: i64, y: i64, text: &str, scale: usize, color: Rgb) {
+        let s = scale as i64;
+        self.text(x + s, y + s, text, scale, [0; 3]);
+        self.text(x, y, text, scale, color);
+    }
+
     /// Fills the `size × size` block whose top-left pixel is `(x, y)`.
     fn fill_block(&mut self, x: i64, y: i64, size: i64, color: Rgb) {
         for yy in y..y + size {

@@ -297,7 +297,7 @@ impl Slice {
             (bottom, (w - gw) / 2, h - 2 - gh),
         ];
         for (letter, x, y) in spots {
-            self.image.text(
+            self.image.text_shadowed(
                 x,
                 y,
                 letter.encode_utf8(&mut [0; 4]),
