@@ -11,12 +11,14 @@
 //! ```
 
 pub mod animation;
+pub mod coverage;
 pub mod geometry;
 pub mod navigate;
 pub mod path;
 pub mod phantom;
 pub mod pose;
 pub mod render;
+pub mod views;
 pub mod volume;
 
 pub use geometry::{Geometry, GeometryError};

@@ -33,6 +33,7 @@ pub mod raw;
 pub mod samples;
 mod text;
 pub mod transfer_json;
+pub mod video;
 
 pub use error::{ReadError, Result};
 pub use image_out::{write_npy_f32, write_png_rgb8, write_png_rgba8};

@@ -11,3 +11,4 @@ mod nifti;
 mod nrrd;
 mod test_volumes;
 mod transfer_json;
+mod video;
