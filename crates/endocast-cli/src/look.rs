@@ -97,7 +97,7 @@ fn finite(name: &str, value: f64) -> Result<f64> {
 }
 
 /// A transfer function from a JSON file, or a preset by name.
-fn transfer_function(spec: &str) -> Result<TransferFunction> {
+pub fn transfer_function(spec: &str) -> Result<TransferFunction> {
     let path = Path::new(spec);
     if path.exists() || spec.ends_with(".json") {
         let points = endocast_io::transfer_json::read_transfer_json(path)
@@ -123,5 +123,18 @@ pub fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send)
             .build()
             .context("cannot start the worker threads")?
             .install(work)),
+    }
+}
+
+/// Makes every later parallel render use `threads` workers (all cores when `None`), for
+/// commands whose work loop cannot move into a pool.
+pub fn set_threads(threads: Option<usize>) -> Result<()> {
+    match threads {
+        None => Ok(()),
+        Some(0) => bail!("--threads must be at least 1"),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot start the worker threads"),
     }
 }

@@ -5,6 +5,7 @@ mod input;
 mod look;
 mod lumen;
 mod parse;
+mod progress;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -29,6 +30,9 @@ enum Command {
     Render(Box<commands::render::RenderArgs>),
     /// The centred flight path through a lumen, to path JSON or Slicer Markups (.mrk.json).
     Path(Box<commands::path::PathArgs>),
+    /// Fly along a path (or key frames) to a GIF, an MP4 or PNG frames, optionally as a
+    /// dashboard with slices and an overview, optionally measuring the wall seen.
+    Fly(Box<commands::fly::FlyArgs>),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
 }
@@ -42,6 +46,7 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Path(args) => commands::path::run(&args),
+        Command::Fly(args) => commands::fly::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -12,6 +12,7 @@
 
 pub mod animation;
 pub mod coverage;
+pub mod flight;
 pub mod geometry;
 pub mod navigate;
 pub mod path;

@@ -2,6 +2,8 @@
 
 pub mod bench;
 pub mod convert;
+pub mod fly;
+mod fly_coverage;
 pub mod info;
 pub mod path;
 pub mod phantom;

@@ -1,0 +1,133 @@
+//! A fly-through: the camera shots along a smooth [`Path`] or a key-frame [`Animation`], and
+//! the frames of the flight — the endoscopic view alone or a dashboard with the three slices
+//! and an overview of the lumen — while the [`Coverage`](crate::coverage::Coverage) of the wall
+//! is tracked.
+
+mod frames;
+mod overview;
+
+pub use frames::{Flight, FlightError, FlightOptions, Layout};
+pub use overview::{lumen_overview, Overview};
+
+use crate::animation::Animation;
+use crate::path::{Path, PathError};
+use crate::pose::Pose;
+use glam::DVec3;
+
+/// One frame's camera and, for key frames, its render parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shot {
+    /// Where the camera is and looks.
+    pub pose: Pose,
+    /// Position along the route, mm of arc from its start.
+    pub arc_mm: f64,
+    /// Vertical field of view, degrees; `None` keeps the flight's.
+    pub fov_deg: Option<f64>,
+    /// Render parameters of a key-frame animation; `None` keeps the flight's.
+    pub look: Option<ShotLook>,
+}
+
+/// The render parameters a key frame carries.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShotLook {
+    /// Isovalue, physical units.
+    pub iso_hu: f64,
+    /// Isosurface opacity, 0–1.
+    pub iso_opacity: f32,
+    /// Transfer function (preset name or file) when the key names one.
+    pub tf: Option<String>,
+}
+
+/// What the camera follows.
+#[derive(Debug, Clone)]
+pub enum Route {
+    /// A path, looked along with a look-ahead.
+    Path(Path),
+    /// Key frames, played at constant speed.
+    Keys(Animation),
+}
+
+impl Route {
+    /// Length of the route, mm of arc (key frames: of playback, see [`Animation`]).
+    pub fn len_mm(&self) -> f64 {
+        match self {
+            Self::Path(path) => path.len_mm(),
+            Self::Keys(animation) => animation.len_mm(),
+        }
+    }
+
+    /// Shots every `step_mm` of arc from the start to the end (both included); a path looks
+    /// `look_ahead_mm` ahead.
+    pub fn shots(&self, step_mm: f64, look_ahead_mm: f64) -> Result<Vec<Shot>, PathError> {
+        if !(step_mm.is_finite() && step_mm > 0.0) {
+            return Err(PathError::BadOption("step_mm", step_mm));
+        }
+        let count = (self.len_mm() / step_mm).ceil() as usize + 1;
+        if count > MAX_SHOTS {
+            return Err(PathError::TooManySamples {
+                requested: count,
+                limit: MAX_SHOTS,
+            });
+        }
+        let arc = |n: usize| (n as f64 * step_mm).min(self.len_mm());
+        match self {
+            Self::Path(path) => (0..count)
+                .map(|n| {
+                    Ok(Shot {
+                        pose: path.pose_at(arc(n), look_ahead_mm)?,
+                        arc_mm: arc(n),
+                        fov_deg: None,
+                        look: None,
+                    })
+                })
+                .collect(),
+            Self::Keys(animation) => Ok((0..count)
+                .map(|n| {
+                    let key = animation.sample_at_arc(arc(n));
+                    Shot {
+                        pose: key.pose(look_ahead_mm.max(1.0)),
+                        arc_mm: arc(n),
+                        fov_deg: Some(key.fov_deg),
+                        look: Some(ShotLook {
+                            iso_hu: key.iso_hu,
+                            iso_opacity: key.iso_opacity as f32,
+                            tf: key.tf,
+                        }),
+                    }
+                })
+                .collect()),
+        }
+    }
+
+    /// The route's points every `step_mm` (for drawing it), world mm.
+    pub fn points_mm(&self, step_mm: f64) -> Vec<DVec3> {
+        let count = (self.len_mm() / step_mm.max(1e-3)).ceil().min(1e6) as usize + 1;
+        let arc = |n: usize| (n as f64 * step_mm).min(self.len_mm());
+        match self {
+            Self::Path(path) => (0..count).map(|n| path.point_at(arc(n))).collect(),
+            Self::Keys(animation) => (0..count)
+                .map(|n| animation.sample_at_arc(arc(n)).eye_mm)
+                .collect(),
+        }
+    }
+
+    /// The same path flown the other way (for the backward pass of coverage); `None` for key
+    /// frames, whose views have no natural reverse.
+    pub fn reversed(&self, step_mm: f64) -> Option<Result<Route, PathError>> {
+        match self {
+            Self::Path(path) => {
+                let mut points: Vec<DVec3> =
+                    path.samples().iter().map(|s| s.position_mm).collect();
+                points.reverse();
+                Some(Path::from_points_exact(&points, step_mm).map(Route::Path))
+            }
+            Self::Keys(_) => None,
+        }
+    }
+}
+
+/// At most this many frames in one flight (a step in the wrong unit would ask for millions).
+pub const MAX_SHOTS: usize = 200_000;
+
+#[cfg(test)]
+mod tests;
