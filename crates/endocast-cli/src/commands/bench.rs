@@ -4,6 +4,7 @@
 //! ramp and a complex transfer function; with a scan and `--path` it measures one setting.
 
 use crate::look::{in_pool, LookArgs};
+use crate::route::read_route;
 use crate::parse::parse_size;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -21,7 +22,8 @@ use std::path::{Path, PathBuf};
 pub struct BenchArgs {
     /// A scan to fly through along `--path`; without it, the colon phantom and its centreline.
     volume: Option<PathBuf>,
-    /// Camera path: a JSON list of {"eye": [x,y,z], "look_at": [..], "up": [..]} in world mm.
+    /// Camera path: a JSON list of {"eye": [x,y,z], "look_at": [..], "up": [..]} in world mm,
+    /// or a path file as `endocast fly` reads it (then --frames cameras along it).
     #[arg(long)]
     path: Option<PathBuf>,
     /// For files that declare no patient orientation: where their index axes point (e.g. LPI).
@@ -30,7 +32,7 @@ pub struct BenchArgs {
     /// Size of the colon phantom (512 gives the paper's 512×512×478).
     #[arg(long, default_value_t = 512)]
     size: usize,
-    /// Frames of the colon phantom's fly path.
+    /// Frames of the colon phantom's fly path (or along a --path file of points).
     #[arg(long, default_value_t = 60)]
     frames: usize,
     /// Image size in pixels.
@@ -147,7 +149,7 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
 /// A scan, the path the user gave, and the one setting the options describe.
 fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> {
     let path = args.path.as_ref().context("a scan needs a camera --path")?;
-    let poses = read_path(path)?;
+    let poses = read_path(path, args.frames)?;
     let mut options = OpenOptions::default();
     options.orientation.clone_from(&args.orientation);
     let loaded = endocast_io::open(volume, &options).context("cannot read the scan")?;
@@ -159,15 +161,17 @@ fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, 
     Ok((Renderer::new(loaded.volume), poses, vec![cell]))
 }
 
-/// Reads a camera path file: a JSON list of {"eye", "look_at", "up"} (world mm).
-fn read_path(path: &Path) -> Result<Vec<Pose>> {
+/// Reads a camera path file: a JSON list of {"eye", "look_at", "up"} (world mm, the format the
+/// VTK peer script reads too), or a path as `endocast fly` takes it (then `frames` cameras
+/// spread evenly along it, looking 10 mm ahead).
+fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read the path {}", path.display()))?;
     let value: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    let list = value
-        .as_array()
-        .with_context(|| format!("{}: expected a list of cameras", path.display()))?;
+    let Some(list) = value.as_array() else {
+        return route_poses(path, frames);
+    };
     let vector = |item: &serde_json::Value, key: &str, n: usize| -> Result<DVec3> {
         let v: Option<Vec<f64>> = item[key]
             .as_array()
@@ -195,6 +199,14 @@ fn read_path(path: &Path) -> Result<Vec<Pose>> {
         bail!("{}: the path has no cameras", path.display());
     }
     Ok(poses)
+}
+
+/// `frames` cameras spread evenly along a route file (see [`read_route`]).
+fn route_poses(path: &Path, frames: usize) -> Result<Vec<Pose>> {
+    let route = read_route(path, 0.5)?;
+    let step = route.len_mm() / frames.saturating_sub(1).max(1) as f64;
+    let shots = route.shots(step, 10.0).context("cannot sample the path")?;
+    Ok(shots.into_iter().take(frames).map(|shot| shot.pose).collect())
 }
 
 /// Prints one table row (and appends a JSON line when asked).

@@ -7,17 +7,16 @@ use crate::look::{set_threads, transfer_function, LookArgs};
 use crate::lumen::LumenArgs;
 use crate::parse::parse_size;
 use crate::progress::Progress;
+use crate::route::read_route;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use endocast_core::animation::Animation;
 use endocast_core::coverage::Coverage;
-use endocast_core::flight::{lumen_overview, Flight, FlightOptions, Layout, Route, Shot};
+use endocast_core::flight::{lumen_overview, Flight, FlightOptions, Layout, Shot};
 use endocast_core::navigate::{seed_voxel, Lumen};
-use endocast_core::path::Path as SmoothPath;
 use endocast_core::render::{RenderSettings, Renderer};
 use endocast_core::views::slices::Window;
 use endocast_io::video::{open_sink, VideoOptions};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `endocast fly`.
 #[derive(Args, Debug)]
@@ -133,31 +132,6 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         crate::commands::fly_coverage::report(args, &renderer, &route, &settings, lumen.as_ref(), forward)?;
     }
     Ok(())
-}
-
-/// The route in `file`: key frames when it has them, else its points (passed through exactly).
-fn read_route(file: &Path, step_mm: f64) -> Result<Route> {
-    let is_markups = file
-        .to_str()
-        .is_some_and(|s| s.to_ascii_lowercase().ends_with(".mrk.json"));
-    let points = if is_markups {
-        let markups = endocast_io::markups::read_markups(file).context("cannot read the path")?;
-        let Some(first) = markups.into_iter().find(|m| m.points_mm.len() >= 2) else {
-            bail!("{}: no curve or point list with two or more points", file.display());
-        };
-        first.points_mm
-    } else {
-        let document = endocast_io::path_file::read_path_json(file).context("cannot read the path")?;
-        if !document.key_frames.is_empty() {
-            let animation = Animation::new(document.key_frames)
-                .with_context(|| format!("{}: unusable key frames", file.display()))?;
-            return Ok(Route::Keys(animation));
-        }
-        document.points_mm
-    };
-    let path = SmoothPath::from_points_exact(&points, step_mm.min(0.5))
-        .with_context(|| format!("{}: unusable path", file.display()))?;
-    Ok(Route::Path(path))
 }
 
 fn video_options(fps: f64) -> VideoOptions {

@@ -69,7 +69,13 @@ pub enum NavError {
     },
     /// The centreline could not be made into a smooth path that stays in the lumen.
     #[error("cannot smooth the centreline: {0}")]
-    Path(#[from] crate::path::PathError),
+    Path(crate::path::PathError),
+}
+
+impl From<crate::path::PathError> for NavError {
+    fn from(error: crate::path::PathError) -> Self {
+        Self::Path(error)
+    }
 }
 
 /// `Ok(value)` when finite (and, with `positive`, greater than 0), else [`NavError::BadNumber`].
