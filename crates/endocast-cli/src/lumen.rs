@@ -69,12 +69,27 @@ mod tests {
     #[test]
     fn the_preset_threshold_moves_with_the_isovalue() {
         let a = args(None, false);
-        assert_eq!(a.resolve(Some("bronchoscopy"), None).unwrap(), (-900.0, LumenSide::Below));
+        assert_eq!(
+            a.resolve(Some("bronchoscopy"), None).unwrap(),
+            (-900.0, LumenSide::Below)
+        );
         // CThead stores HU + 1024: an isovalue of 524 puts the airway threshold at 124.
-        assert_eq!(a.resolve(Some("bronchoscopy"), Some(524.0)).unwrap().0, 124.0);
-        assert_eq!(a.resolve(Some("angioscopy"), None).unwrap().1, LumenSide::Above);
-        assert_eq!(a.resolve(None, Some(-400.0)).unwrap(), (-400.0, LumenSide::Below));
-        assert_eq!(args(Some(7.0), true).resolve(None, None).unwrap(), (7.0, LumenSide::Above));
+        assert_eq!(
+            a.resolve(Some("bronchoscopy"), Some(524.0)).unwrap().0,
+            124.0
+        );
+        assert_eq!(
+            a.resolve(Some("angioscopy"), None).unwrap().1,
+            LumenSide::Above
+        );
+        assert_eq!(
+            a.resolve(None, Some(-400.0)).unwrap(),
+            (-400.0, LumenSide::Below)
+        );
+        assert_eq!(
+            args(Some(7.0), true).resolve(None, None).unwrap(),
+            (7.0, LumenSide::Above)
+        );
         assert!(a.resolve(None, None).is_err());
         assert!(a.resolve(Some("ramp"), None).is_err());
         assert!(args(Some(f64::NAN), false).resolve(None, None).is_err());

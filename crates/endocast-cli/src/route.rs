@@ -15,11 +15,15 @@ pub fn read_route(file: &Path, step_mm: f64) -> Result<Route> {
     let points = if is_markups {
         let markups = endocast_io::markups::read_markups(file).context("cannot read the path")?;
         let Some(first) = markups.into_iter().find(|m| m.points_mm.len() >= 2) else {
-            bail!("{}: no curve or point list with two or more points", file.display());
+            bail!(
+                "{}: no curve or point list with two or more points",
+                file.display()
+            );
         };
         first.points_mm
     } else {
-        let document = endocast_io::path_file::read_path_json(file).context("cannot read the path")?;
+        let document =
+            endocast_io::path_file::read_path_json(file).context("cannot read the path")?;
         if !document.key_frames.is_empty() {
             let animation = Animation::new(document.key_frames)
                 .with_context(|| format!("{}: unusable key frames", file.display()))?;
@@ -31,4 +35,3 @@ pub fn read_route(file: &Path, step_mm: f64) -> Result<Route> {
         .with_context(|| format!("{}: unusable path", file.display()))?;
     Ok(Route::Path(path))
 }
-

@@ -4,8 +4,8 @@
 //! ramp and a complex transfer function; with a scan and `--path` it measures one setting.
 
 use crate::look::{in_pool, LookArgs};
-use crate::route::read_route;
 use crate::parse::parse_size;
+use crate::route::read_route;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::phantom::{self, PhantomOptions};
@@ -206,7 +206,11 @@ fn route_poses(path: &Path, frames: usize) -> Result<Vec<Pose>> {
     let route = read_route(path, 0.5)?;
     let step = route.len_mm() / frames.saturating_sub(1).max(1) as f64;
     let shots = route.shots(step, 10.0).context("cannot sample the path")?;
-    Ok(shots.into_iter().take(frames).map(|shot| shot.pose).collect())
+    Ok(shots
+        .into_iter()
+        .take(frames)
+        .map(|shot| shot.pose)
+        .collect())
 }
 
 /// Prints one table row (and appends a JSON line when asked).

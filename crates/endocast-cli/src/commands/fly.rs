@@ -53,7 +53,12 @@ pub struct FlyArgs {
     #[arg(long, default_value_t = 25.0)]
     fps: f64,
     /// Slice window centre and width, physical units (HU), for the dashboard.
-    #[arg(long, value_name = "LEVEL,WIDTH", default_value = "-300,1400", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "LEVEL,WIDTH",
+        default_value = "-300,1400",
+        allow_hyphen_values = true
+    )]
     window: String,
     /// Measure the wall seen (forward, then forward + backward), print it and write
     /// OUT.coverage.json, OUT.coverage.png (unseen wall in red) and OUT.coverage.nii.gz
@@ -79,7 +84,8 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     let shots = route
         .shots(args.frame_step, args.look_ahead)
         .context("cannot sample the route")?;
-    let mut sink = open_sink(&args.output, &video_options(args.fps)).context("cannot write the video")?;
+    let mut sink =
+        open_sink(&args.output, &video_options(args.fps)).context("cannot write the video")?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
@@ -129,7 +135,14 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         progress.rate()
     );
     if let Some(forward) = flight.into_coverage() {
-        crate::commands::fly_coverage::report(args, &renderer, &route, &settings, lumen.as_ref(), forward)?;
+        crate::commands::fly_coverage::report(
+            args,
+            &renderer,
+            &route,
+            &settings,
+            lumen.as_ref(),
+            &forward,
+        )?;
     }
     Ok(())
 }
@@ -147,8 +160,14 @@ fn lumen_at_start(
     settings: &RenderSettings,
     shots: &[Shot],
 ) -> Result<Lumen> {
-    let (threshold, side) = args.lumen.resolve(args.look.preset(), Some(settings.iso_hu))?;
-    let start = shots.first().context("the route has no frames")?.pose.eye_mm;
+    let (threshold, side) = args
+        .lumen
+        .resolve(args.look.preset(), Some(settings.iso_hu))?;
+    let start = shots
+        .first()
+        .context("the route has no frames")?
+        .pose
+        .eye_mm;
     let seed = seed_voxel(volume, start).context("the route starts outside the volume")?;
     Lumen::from_seed(volume, seed, threshold, side)
         .with_context(|| format!("the route's start is not in a lumen {side} {threshold}"))

@@ -23,14 +23,20 @@ pub fn report(
     route: &Route,
     settings: &RenderSettings,
     lumen: Option<&Lumen>,
-    forward: Coverage,
+    forward: &Coverage,
 ) -> Result<()> {
     let lumen = lumen.context("coverage needs the lumen")?;
     let geometry = renderer.volume().geometry();
     let mut both = forward.clone();
     if let Some(back) = route.reversed(0.5) {
         let back = back.context("cannot reverse the path")?;
-        let backward = fly_for_coverage(args, renderer, &back, settings, wall_coverage(lumen, geometry)?)?;
+        let backward = fly_for_coverage(
+            args,
+            renderer,
+            &back,
+            settings,
+            wall_coverage(lumen, geometry)?,
+        )?;
         both.merge(&backward)?;
     }
     println!(
@@ -50,11 +56,22 @@ pub fn report(
     endocast_io::atomic::write_file(&beside(args, "json"), |w| w.write_all(text.as_bytes()))
         .context("cannot write the coverage report")?;
     let mut overview = lumen_overview(lumen, geometry, [OVERVIEW_PX; 2])?;
-    forward.tint_unseen(&mut overview.image, &overview.camera, &overview.depth_mm, [230, 40, 40], 0.8)?;
+    forward.tint_unseen(
+        &mut overview.image,
+        &overview.camera,
+        &overview.depth_mm,
+        [230, 40, 40],
+        0.8,
+    )?;
     let image = &overview.image;
-    endocast_io::image_out::write_png_rgb8(&beside(args, "png"), image.width() as u32, image.height() as u32, image.rgb())
-        .context("cannot write the coverage image")?;
-    let mask = mask_volume(renderer.volume(), &forward)?;
+    endocast_io::image_out::write_png_rgb8(
+        &beside(args, "png"),
+        image.width() as u32,
+        image.height() as u32,
+        image.rgb(),
+    )
+    .context("cannot write the coverage image")?;
+    let mask = mask_volume(renderer.volume(), forward)?;
     endocast_io::write(&beside(args, "nii.gz"), &mask).context("cannot write the coverage mask")?;
     Ok(())
 }
@@ -95,5 +112,10 @@ fn beside(args: &FlyArgs, ending: &str) -> PathBuf {
 fn mask_volume(scan: &Volume, coverage: &Coverage) -> Result<Volume> {
     let voxels = coverage.mask().into_iter().map(u16::from).collect();
     let map = ValueMap::new(1.0, 0.0)?;
-    Ok(Volume::new(*scan.geometry(), voxels, map, Modality::Unknown)?)
+    Ok(Volume::new(
+        *scan.geometry(),
+        voxels,
+        map,
+        Modality::Unknown,
+    )?)
 }

@@ -65,7 +65,8 @@ pub fn run(args: &PathArgs) -> Result<()> {
     let (threshold, side) = args.lumen.resolve(args.preset.as_deref(), args.iso)?;
     let start = point(volume, args.from, args.from_voxel, "--from")?
         .context("give the start with --from X,Y,Z (mm) or --from-voxel I,J,K")?;
-    let end = point(volume, args.to, args.to_voxel, "--to")?.map_or(PathEnd::Farthest, PathEnd::Point);
+    let end =
+        point(volume, args.to, args.to_voxel, "--to")?.map_or(PathEnd::Farthest, PathEnd::Point);
     let options = SmoothOptions {
         control_spacing_mm: args.smoothing,
         step_mm: 0.5,

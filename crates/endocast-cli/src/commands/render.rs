@@ -6,9 +6,9 @@ use crate::lumen::LumenArgs;
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
 use endocast_core::navigate::{default_viewpoint, preset_lumen};
 use endocast_core::pose::Pose;
+use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
 use endocast_core::{Geometry, Volume};
 use glam::DVec3;
 use serde_json::json;
@@ -125,7 +125,10 @@ fn camera(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Resu
 /// The default endoscopic view of `--preset` (see [`default_viewpoint`]), if it names a lumen
 /// and the scan has one.
 fn inside_view(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Option<Pose> {
-    let name = args.look.preset().filter(|name| preset_lumen(name).is_some())?;
+    let name = args
+        .look
+        .preset()
+        .filter(|name| preset_lumen(name).is_some())?;
     let (threshold, side) = match args.lumen.resolve(Some(name), Some(settings.iso_hu)) {
         Ok(lumen) => lumen,
         Err(error) => {

@@ -4,8 +4,8 @@ use super::overview::Overview;
 use super::Shot;
 use crate::coverage::{Coverage, CoverageError};
 use crate::path::PathError;
-use crate::render::{Camera, CameraError, Prepared, RenderSettings, RenderStats, Renderer};
 use crate::render::SettingsError;
+use crate::render::{Camera, CameraError, Prepared, RenderSettings, RenderStats, Renderer};
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_slices, SliceOptions, Window};
 use crate::views::{Image, Rgb, ViewError};
@@ -98,7 +98,11 @@ impl<'a> Flight<'a> {
     }
 
     /// The dashboard's overview (rendered at [`Flight::overview_size`]) and the route drawn on it.
-    pub fn with_overview(mut self, overview: Overview, route_mm: Vec<DVec3>) -> Result<Self, FlightError> {
+    pub fn with_overview(
+        mut self,
+        overview: Overview,
+        route_mm: Vec<DVec3>,
+    ) -> Result<Self, FlightError> {
         let [w, h] = self.options.size;
         let layout = DashboardLayout::for_endoscope(w, h)?;
         self.dashboard = Some(DashboardParts {
@@ -141,7 +145,13 @@ impl<'a> Flight<'a> {
     ) -> Result<(Image, RenderStats), FlightError> {
         let pose = &shot.pose;
         let fov = shot.fov_deg.unwrap_or(self.options.fov_deg);
-        let camera = Camera::look_at(pose.eye_mm, pose.look_at_mm, pose.up, fov, self.options.size)?;
+        let camera = Camera::look_at(
+            pose.eye_mm,
+            pose.look_at_mm,
+            pose.up,
+            fov,
+            self.options.size,
+        )?;
         let frame = self.prepared(settings)?.render(&camera);
         if let Some(coverage) = &mut self.coverage {
             coverage.record(&camera, &frame)?;

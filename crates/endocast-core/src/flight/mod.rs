@@ -116,8 +116,7 @@ impl Route {
     pub fn reversed(&self, step_mm: f64) -> Option<Result<Route, PathError>> {
         match self {
             Self::Path(path) => {
-                let mut points: Vec<DVec3> =
-                    path.samples().iter().map(|s| s.position_mm).collect();
+                let mut points: Vec<DVec3> = path.samples().iter().map(|s| s.position_mm).collect();
                 points.reverse();
                 Some(Path::from_points_exact(&points, step_mm).map(Route::Path))
             }

@@ -132,7 +132,12 @@ mod tests {
             assert!(field.distance_mm(s.position_mm) >= 0.5);
         }
         for pair in samples.windows(2) {
-            let turn = pair[0].up.dot(pair[1].up).clamp(-1.0, 1.0).acos().to_degrees();
+            let turn = pair[0]
+                .up
+                .dot(pair[1].up)
+                .clamp(-1.0, 1.0)
+                .acos()
+                .to_degrees();
             assert!(turn < 5.0, "up turned {turn}° in one step");
         }
     }

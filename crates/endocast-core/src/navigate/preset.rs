@@ -27,7 +27,13 @@ mod tests {
 
     #[test]
     fn every_endoscopic_preset_has_a_lumen_on_the_renderers_side_of_its_surface() {
-        for name in ["colonoscopy", "bronchoscopy", "angioscopy", "sinus", "ventricles"] {
+        for name in [
+            "colonoscopy",
+            "bronchoscopy",
+            "angioscopy",
+            "sinus",
+            "ventricles",
+        ] {
             let (threshold, side) = preset_lumen(name).unwrap();
             let iso = RenderSettings::preset(name).unwrap().iso_hu;
             // The grown lumen must not reach past the surface the renderer draws.

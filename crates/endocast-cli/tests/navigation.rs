@@ -1,0 +1,239 @@
+//! `endocast path` and `endocast fly` end to end on phantoms: the path stays on the tube's axis,
+//! flights come out as GIF, PNG frames, dashboards and MP4, coverage grows with a backward pass,
+//! and bad requests fail with a clear message.
+
+use crate::common::endocast;
+use std::path::Path;
+
+/// A phantom written into `dir`; returns its path.
+fn phantom(dir: &Path, name: &str, size: &str) -> String {
+    let file = dir.join(format!("{name}.nii.gz"));
+    let file = file.to_str().unwrap().to_owned();
+    let out = endocast(&["phantom", name, "--size", size, "-o", &file]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    file
+}
+
+/// Runs endocast and returns stdout, panicking with stderr on failure.
+fn ok(args: &[&str]) -> String {
+    let out = endocast(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?} failed: {stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn fails_with(args: &[&str], needle: &str) {
+    let out = endocast(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: {stderr:?} lacks {needle:?}"
+    );
+}
+
+/// A path along the 48³ straight tube (axis x = y = 0, radius 9.6 mm) from z = −18 to 18 mm.
+fn tube_path(dir: &Path, tube: &str, name: &str) -> String {
+    let file = dir.join(name).to_str().unwrap().to_owned();
+    let args = [
+        "path", tube, "--iso", "-480", "--from", "0,0,-18", "--to", "0,0,18", "-o", &file,
+    ];
+    let stdout = ok(&args);
+    assert!(stdout.contains("mm long"), "{stdout}");
+    file
+}
+
+#[test]
+fn the_tube_path_runs_on_the_axis_and_reads_back_in_both_formats() {
+    let dir = tempfile::tempdir().unwrap();
+    let tube = phantom(dir.path(), "straight-tube", "48");
+    let ours = tube_path(dir.path(), &tube, "p.json");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&ours).unwrap()).unwrap();
+    assert_eq!(json["format"], "endocast-path");
+    let points = json["points"].as_array().unwrap();
+    assert!(points.len() >= 18, "{} points", points.len());
+    for p in points {
+        let [x, y, z] = [0, 1, 2].map(|a| p[a].as_f64().unwrap());
+        assert!(x.hypot(y) < 1.0, "({x}, {y}, {z}) is off the axis");
+    }
+    let slicer = tube_path(dir.path(), &tube, "p.mrk.json");
+    let text = std::fs::read_to_string(&slicer).unwrap();
+    assert!(text.contains("\"Curve\"") && text.contains("LPS"), "{text}");
+    for route in [&ours, &slicer] {
+        let gif = dir.path().join("f.gif");
+        let gif = gif.to_str().unwrap();
+        let args = [
+            "fly",
+            &tube,
+            "--path",
+            route,
+            "--iso",
+            "-480",
+            "--size",
+            "48x48",
+            "--frame-step",
+            "4",
+            "-o",
+            gif,
+        ];
+        let stdout = ok(&args);
+        // 36 mm at 4 mm: frames at 0, 4, ..., 36.
+        assert!(stdout.contains("10 frames"), "{stdout}");
+        assert_eq!(&std::fs::read(gif).unwrap()[..6], b"GIF89a");
+    }
+}
+
+#[test]
+fn a_dashboard_flight_writes_one_wide_png_per_frame_and_coverage_grows_backward() {
+    let dir = tempfile::tempdir().unwrap();
+    let tube = phantom(dir.path(), "straight-tube", "48");
+    let route = tube_path(dir.path(), &tube, "p.json");
+    let frames = dir.path().join("frames");
+    let frames = frames.to_str().unwrap();
+    let args = [
+        "fly",
+        &tube,
+        "--path",
+        &route,
+        "--iso",
+        "-480",
+        "--size",
+        "60x60",
+        "--frame-step",
+        "6",
+        "--layout",
+        "dashboard",
+        "--coverage",
+        "-o",
+        frames,
+    ];
+    let stdout = ok(&args);
+    assert!(stdout.contains("coverage:"), "{stdout}");
+    let pngs = std::fs::read_dir(frames).unwrap().count();
+    assert_eq!(pngs, 7);
+    let png = std::fs::read(Path::new(frames).join("frame_00003.png")).unwrap();
+    let width = u32::from_be_bytes([png[16], png[17], png[18], png[19]]);
+    assert!(
+        width > 60 + 60,
+        "a dashboard is wider than the endoscope view: {width}"
+    );
+    let report = dir.path().join("frames.coverage.json");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    let forward = report["fraction_forward"].as_f64().unwrap();
+    let both = report["fraction_forward_backward"].as_f64().unwrap();
+    // Looking ahead down a tube hides the wall beside and behind the first camera.
+    assert!(forward > 0.3 && forward < 0.99, "forward {forward}");
+    assert!(both > forward, "forward {forward}, both {both}");
+    assert!(dir.path().join("frames.coverage.png").exists());
+    assert!(dir.path().join("frames.coverage.nii.gz").exists());
+}
+
+#[test]
+fn mp4_through_ffmpeg_when_present() {
+    let ffmpeg = std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output();
+    if !ffmpeg.is_ok_and(|o| o.status.success()) {
+        eprintln!("skipping: ffmpeg is not on PATH");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let tube = phantom(dir.path(), "straight-tube", "48");
+    let route = tube_path(dir.path(), &tube, "p.json");
+    let mp4 = dir.path().join("f.mp4");
+    let mp4 = mp4.to_str().unwrap();
+    let args = [
+        "fly",
+        &tube,
+        "--path",
+        &route,
+        "--iso",
+        "-480",
+        "--size",
+        "48x48",
+        "--frame-step",
+        "6",
+        "-o",
+        mp4,
+    ];
+    ok(&args);
+    assert_eq!(&std::fs::read(mp4).unwrap()[4..8], b"ftyp");
+}
+
+#[test]
+fn bad_navigation_requests_fail_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let tube = phantom(dir.path(), "straight-tube", "48");
+    let shell = phantom(dir.path(), "sphere-shell", "48");
+    let out = dir.path().join("p.json");
+    let out = out.to_str().unwrap();
+    fails_with(
+        &[
+            "path", &tube, "--iso", "-480", "--from", "0,15,0", "-o", out,
+        ],
+        "in the wall",
+    );
+    fails_with(
+        &[
+            "path", &shell, "--iso", "-480", "--from", "0,0,0", "--to", "22,22,22", "-o", out,
+        ],
+        "disconnected",
+    );
+    fails_with(
+        &[
+            "path", &tube, "--iso", "-480", "--from", "0,0,500", "-o", out,
+        ],
+        "outside",
+    );
+    fails_with(&["path", &tube, "--from", "0,0,0", "-o", out], "--iso");
+    let bad = dir.path().join("bad.json");
+    let no_points =
+        r#"{"format": "endocast-path", "version": 1, "coordinate_system": "LPS", "units": "mm"}"#;
+    let nan = r#"{"format": "endocast-path", "version": 1, "coordinate_system": "LPS", "units": "mm", "points": [[0,0,"NaN"],[0,0,1]]}"#;
+    for text in [no_points, nan, "{", r#"{"format": "endocast-path"}"#] {
+        std::fs::write(&bad, text).unwrap();
+        let args = [
+            "fly",
+            &tube,
+            "--path",
+            bad.to_str().unwrap(),
+            "--iso",
+            "-480",
+            "-o",
+            "x.gif",
+        ];
+        fails_with(&args, "bad.json");
+    }
+    let route = tube_path(dir.path(), &tube, "p2.json");
+    let args = [
+        "fly",
+        &tube,
+        "--path",
+        &route,
+        "--iso",
+        "-480",
+        "--frame-step",
+        "NaN",
+        "-o",
+        "x.gif",
+    ];
+    fails_with(&args, "step");
+    let args = [
+        "fly",
+        &tube,
+        "--path",
+        &route,
+        "--iso",
+        "-480",
+        "-o",
+        "frame.png",
+    ];
+    fails_with(&args, "frame.png");
+}
