@@ -7,7 +7,7 @@ use crate::path::PathError;
 use crate::render::SettingsError;
 use crate::render::{Camera, CameraError, Prepared, RenderSettings, RenderStats, Renderer};
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
-use crate::views::slices::{camera_slices, SliceOptions, Window};
+use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
 use crate::views::{Image, Rgb, ViewError};
 use crate::{GeometryError, VolumeError};
 use glam::DVec3;
@@ -188,7 +188,9 @@ impl<'a> Flight<'a> {
             window: self.options.window,
             ..SliceOptions::default()
         };
-        let slices = camera_slices(self.renderer.volume(), camera, &options)?;
+        let volume = self.renderer.volume();
+        let slices = camera_slices(volume, camera, &options)?;
+        let cross = camera_cross_section(volume, camera, shot.tangent, &cross_options(&options))?;
         let mut overview = parts.overview.image.clone();
         if let Some(coverage) = &self.coverage {
             let (color, amount) = UNSEEN_TINT;
@@ -197,7 +199,12 @@ impl<'a> Flight<'a> {
         }
         let dashboard = Dashboard {
             endoscope,
-            slices: [slices[0].image(), slices[1].image(), slices[2].image()],
+            slices: [
+                slices[0].image(),
+                slices[1].image(),
+                slices[2].image(),
+                cross.image(),
+            ],
             overview: &overview,
             overview_camera: &parts.overview.camera,
             path_mm: &parts.route_mm,
@@ -209,5 +216,16 @@ impl<'a> Flight<'a> {
             coverage: self.coverage.as_ref().map(Coverage::seen_fraction),
         };
         Ok(dashboard.compose(&parts.layout, &info)?)
+    }
+}
+
+/// The cross-section shows the lumen around the camera: a field of this many mm.
+const CROSS_SECTION_FIELD_MM: f64 = 80.0;
+
+/// Slice options for the cross-section: the slices' window and size, a close field of view.
+fn cross_options(slices: &SliceOptions) -> SliceOptions {
+    SliceOptions {
+        field_mm: Some(CROSS_SECTION_FIELD_MM),
+        ..slices.clone()
     }
 }

@@ -21,6 +21,8 @@ pub struct Shot {
     pub pose: Pose,
     /// Position along the route, mm of arc from its start.
     pub arc_mm: f64,
+    /// Direction of the route at the camera (unit): the normal of the cross-section.
+    pub tangent: DVec3,
     /// Vertical field of view, degrees; `None` keeps the flight's.
     pub fov_deg: Option<f64>,
     /// Render parameters of a key-frame animation; `None` keeps the flight's.
@@ -76,6 +78,7 @@ impl Route {
                     Ok(Shot {
                         pose: path.pose_at(arc(n), look_ahead_mm)?,
                         arc_mm: arc(n),
+                        tangent: path_tangent(path, arc(n)),
                         fov_deg: None,
                         look: None,
                     })
@@ -87,6 +90,7 @@ impl Route {
                     Shot {
                         pose: key.pose(look_ahead_mm.max(1.0)),
                         arc_mm: arc(n),
+                        tangent: key.forward(),
                         fov_deg: Some(key.fov_deg),
                         look: Some(ShotLook {
                             iso_hu: key.iso_hu,
@@ -123,6 +127,15 @@ impl Route {
             Self::Keys(_) => None,
         }
     }
+}
+
+/// The unit direction of `path` at arc `s_mm` (a central difference over half a millimetre,
+/// one-sided at the ends).
+fn path_tangent(path: &Path, s_mm: f64) -> DVec3 {
+    let h = 0.25;
+    let a = path.point_at((s_mm - h).max(0.0));
+    let b = path.point_at((s_mm + h).min(path.len_mm()));
+    (b - a).normalize_or(DVec3::Z)
 }
 
 /// At most this many frames in one flight (a step in the wrong unit would ask for millions).

@@ -1,21 +1,19 @@
 //! The fly-through dashboard: one RGB image with the endoscopic view large on the left, the
-//! axial, coronal and sagittal slices stacked beside it, an overview of the whole lumen with the
-//! path and the camera on the right, and a line of text below (frame number, arc position,
-//! coverage).
+//! axial, coronal and sagittal slices and the cross-section perpendicular to the path in a 2×2
+//! grid beside it, an overview of the whole lumen with the path and the camera on the right, and
+//! a line of text below (frame number, arc position, coverage).
 //!
 //! ```text
-//! +-------------------+-------+-------------------+
-//! |                   | axial |                   |
-//! |    endoscope      +-------+     overview      |
-//! |      w × h        |coronal|       h × h       |
-//! |                   +-------+                   |
-//! |                   |sagitt.|                   |
-//! +-------------------+-------+-------------------+
-//! | FRAME 12   ARC 123.4 mm   COVERAGE 81.0%      |
-//! +-----------------------------------------------+
+//! +-------------------+-------+-------+-------------------+
+//! |                   | axial |coronal|                   |
+//! |    endoscope      +-------+-------+     overview      |
+//! |      w × h        |sagitt.| cross |       h × h       |
+//! +-------------------+-------+-------+-------------------+
+//! | FRAME 12   ARC 123.4 mm   COVERAGE 81.0%              |
+//! +-------------------------------------------------------+
 //! ```
 //!
-//! Every size follows from the endoscope image's: slice tiles are `h/3` square, the overview
+//! Every size follows from the endoscope image's: slice tiles are `h/2` square, the overview
 //! `h` square, and both dimensions are rounded up to even numbers (video encoders using 4:2:0
 //! chroma need them).
 
@@ -50,8 +48,9 @@ pub struct DashboardLayout {
     pub height: usize,
     /// The endoscopic view, at its own size.
     pub endoscope: Rect,
-    /// The axial, coronal and sagittal tiles, top to bottom: render slices at this size.
-    pub slices: [Rect; 3],
+    /// The axial, coronal, sagittal and cross-section tiles (row by row): render slices at this
+    /// size.
+    pub slices: [Rect; 4],
     /// The overview: render it at this size so nothing is rescaled.
     pub overview: Rect,
     /// The text bar along the bottom.
@@ -66,11 +65,11 @@ impl DashboardLayout {
         if !(3..=8192).contains(&width) || !(3..=8192).contains(&height) {
             return Err(ViewError::BadSize(width, height));
         }
-        let tile = height / 3;
+        let tile = height / 2;
         let text_scale = (height / 256).max(1);
         let pad = 3 * text_scale;
         let bar = font::GLYPH_HEIGHT * text_scale + 2 * pad;
-        let total_width = (width + tile + height).next_multiple_of(2);
+        let total_width = (width + 2 * tile + height).next_multiple_of(2);
         let total_height = (height + bar).next_multiple_of(2);
         let rect = |x, y, width, height| Rect {
             x,
@@ -82,8 +81,8 @@ impl DashboardLayout {
             width: total_width,
             height: total_height,
             endoscope: rect(0, 0, width, height),
-            slices: [0, 1, 2].map(|n| rect(width, n * tile, tile, tile)),
-            overview: rect(width + tile, 0, height, height),
+            slices: [0, 1, 2, 3].map(|n| rect(width + n % 2 * tile, n / 2 * tile, tile, tile)),
+            overview: rect(width + 2 * tile, 0, height, height),
             text: rect(0, height, total_width, total_height - height),
             text_scale,
         })
@@ -118,8 +117,8 @@ impl DashboardInfo {
 pub struct Dashboard<'a> {
     /// The endoscopic view; must have the layout's endoscope size.
     pub endoscope: &'a Image,
-    /// The axial, coronal and sagittal slices.
-    pub slices: [&'a Image; 3],
+    /// The axial, coronal and sagittal slices and the cross-section perpendicular to the path.
+    pub slices: [&'a Image; 4],
     /// An outside render of the lumen.
     pub overview: &'a Image,
     /// The camera the overview was rendered with (for projecting the path onto it).
@@ -146,7 +145,7 @@ impl Dashboard<'_> {
         }
         let mut out = Image::new(layout.width, layout.height, [0; 3])?;
         out.blit(self.endoscope, 0, 0);
-        let names = ["AXIAL", "CORONAL", "SAGITTAL"];
+        let names = ["AXIAL", "CORONAL", "SAGITTAL", "CROSS-SECTION"];
         for ((slice, tile), name) in self.slices.iter().zip(layout.slices).zip(names) {
             place(&mut out, slice, tile)?;
             out.text_shadowed(tile.x as i64 + 3, tile.y as i64 + 3, name, 1, TITLE_COLOR);
@@ -259,7 +258,7 @@ mod tests {
         let camera = Camera::look_at(path[15], path[16], DVec3::Z, 90.0, [96, 96]).unwrap();
         let dashboard = Dashboard {
             endoscope: &endoscope,
-            slices: [&slice; 3],
+            slices: [&slice; 4],
             overview: &overview,
             overview_camera: &view,
             path_mm: &path,
