@@ -237,3 +237,79 @@ fn bad_navigation_requests_fail_clearly() {
     ];
     fails_with(&args, "frame.png");
 }
+
+/// Runs `endocast path ... --json` and returns its report.
+fn path_json(args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["path"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    serde_json::from_str(&ok(&all)).unwrap()
+}
+
+#[test]
+fn real_scans_trachea_into_a_bronchus_and_down_the_aorta() {
+    let Some(data) = crate::common::shared_data() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let chest = data.join("chest-ct-airways-dicom");
+    let airway = dir.path().join("airway.json");
+    let report = path_json(&[
+        chest.to_str().unwrap(),
+        "--preset",
+        "bronchoscopy",
+        "--from",
+        "-9.84,66.32,51.5",
+        "-o",
+        airway.to_str().unwrap(),
+    ]);
+    // From the upper trachea past the carina (about 60 mm down) into a main bronchus.
+    let length = report["length_mm"].as_f64().unwrap();
+    assert!((100.0..250.0).contains(&length), "{report}");
+    assert!(report["min_radius_mm"].as_f64().unwrap() > 0.5, "{report}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&airway).unwrap()).unwrap();
+    let last = json["points"].as_array().unwrap().last().unwrap().clone();
+    let [x, _, z] = [0, 1, 2].map(|a| last[a].as_f64().unwrap());
+    assert!(
+        x.abs() > 20.0 && z < 0.0,
+        "ends at x {x}, z {z}: not in a bronchus"
+    );
+
+    let abdomen = data.join("abdomen-ct-pancreas-dicom");
+    let aorta = dir.path().join("aorta.json");
+    let report = path_json(&[
+        abdomen.to_str().unwrap(),
+        "--preset",
+        "angioscopy",
+        "--from",
+        "27.55,113.71,355.91",
+        "--to",
+        "11.8,76.5,205.9",
+        "-o",
+        aorta.to_str().unwrap(),
+    ]);
+    // The end points are 155 mm apart along a nearly straight aorta about 20 mm wide.
+    let length = report["length_mm"].as_f64().unwrap();
+    assert!((150.0..175.0).contains(&length), "{report}");
+    let mean = report["mean_radius_mm"].as_f64().unwrap();
+    assert!((5.0..12.0).contains(&mean), "{report}");
+    let gif = dir.path().join("aorta.gif");
+    let args = [
+        "fly",
+        abdomen.to_str().unwrap(),
+        "--path",
+        aorta.to_str().unwrap(),
+        "--preset",
+        "angioscopy",
+        "--layout",
+        "dashboard",
+        "--size",
+        "64x64",
+        "--frame-step",
+        "40",
+        "-o",
+        gif.to_str().unwrap(),
+    ];
+    assert!(ok(&args).contains("5 frames"));
+}
