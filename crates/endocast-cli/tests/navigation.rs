@@ -313,3 +313,39 @@ fn real_scans_trachea_into_a_bronchus_and_down_the_aorta() {
     ];
     assert!(ok(&args).contains("5 frames"));
 }
+
+#[test]
+fn key_frames_fly_at_constant_speed_with_their_own_look() {
+    let dir = tempfile::tempdir().unwrap();
+    let tube = phantom(dir.path(), "straight-tube", "48");
+    let keys = dir.path().join("keys.json");
+    std::fs::write(
+        &keys,
+        r#"{"format": "endocast-path", "version": 1, "coordinate_system": "LPS", "units": "mm",
+            "key_frames": [
+              {"eye": [0, 0, -15], "forward": [0, 0, 1], "up": [0, -1, 0], "fov_deg": 90,
+               "iso_hu": -480, "iso_opacity": 1.0, "tf": "colonoscopy"},
+              {"eye": [0, 0, 15], "forward": [0, 0.3, 1], "up": [0, -1, 0], "fov_deg": 60,
+               "iso_hu": -300, "iso_opacity": 0.5}]}"#,
+    )
+    .unwrap();
+    let frames = dir.path().join("frames");
+    let args = [
+        "fly",
+        &tube,
+        "--path",
+        keys.to_str().unwrap(),
+        "--mode",
+        "hybrid",
+        "--size",
+        "32x32",
+        "--frame-step",
+        "5",
+        "-o",
+        frames.to_str().unwrap(),
+    ];
+    let stdout = ok(&args);
+    // 30 mm of eye path at 5 mm: 7 frames.
+    assert!(stdout.contains("7 frames"), "{stdout}");
+    assert_eq!(std::fs::read_dir(&frames).unwrap().count(), 7);
+}

@@ -64,7 +64,8 @@ impl Route {
         if !(step_mm.is_finite() && step_mm > 0.0) {
             return Err(PathError::BadOption("step_mm", step_mm));
         }
-        let count = (self.len_mm() / step_mm).ceil() as usize + 1;
+        // A length a hair over a whole number of steps (rounding) gets no extra last frame.
+        let count = (self.len_mm() / step_mm - 1e-6).ceil().max(0.0) as usize + 1;
         if count > MAX_SHOTS {
             return Err(PathError::TooManySamples {
                 requested: count,
