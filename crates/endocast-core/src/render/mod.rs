@@ -2,7 +2,7 @@
 //! Rendering for Virtual Endoscopy Applications" (EuroVis 2006), on the CPU.
 //!
 //! Three objects with three lifetimes (as in Open VKL):
-//! - [`Renderer`]: the volume and its [`BrickGrid`] (min/max per 8³ brick), built once;
+//! - [`Renderer`]: the volume and its [`BrickGrid`] (min/max per brick of `BRICK_VOX`³ voxels), built once;
 //! - [`Prepared`]: what the settings imply — the transfer function's [`TfTable`] and the
 //!   brick [`Activity`] — rebuilt in milliseconds whenever an isovalue or the TF changes;
 //! - [`Camera`]: one per frame.
