@@ -7,12 +7,12 @@ use super::transfer::TfTable;
 use crate::Volume;
 use rayon::prelude::*;
 
-/// Edge of a brick in voxels. The paper uses 8³; on the CPU 4³ measured faster (colon phantom,
-/// 512×512×478, 30–60 frames of the benchmark path: iso 6.3 → 7.2–8.0 fps, DVR ramp 198 → 181 ms,
-/// DVR complex 582 → 517 ms): the isosurface walk takes less than half the samples next to the
-/// wall, which outweighs the extra brick steps, and the per-brick bits (2 M bricks, 8 MiB of
-/// min/max) still re-classify in 6–7 ms.
-pub const BRICK_VOX: usize = 4;
+/// Edge of a brick in voxels: the paper's 8³. 4³ was measured too (colon phantom 512×512×478,
+/// 60 frames of the benchmark path): the isosurface walk next to the wall takes half the
+/// samples, but long DVR rays take twice the brick steps, and on the paper's protocol 4³ lost
+/// (iso-only 7.0 vs 7.5 fps, hybrid 50 % complex TF 2.5 vs 1.7 s per frame). A finer level used
+/// only by the isosurface walk would get the first without the second.
+pub const BRICK_VOX: usize = 8;
 
 /// Minimum and maximum stored value per brick. Brick `b` along an axis covers the positions
 /// `[Bb, Bb + B]` (B = [`BRICK_VOX`]) in voxel index space, so its range is taken over voxels
