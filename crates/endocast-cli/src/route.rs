@@ -7,12 +7,19 @@ use endocast_core::flight::Route;
 use endocast_core::path::Path as SmoothPath;
 use std::path::Path;
 
+/// Sample step of the spline through a route file's points, mm (frames are taken from it at
+/// any spacing).
+const ROUTE_STEP_MM: f64 = 0.5;
+
+/// Whether `file` is named as 3D Slicer Markups (`.mrk.json`, any case).
+pub fn is_markups(file: &Path) -> bool {
+    file.to_str()
+        .is_some_and(|s| s.to_ascii_lowercase().ends_with(".mrk.json"))
+}
+
 /// The route in `file`: key frames when it has them, else its points (passed through exactly).
-pub fn read_route(file: &Path, step_mm: f64) -> Result<Route> {
-    let is_markups = file
-        .to_str()
-        .is_some_and(|s| s.to_ascii_lowercase().ends_with(".mrk.json"));
-    let points = if is_markups {
+pub fn read_route(file: &Path) -> Result<Route> {
+    let points = if is_markups(file) {
         let markups = endocast_io::markups::read_markups(file).context("cannot read the path")?;
         let Some(first) = markups.into_iter().find(|m| m.points_mm.len() >= 2) else {
             bail!(
@@ -31,7 +38,7 @@ pub fn read_route(file: &Path, step_mm: f64) -> Result<Route> {
         }
         document.points_mm
     };
-    let path = SmoothPath::from_points_exact(&points, step_mm.min(0.5))
+    let path = SmoothPath::from_points_exact(&points, ROUTE_STEP_MM)
         .with_context(|| format!("{}: unusable path", file.display()))?;
     Ok(Route::Path(path))
 }

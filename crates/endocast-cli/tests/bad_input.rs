@@ -1,17 +1,6 @@
 //! Bad input gives one readable line naming the problem and a non-zero exit, never a panic.
 
-use crate::common::endocast;
-
-fn fails_with(args: &[&str], needle: &str) {
-    let out = endocast(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "{args:?} succeeded");
-    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
-    assert!(
-        stderr.contains(needle),
-        "{args:?}: {stderr:?} lacks {needle:?}"
-    );
-}
+use crate::common::fails_with;
 
 #[test]
 fn missing_and_unknown_files() {

@@ -11,6 +11,19 @@ pub fn endocast(args: &[&str]) -> Output {
         .expect("the endocast binary runs")
 }
 
+/// Runs `endocast` with `args` and asserts that it fails cleanly: a non-zero exit, no panic, and
+/// `needle` in the error output.
+pub fn fails_with(args: &[&str], needle: &str) {
+    let out = endocast(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: {stderr:?} lacks {needle:?}"
+    );
+}
+
 /// Runs `endocast info --json PATH [extra]` and parses the report; panics with stderr on failure.
 pub fn info_json(path: &str, extra: &[&str]) -> serde_json::Value {
     let mut args = vec!["info", "--json", path];

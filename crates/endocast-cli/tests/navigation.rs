@@ -2,7 +2,7 @@
 //! flights come out as GIF, PNG frames, dashboards and MP4, coverage grows with a backward pass,
 //! and bad requests fail with a clear message.
 
-use crate::common::endocast;
+use crate::common::{endocast, fails_with};
 use std::path::Path;
 
 /// A phantom written into `dir`; returns its path.
@@ -24,17 +24,6 @@ fn ok(args: &[&str]) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{args:?} failed: {stderr}");
     String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn fails_with(args: &[&str], needle: &str) {
-    let out = endocast(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "{args:?} succeeded");
-    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
-    assert!(
-        stderr.contains(needle),
-        "{args:?}: {stderr:?} lacks {needle:?}"
-    );
 }
 
 /// A path along the 48³ straight tube (axis x = y = 0, radius 9.6 mm) from z = −18 to 18 mm.
@@ -225,6 +214,10 @@ fn bad_navigation_requests_fail_clearly() {
         "x.gif",
     ];
     fails_with(&args, "step");
+    // A zero step is the option's fault, not the path file's.
+    let mut zero = args;
+    zero[7] = "0";
+    fails_with(&zero, "--frame-step");
     let args = [
         "fly",
         &tube,

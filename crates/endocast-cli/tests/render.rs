@@ -1,6 +1,6 @@
 //! `endocast render` end to end: a phantom with a known answer, outputs, and bad options.
 
-use crate::common::{endocast, read_npy};
+use crate::common::{endocast, fails_with, read_npy};
 
 #[test]
 fn from_the_centre_of_a_sphere_shell_every_depth_is_the_radius() {
@@ -87,13 +87,6 @@ fn bad_render_options_are_clear_errors() {
     ] {
         let mut args = vec!["render", v, "-o", o];
         args.extend(extra.iter().copied());
-        let out = endocast(&args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{extra:?} succeeded");
-        assert!(!stderr.contains("panicked"), "{extra:?}: {stderr}");
-        assert!(
-            stderr.contains(needle),
-            "{extra:?}: {stderr:?} lacks {needle:?}"
-        );
+        fails_with(&args, needle);
     }
 }

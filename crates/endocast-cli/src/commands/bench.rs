@@ -203,7 +203,7 @@ fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
 
 /// `frames` cameras spread evenly along a route file (see [`read_route`]).
 fn route_poses(path: &Path, frames: usize) -> Result<Vec<Pose>> {
-    let route = read_route(path, 0.5)?;
+    let route = read_route(path)?;
     let step = route.len_mm() / frames.saturating_sub(1).max(1) as f64;
     let shots = route.shots(step, 10.0).context("cannot sample the path")?;
     Ok(shots

@@ -80,7 +80,13 @@ enum LayoutArg {
 pub fn run(args: &FlyArgs) -> Result<()> {
     set_threads(args.look.threads)?;
     let settings = args.look.settings()?;
-    let route = read_route(&args.route, args.frame_step)?;
+    if !(args.frame_step.is_finite() && args.frame_step > 0.0) {
+        bail!(
+            "--frame-step must be a positive number of mm, not {}",
+            args.frame_step
+        );
+    }
+    let route = read_route(&args.route)?;
     let shots = route
         .shots(args.frame_step, args.look_ahead)
         .context("cannot sample the route")?;
@@ -111,7 +117,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {
             let overview = lumen_overview(lumen, geometry, flight.overview_size()?)?;
-            flight = flight.with_overview(overview, route.points_mm(2.0))?;
+            flight = flight.with_overview(overview, route.points_mm(2.0)?)?;
         }
         if args.coverage {
             flight = flight.with_coverage(wall_coverage(lumen, geometry)?);

@@ -4,6 +4,7 @@
 use crate::input::InputArgs;
 use crate::lumen::LumenArgs;
 use crate::parse::parse_vec3;
+use crate::route::is_markups;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::navigate::{plan_path, PathEnd, PlannedPath};
@@ -139,10 +140,7 @@ fn write(output: &Path, points: &[DVec3]) -> Result<()> {
         .file_name()
         .and_then(|n| n.to_str())
         .map_or("path", |n| n.split('.').next().unwrap_or(n));
-    let is_markups = output
-        .to_str()
-        .is_some_and(|s| s.to_ascii_lowercase().ends_with(".mrk.json"));
-    if is_markups {
+    if is_markups(output) {
         endocast_io::markups::write_markups_curve(output, name, points)
     } else {
         let document = PathDocument {

@@ -61,36 +61,25 @@ impl Route {
     /// Shots every `step_mm` of arc from the start to the end (both included); a path looks
     /// `look_ahead_mm` ahead.
     pub fn shots(&self, step_mm: f64, look_ahead_mm: f64) -> Result<Vec<Shot>, PathError> {
-        if !(step_mm.is_finite() && step_mm > 0.0) {
-            return Err(PathError::BadOption("step_mm", step_mm));
-        }
-        // A length a hair over a whole number of steps (rounding) gets no extra last frame.
-        let count = (self.len_mm() / step_mm - 1e-6).ceil().max(0.0) as usize + 1;
-        if count > MAX_SHOTS {
-            return Err(PathError::TooManySamples {
-                requested: count,
-                limit: MAX_SHOTS,
-            });
-        }
-        let arc = |n: usize| (n as f64 * step_mm).min(self.len_mm());
+        let arcs = self.arcs(step_mm)?;
         match self {
-            Self::Path(path) => (0..count)
-                .map(|n| {
+            Self::Path(path) => arcs
+                .map(|arc_mm| {
                     Ok(Shot {
-                        pose: path.pose_at(arc(n), look_ahead_mm)?,
-                        arc_mm: arc(n),
-                        tangent: path_tangent(path, arc(n)),
+                        pose: path.pose_at(arc_mm, look_ahead_mm)?,
+                        arc_mm,
+                        tangent: path_tangent(path, arc_mm),
                         fov_deg: None,
                         look: None,
                     })
                 })
                 .collect(),
-            Self::Keys(animation) => Ok((0..count)
-                .map(|n| {
-                    let key = animation.sample_at_arc(arc(n));
+            Self::Keys(animation) => Ok(arcs
+                .map(|arc_mm| {
+                    let key = animation.sample_at_arc(arc_mm);
                     Shot {
                         pose: key.pose(look_ahead_mm.max(1.0)),
-                        arc_mm: arc(n),
+                        arc_mm,
                         tangent: key.forward(),
                         fov_deg: Some(key.fov_deg),
                         look: Some(ShotLook {
@@ -105,15 +94,29 @@ impl Route {
     }
 
     /// The route's points every `step_mm` (for drawing it), world mm.
-    pub fn points_mm(&self, step_mm: f64) -> Vec<DVec3> {
-        let count = (self.len_mm() / step_mm.max(1e-3)).ceil().min(1e6) as usize + 1;
-        let arc = |n: usize| (n as f64 * step_mm).min(self.len_mm());
-        match self {
-            Self::Path(path) => (0..count).map(|n| path.point_at(arc(n))).collect(),
-            Self::Keys(animation) => (0..count)
-                .map(|n| animation.sample_at_arc(arc(n)).eye_mm)
-                .collect(),
+    pub fn points_mm(&self, step_mm: f64) -> Result<Vec<DVec3>, PathError> {
+        let arcs = self.arcs(step_mm)?;
+        Ok(match self {
+            Self::Path(path) => arcs.map(|s| path.point_at(s)).collect(),
+            Self::Keys(animation) => arcs.map(|s| animation.sample_at_arc(s).eye_mm).collect(),
+        })
+    }
+
+    /// Arc positions every `step_mm` from the start to the end, both included.
+    fn arcs(&self, step_mm: f64) -> Result<impl Iterator<Item = f64>, PathError> {
+        if !(step_mm.is_finite() && step_mm > 0.0) {
+            return Err(PathError::BadOption("step_mm", step_mm));
         }
+        let len = self.len_mm();
+        // A length a hair over a whole number of steps (rounding) gets no extra last frame.
+        let count = (len / step_mm - 1e-6).ceil().max(0.0) as usize + 1;
+        if count > MAX_SHOTS {
+            return Err(PathError::TooManySamples {
+                requested: count,
+                limit: MAX_SHOTS,
+            });
+        }
+        Ok((0..count).map(move |n| (n as f64 * step_mm).min(len)))
     }
 
     /// The same path flown the other way (for the backward pass of coverage); `None` for key

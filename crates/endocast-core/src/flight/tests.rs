@@ -64,7 +64,7 @@ fn a_dashboard_frame_is_wider_than_the_view_and_coverage_grows() {
     let bbox = [0, 1, 2].map(|a| lo[a].saturating_sub(1)..(hi[a] + 2).min(geometry.dims()[a]));
     let coverage = Coverage::new(&geometry, |v| lumen.is_wall(v), &bbox).unwrap();
     let mut flight = flight
-        .with_overview(overview, route.points_mm(1.0))
+        .with_overview(overview, route.points_mm(1.0).unwrap())
         .unwrap()
         .with_coverage(coverage);
     let settings = RenderSettings {
