@@ -4,8 +4,8 @@
 //! termination) — over a [`RayMarch`].
 
 use super::bricks::{Activity, BrickGrid};
-use super::march::{Flow, Line, RayMarch, Sample};
-use super::sample::{Accum, Sampler, Shader};
+use super::march::{Flow, RayMarch, Sample};
+use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
 use super::transfer::TfTable;
 use glam::Vec3;
@@ -46,6 +46,9 @@ pub(crate) struct Params {
     pub shade_dvr: bool,
     pub skip_empty: bool,
 }
+
+/// Bisection steps per batch of samples: the seven midpoints of three steps fill one batch.
+const BISECTION_LEVELS: u32 = 3;
 
 /// What a ray produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,7 +134,7 @@ impl Integrator<'_> {
             return out;
         };
         out.depth_mm = hit.t;
-        let lit = self.surface(march.line().at(hit.t), surface.color, dir_world);
+        let lit = self.surface(march.grid().at(hit.t), surface.color, dir_world);
         out.accum.under_surface(lit, surface.opacity);
         if volume_behind {
             self.composite(march, &mut out, dir_world, false, probe);
@@ -144,7 +147,7 @@ impl Integrator<'_> {
         match self.params.crossing {
             Crossing::Rising => true,
             Crossing::Falling => false,
-            Crossing::Auto => self.sampler.value(march.line().at(march.t_start())) < iso,
+            Crossing::Auto => self.sampler.value(march.grid().at(march.grid().t_start)) < iso,
         }
     }
 
@@ -170,7 +173,7 @@ impl Integrator<'_> {
             },
         );
         let before = hit?;
-        let t = self.refine(march.line(), iso, rising, before, previous);
+        let t = self.refine(march.grid(), iso, rising, before, previous);
         Some(Hit { t })
     }
 
@@ -179,25 +182,23 @@ impl Integrator<'_> {
     /// final bracket (no refinement: the sample after the crossing).
     fn refine(
         &self,
-        line: Line,
+        line: SampleGrid,
         iso: f32,
         rising: bool,
-        (mut a, mut va): (f32, f32),
-        (mut b, mut vb): (f32, f32),
+        mut before: (f32, f32),
+        mut after: (f32, f32),
     ) -> f32 {
         if self.params.refine_steps == 0 {
-            return b;
+            return after.0;
         }
-        let value = |t: f32| self.sampler.value(line.at(t));
-        for _ in 0..self.params.refine_steps {
-            let m = 0.5 * (a + b);
-            let vm = value(m);
-            if (vm >= iso) == rising {
-                (b, vb) = (m, vm);
-            } else {
-                (a, va) = (m, vm);
-            }
+        let mut left = self.params.refine_steps;
+        while left > 0 {
+            let levels = left.min(BISECTION_LEVELS);
+            let bracket = (&mut before, &mut after);
+            bisect(&self.sampler, line, (iso, rising), levels, bracket);
+            left -= levels;
         }
+        let ((a, va), (b, vb)) = (before, after);
         let span = vb - va;
         let f = if span != 0.0 {
             ((iso - va) / span).clamp(0.0, 1.0)
@@ -215,7 +216,14 @@ impl Integrator<'_> {
 
     /// Composites one DVR sample through the transfer function, shaded on request.
     #[inline(always)]
-    fn add_sample(&self, acc: &mut Accum, line: Line, s: Sample, dir_world: Vec3, shade: bool) {
+    fn add_sample(
+        &self,
+        acc: &mut Accum,
+        line: SampleGrid,
+        s: Sample,
+        dir_world: Vec3,
+        shade: bool,
+    ) {
         let [r, g, b, alpha] = self.table.lookup(s.value);
         let mut rgb = Vec3::new(r, g, b);
         if shade {
@@ -244,7 +252,7 @@ impl Integrator<'_> {
             return;
         }
         let acc = &mut out.accum;
-        let line = march.line();
+        let line = march.grid();
         let terminated = march.walk(
             &self.sampler,
             false,
@@ -266,7 +274,7 @@ impl Integrator<'_> {
         let stop = self.params.early_termination;
         let mut out = PixelOut::default();
         let mut previous = (0.0f32, 0.0f32);
-        let line = march.line();
+        let line = march.grid();
         let acc = &mut out.accum;
         let depth = &mut out.depth_mm;
         let terminated = march.walk(
@@ -350,6 +358,50 @@ impl Integrator<'_> {
     }
 }
 
+/// `levels` (1–3) bisection steps of the bracket `[before, after]` with one batch of
+/// samples: the batch holds the whole tree of midpoints those steps can visit (heap order,
+/// node `i`'s halves at `2i` and `2i + 1`), each computed as the step-by-step bisection
+/// would, so the bracket ends the same, only without waiting on each sample in turn.
+fn bisect(
+    sampler: &Sampler<'_>,
+    line: SampleGrid,
+    (iso, rising): (f32, bool),
+    levels: u32,
+    (before, after): (&mut (f32, f32), &mut (f32, f32)),
+) {
+    let nodes = 1usize << levels;
+    let (mut lo, mut hi, mut t) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
+    (lo[1], hi[1]) = (before.0, after.0);
+    t[1] = 0.5 * (lo[1] + hi[1]);
+    for i in 2..nodes {
+        let parent = i / 2;
+        (lo[i], hi[i]) = if i % 2 == 0 {
+            (lo[parent], t[parent])
+        } else {
+            (t[parent], hi[parent])
+        };
+        t[i] = 0.5 * (lo[i] + hi[i]);
+    }
+    let values = if nodes == 2 {
+        let mut one = [0.0; 8];
+        one[1] = sampler.value(line.at(t[1]));
+        one
+    } else {
+        sampler.points8(&t.map(|t| line.at(t)))
+    };
+    let mut node = 1;
+    for _ in 0..levels {
+        let m = (t[node], values[node]);
+        node *= 2;
+        if (m.1 >= iso) == rising {
+            *after = m;
+        } else {
+            *before = m;
+            node += 1;
+        }
+    }
+}
+
 /// Whether the value goes from `before` to `after` across `iso` in the given direction.
 #[inline]
 fn crosses(before: f32, after: f32, iso: f32, rising: bool) -> bool {
@@ -367,5 +419,69 @@ fn until_opaque(alpha: f32, stop: f32) -> Flow {
         Flow::Stop
     } else {
         Flow::Continue
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::phantom::{self, PhantomOptions};
+
+    /// Step-by-step bisection, the reference the batched tree must equal.
+    fn sequential(
+        sampler: &Sampler<'_>,
+        line: SampleGrid,
+        (iso, rising): (f32, bool),
+        steps: u32,
+        (mut a, mut b): ((f32, f32), (f32, f32)),
+    ) -> ((f32, f32), (f32, f32)) {
+        for _ in 0..steps {
+            let t = 0.5 * (a.0 + b.0);
+            let m = (t, sampler.value(line.at(t)));
+            if (m.1 >= iso) == rising {
+                b = m;
+            } else {
+                a = m;
+            }
+        }
+        (a, b)
+    }
+
+    #[test]
+    fn batched_bisection_ends_on_the_step_by_step_bracket() {
+        let options = PhantomOptions {
+            size: 32,
+            noise_hu: 30.0,
+            ..Default::default()
+        };
+        let (volume, _) = phantom::sphere_shell(&options);
+        let sampler = Sampler::new(&volume);
+        for k in 0..200u16 {
+            let f = f32::from(k);
+            let line = SampleGrid {
+                origin: Vec3::new(3.0 + f % 7.0, 16.0, 4.0 + f % 11.0),
+                direction: Vec3::new(0.3 + f % 3.0 * 0.1, -0.2, 0.9).normalize(),
+                t_start: 0.0,
+                offset: 0.5,
+                step: 0.5,
+            };
+            let (t0, t1) = (f * 0.1 % 20.0, f * 0.1 % 20.0 + 0.5);
+            let a = (t0, sampler.value(line.at(t0)));
+            let b = (t1, sampler.value(line.at(t1)));
+            let iso = 0.5 * (a.1 + b.1);
+            let rising = a.1 < b.1;
+            for levels in 1..=BISECTION_LEVELS {
+                let expected = sequential(&sampler, line, (iso, rising), levels, (a, b));
+                let (mut before, mut after) = (a, b);
+                bisect(
+                    &sampler,
+                    line,
+                    (iso, rising),
+                    levels,
+                    (&mut before, &mut after),
+                );
+                assert_eq!((before, after), expected, "{k} {levels}");
+            }
+        }
     }
 }

@@ -6,9 +6,8 @@
 //! may ask for padded runs: one extra sample before and after every active brick's samples,
 //! which puts both samples around any crossing inside an active brick into one run.
 
-use super::sample::Sampler;
+use super::sample::{SampleGrid, Sampler};
 use super::traverse::{ray_f32, BrickDda, Segment, VoxelRay};
-use glam::Vec3;
 
 /// One sample handed to a walk's visitor.
 #[derive(Debug, Clone, Copy)]
@@ -33,22 +32,6 @@ pub(crate) enum Flow {
     StopBefore,
 }
 
-/// The ray's straight line in voxel space, parametrised by mm from the eye (`Copy`, so closures
-/// can read it while a walk holds the march).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Line {
-    origin: Vec3,
-    direction: Vec3,
-}
-
-impl Line {
-    /// Voxel position at distance `t` (mm).
-    #[inline]
-    pub fn at(&self, t: f32) -> Vec3 {
-        self.origin + self.direction * t
-    }
-}
-
 /// Counters of one ray's walks.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(crate) struct MarchStats {
@@ -63,10 +46,7 @@ pub(crate) struct RayMarch {
     dda: BrickDda,
     /// A brick a stopped walk was in, to resume in.
     pending: Option<Segment>,
-    line: Line,
-    t_start: f32,
-    step: f32,
-    offset: f32,
+    grid: SampleGrid,
     /// First sample index not yet taken.
     next: i32,
     /// One past the last sample index (`t_n < t_end`).
@@ -90,10 +70,13 @@ impl RayMarch {
         let mut march = Self {
             dda: BrickDda::new(ray, range, bricks),
             pending: None,
-            line: Line { origin, direction },
-            t_start: range.0 as f32,
-            step: step_mm,
-            offset,
+            grid: SampleGrid {
+                origin,
+                direction,
+                t_start: range.0 as f32,
+                offset,
+                step: step_mm,
+            },
             next: 0,
             end: 0,
             has_previous: false,
@@ -107,26 +90,16 @@ impl RayMarch {
     #[inline]
     fn index_at(&self, t: f32) -> i32 {
         // A ceiling without libm's `ceilf` (a call on baseline x86-64); `as` saturates.
-        let x = (t - self.t_start) / self.step - self.offset;
+        let g = &self.grid;
+        let x = (t - g.t_start) / g.step - g.offset;
         let truncated = x as i32;
         truncated + i32::from((truncated as f32) < x)
     }
 
-    /// Distance of sample `n` from the eye, mm.
+    /// The ray's sample grid.
     #[inline]
-    pub fn t_of(&self, n: i32) -> f32 {
-        self.t_start + (n as f32 + self.offset) * self.step
-    }
-
-    /// The ray's line.
-    #[inline]
-    pub fn line(&self) -> Line {
-        self.line
-    }
-
-    /// Where the ray starts (mm) — on the near plane or where it enters the volume.
-    pub fn t_start(&self) -> f32 {
-        self.t_start
+    pub fn grid(&self) -> SampleGrid {
+        self.grid
     }
 
     /// Samples, in order, the bricks for which `active(brick)` holds, handing each sample to
@@ -149,26 +122,29 @@ impl RayMarch {
             self.stats.bricks_visited += 1;
             let first = (self.index_at(segment.t0) - pad).max(self.next);
             let last = (self.index_at(segment.t1) + pad).min(self.end);
-            for n in first..last {
-                let t = self.t_of(n);
-                let sample = Sample {
-                    t,
-                    value: sampler.value(self.line.at(t)),
-                    fresh: !(self.has_previous && n == self.next),
-                };
-                self.stats.samples += 1;
-                self.next = n + 1;
-                self.has_previous = true;
-                match visit(sample) {
-                    Flow::Continue => {}
-                    Flow::Stop => {
-                        self.pending = Some(segment);
-                        return true;
-                    }
-                    Flow::StopBefore => {
-                        self.next = n;
-                        self.pending = Some(segment);
-                        return true;
+            for batch in (first..last).step_by(8) {
+                let count = (last - batch).min(8) as usize;
+                let values = sampler.grid8(&self.grid, batch, count);
+                for (n, &value) in (batch..).zip(&values[..count]) {
+                    let sample = Sample {
+                        t: self.grid.t_of(n),
+                        value,
+                        fresh: !(self.has_previous && n == self.next),
+                    };
+                    self.stats.samples += 1;
+                    self.next = n + 1;
+                    self.has_previous = true;
+                    match visit(sample) {
+                        Flow::Continue => {}
+                        Flow::Stop => {
+                            self.pending = Some(segment);
+                            return true;
+                        }
+                        Flow::StopBefore => {
+                            self.next = n;
+                            self.pending = Some(segment);
+                            return true;
+                        }
                     }
                 }
             }

@@ -47,7 +47,7 @@ mod tests;
 pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
 pub use camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
 pub use frame::{Frame, RenderStats};
-pub use sample::{Accum, Lighting, Sampler, Shader};
+pub use sample::{Accum, Lanes, Lighting, SampleGrid, Sampler, Shader};
 pub use settings::{Crossing, Mode, RenderSettings, SettingsError};
 pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
