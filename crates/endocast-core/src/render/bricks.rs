@@ -77,6 +77,17 @@ impl BrickGrid {
         self.max[index]
     }
 
+    /// Linear index of the brick holding voxel position `p` (clamped to the grid; a position on
+    /// a face between two bricks lies in both footprints, so either answer is right).
+    #[inline]
+    pub fn brick_at(&self, p: glam::Vec3) -> usize {
+        let cell = |axis: usize| {
+            // `as` saturates (NaN to 0), so a position outside the grid clamps to its border.
+            ((p[axis] / BRICK_VOX as f32) as usize).min(self.bricks[axis] - 1)
+        };
+        self.index([cell(0), cell(1), cell(2)])
+    }
+
     /// Linear index of brick `(bi, bj, bk)` (`bi` fastest).
     #[inline]
     pub fn index(&self, brick: [usize; 3]) -> usize {

@@ -114,13 +114,16 @@ impl RayMarch {
         mut visit: impl FnMut(Sample) -> Flow,
     ) -> bool {
         let pad = i32::from(padded);
+        // The per-sample state lives in locals (registers) and is written back when the walk
+        // stops or ends.
+        let (mut next, mut has_previous, mut samples) = (self.next, self.has_previous, 0u64);
         while let Some(segment) = self.pending.take().or_else(|| self.dda.next()) {
             if !active(segment.brick) {
                 self.stats.bricks_skipped += 1;
                 continue;
             }
             self.stats.bricks_visited += 1;
-            let first = (self.index_at(segment.t0) - pad).max(self.next);
+            let first = (self.index_at(segment.t0) - pad).max(next);
             let last = (self.index_at(segment.t1) + pad).min(self.end);
             for batch in (first..last).step_by(8) {
                 let count = (last - batch).min(8) as usize;
@@ -129,26 +132,25 @@ impl RayMarch {
                     let sample = Sample {
                         t: self.grid.t_of(n),
                         value,
-                        fresh: !(self.has_previous && n == self.next),
+                        fresh: !(has_previous && n == next),
                     };
-                    self.stats.samples += 1;
-                    self.next = n + 1;
-                    self.has_previous = true;
-                    match visit(sample) {
-                        Flow::Continue => {}
-                        Flow::Stop => {
-                            self.pending = Some(segment);
-                            return true;
-                        }
-                        Flow::StopBefore => {
-                            self.next = n;
-                            self.pending = Some(segment);
-                            return true;
-                        }
+                    samples += 1;
+                    next = n + 1;
+                    has_previous = true;
+                    let flow = visit(sample);
+                    if flow != Flow::Continue {
+                        self.next = if flow == Flow::StopBefore { n } else { next };
+                        self.has_previous = true;
+                        self.stats.samples += samples;
+                        self.pending = Some(segment);
+                        return true;
                     }
                 }
             }
         }
+        self.next = next;
+        self.has_previous = has_previous;
+        self.stats.samples += samples;
         false
     }
 }

@@ -279,14 +279,19 @@ impl Prepared<'_> {
             offset: self.offset(x, y),
             samples,
             rgb: self.display(&out.accum),
-            alpha: out.accum.alpha,
+            alpha: out.accum.alpha(),
             depth_mm: out.depth_mm,
         }
     }
 
     /// The voxel-space ray of pixel `(x, y)` and its part inside the volume.
     fn ray(&self, camera: &Camera, x: usize, y: usize) -> (VoxelRay, Option<(f64, f64)>) {
-        let dir = camera.pixel_direction(x, y);
+        self.ray_along(camera, camera.pixel_direction(x, y))
+    }
+
+    /// The voxel-space ray from the eye along the unit world direction `dir`, and its part
+    /// inside the volume.
+    fn ray_along(&self, camera: &Camera, dir: DVec3) -> (VoxelRay, Option<(f64, f64)>) {
         let ray = VoxelRay::new(&self.voxel_from_world, camera.eye_mm(), dir);
         let dims = self.renderer.volume.dims();
         let extent = DVec3::from(dims.map(|n| (n - 1) as f64));
@@ -311,13 +316,14 @@ impl Prepared<'_> {
         stats: &mut RenderStats,
         probe: &mut impl Probe,
     ) -> PixelOut {
-        let (ray, range) = self.ray(camera, x, y);
+        let dir = camera.pixel_direction(x, y);
+        let (ray, range) = self.ray_along(camera, dir);
         let Some(range) = range else {
             return PixelOut::default();
         };
         let bricks = self.renderer.grid.bricks();
         let mut march = RayMarch::new(&ray, range, bricks, self.step_mm as f32, self.offset(x, y));
-        let dir_world = camera.pixel_direction(x, y).as_vec3();
+        let dir_world = dir.as_vec3();
         let out = integrator.run(&mut march, dir_world, probe);
         stats.rays += 1;
         stats.samples += march.stats.samples;
@@ -331,7 +337,7 @@ impl Prepared<'_> {
     /// A composited pixel over the background, as 8-bit colour.
     fn display(&self, accum: &Accum) -> [u8; 3] {
         let background = Vec3::from(self.settings.background);
-        let c = accum.rgb + background * (1.0 - accum.alpha);
+        let c = Vec3::from(accum.rgb) + background * accum.transmittance;
         [to_u8(c.x), to_u8(c.y), to_u8(c.z)]
     }
 
@@ -348,7 +354,7 @@ impl Prepared<'_> {
             width,
             height,
             rgb: pixels.iter().flat_map(|p| self.display(&p.accum)).collect(),
-            alpha: pixels.iter().map(|p| p.accum.alpha).collect(),
+            alpha: pixels.iter().map(|p| p.accum.alpha()).collect(),
             depth_mm: pixels.iter().map(|p| p.depth_mm).collect(),
             value: pixels.iter().map(|p| physical(p.value)).collect(),
             stats,

@@ -2,7 +2,7 @@
 //! world-space normals, Blinn-Phong shading with a headlight, and front-to-back compositing.
 
 use crate::Volume;
-use glam::{DMat3, Mat3, Vec3, Vec4};
+use glam::{DMat3, Mat3, Vec3, Vec3A, Vec4};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -255,28 +255,45 @@ impl Shader {
     }
 }
 
-/// Front-to-back compositing state: premultiplied colour and opacity accumulated so far.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+/// Front-to-back compositing state: premultiplied colour accumulated so far and the
+/// transmittance left (1 − opacity). Keeping the transmittance makes each sample's update of the
+/// running state one multiplication (`T ← T · (1 − α)`), the only step a ray's samples wait on
+/// one another for; the colour adds up beside it.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accum {
     /// Premultiplied colour.
-    pub rgb: Vec3,
-    /// Opacity.
-    pub alpha: f32,
+    pub rgb: Vec3A,
+    /// Transmittance: the share of light from behind that still gets through.
+    pub transmittance: f32,
+}
+
+impl Default for Accum {
+    fn default() -> Self {
+        Self {
+            rgb: Vec3A::ZERO,
+            transmittance: 1.0,
+        }
+    }
 }
 
 impl Accum {
+    /// Opacity accumulated so far.
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        1.0 - self.transmittance
+    }
+
     /// Adds a premultiplied colour `rgb` of opacity `alpha` behind what is accumulated.
     #[inline]
-    pub fn under(&mut self, rgb: Vec3, alpha: f32) {
-        let t = 1.0 - self.alpha;
-        self.rgb += rgb * t;
-        self.alpha += alpha * t;
+    pub fn under(&mut self, rgb: Vec3A, alpha: f32) {
+        self.rgb += rgb * self.transmittance;
+        self.transmittance *= 1.0 - alpha;
     }
 
     /// Adds a surface of plain colour `rgb` and opacity `alpha`.
     #[inline]
     pub fn under_surface(&mut self, rgb: Vec3, alpha: f32) {
-        self.under(rgb * alpha, alpha);
+        self.under(Vec3A::from(rgb) * alpha, alpha);
     }
 }
 
@@ -369,7 +386,7 @@ mod tests {
         let mut acc = Accum::default();
         acc.under_surface(Vec3::X, 0.5);
         acc.under_surface(Vec3::Y, 0.5);
-        assert_eq!(acc.alpha, 0.75);
-        assert_eq!(acc.rgb, Vec3::new(0.5, 0.25, 0.0));
+        assert_eq!(acc.alpha(), 0.75);
+        assert_eq!(acc.rgb, Vec3A::new(0.5, 0.25, 0.0));
     }
 }

@@ -276,9 +276,6 @@ fn interpolate<T: Copy>(points: &[(f64, T)], value: f64, lerp: impl Fn(T, T, f32
     lerp(y0, y1, t as f32)
 }
 
-/// One table entry: colour premultiplied by the step-corrected opacity, and that opacity.
-pub type Rgba = [f32; 4];
-
 /// A transfer function sampled at every stored value of a volume, for the sample loop:
 /// premultiplied colour and step-corrected opacity per stored value, interpolated linearly
 /// between entries, and a prefix count of non-transparent entries so that "is every value in
@@ -287,8 +284,9 @@ pub type Rgba = [f32; 4];
 pub struct TfTable {
     /// Stored value of entry 0.
     first: u16,
-    /// Premultiplied colour and opacity per stored value `first + index`.
-    entries: Vec<Rgba>,
+    /// Premultiplied colour and opacity per stored value `first + index`, then a copy of the
+    /// last entry, so that an entry's upper neighbour always exists.
+    entries: Vec<Vec4>,
     /// Plain (not premultiplied) colour per entry, for MIP/MinIP.
     colors: Vec<[f32; 3]>,
     /// `opaque_before[i]` = number of entries below `i` with non-zero opacity.
@@ -309,14 +307,15 @@ impl TfTable {
             stored_range.0.max(stored_range.1),
         );
         let exponent = step_mm / OPACITY_UNIT_MM;
-        let (entries, colors): (Vec<Rgba>, Vec<[f32; 3]>) = (lo..=hi)
+        let (mut entries, colors): (Vec<Vec4>, Vec<[f32; 3]>) = (lo..=hi)
             .map(|stored| {
                 let value = value_map.physical(stored);
                 let alpha = corrected_opacity(tf.opacity_at(value), exponent);
                 let [r, g, b] = tf.color_at(value);
-                ([r * alpha, g * alpha, b * alpha, alpha], [r, g, b])
+                (Vec4::new(r * alpha, g * alpha, b * alpha, alpha), [r, g, b])
             })
             .unzip();
+        entries.push(entries[entries.len() - 1]);
         let mut table = Self {
             first: lo,
             entries,
@@ -330,8 +329,8 @@ impl TfTable {
     fn count_opaque(&mut self) {
         let mut count = 0u32;
         self.opaque_before = std::iter::once(0)
-            .chain(self.entries.iter().map(|e| {
-                count += u32::from(e[3] > 0.0);
+            .chain(self.entries[..self.colors.len()].iter().map(|e| {
+                count += u32::from(e.w > 0.0);
                 count
             }))
             .collect();
@@ -344,9 +343,11 @@ impl TfTable {
         for (index, entry) in self.entries.iter_mut().enumerate() {
             let stored = first + index as f32;
             if stored >= lo && stored <= hi {
-                *entry = [0.0; 4];
+                *entry = Vec4::ZERO;
             }
         }
+        let last = self.colors.len() - 1;
+        self.entries[last + 1] = self.entries[last];
         self.count_opaque();
     }
 
@@ -354,7 +355,7 @@ impl TfTable {
     /// unit of margin on each side covers the interpolation between neighbouring entries and
     /// rounding of trilinear samples, so a `false` is safe for skipping.
     pub fn any_opacity(&self, stored_lo: u16, stored_hi: u16) -> bool {
-        let len = self.entries.len();
+        let len = self.colors.len();
         let first = usize::from(self.first);
         let lo = usize::from(stored_lo)
             .saturating_sub(1)
@@ -367,20 +368,23 @@ impl TfTable {
     #[inline(always)]
     fn locate(&self, stored: f32) -> (usize, usize, f32) {
         let x = (stored - f32::from(self.first)).max(0.0);
-        let last = self.entries.len() - 1;
+        let last = self.colors.len() - 1;
         let i = (x as usize).min(last);
         let frac = (x - i as f32).min(1.0);
         (i, (i + 1).min(last), frac)
     }
 
-    /// Premultiplied colour and step-corrected opacity at a continuous stored value.
-    /// The four channels are interpolated in one SIMD vector (the same IEEE operations as one
-    /// by one; the per-channel `map` it replaces was not inlined and cost a call per sample).
+    /// Premultiplied colour and step-corrected opacity at a continuous stored value: one
+    /// `i32` conversion, the entry and its upper neighbour (always there: the table ends with a
+    /// copy of its last entry), one SIMD lerp of the four channels.
     #[inline(always)]
-    pub fn lookup(&self, stored: f32) -> Rgba {
-        let (i, j, t) = self.locate(stored);
-        let (a, b) = (Vec4::from(self.entries[i]), Vec4::from(self.entries[j]));
-        (a + (b - a) * t).to_array()
+    pub fn lookup(&self, stored: f32) -> Vec4 {
+        let x = (stored - f32::from(self.first)).max(0.0);
+        // `as` saturates; the table has far fewer than 2³¹ entries.
+        let i = (x as i32).min(self.colors.len() as i32 - 1);
+        let frac = (x - i as f32).min(1.0);
+        let pair = &self.entries[i as usize..i as usize + 2];
+        pair[0] + (pair[1] - pair[0]) * frac
     }
 
     /// Plain colour at a continuous stored value (for maximum/minimum intensity projections).
@@ -448,7 +452,7 @@ mod tests {
         let table = TfTable::new(&tf, map, (100, 140), 0.5);
         // Stored 115 = 15 HU: α = 0.5 per mm, over 0.5 mm: 1 − 0.5^0.5.
         let expected = 1.0 - 0.5f32.sqrt();
-        let [r, g, b, a] = table.lookup(115.0);
+        let [r, g, b, a] = table.lookup(115.0).to_array();
         assert!((a - expected).abs() < 1e-6);
         assert!((r - expected).abs() < 1e-6 && (g - 0.5 * expected).abs() < 1e-6 && b == 0.0);
         assert!(!table.any_opacity(100, 108));
