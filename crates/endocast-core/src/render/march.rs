@@ -105,11 +105,16 @@ impl RayMarch {
     /// Samples, in order, the bricks for which `active(brick)` holds, handing each sample to
     /// `visit` until it stops the walk (returns true) or the ray ends (returns false). With
     /// `padded`, runs include one sample before and after each active brick's own samples.
+    ///
+    /// A `long` walk (compositing: many samples, no walk after it) joins consecutive active
+    /// bricks into one run and fetches each batch while the one before it is visited, so that
+    /// its gathers are in flight meanwhile; it ends the ray when it stops. (A short walk, the
+    /// isosurface search, would waste the batch fetched ahead, and is resumed after its stop.)
     #[inline]
     pub fn walk(
         &mut self,
         sampler: &Sampler<'_>,
-        padded: bool,
+        (padded, long): (bool, bool),
         mut active: impl FnMut(u32) -> bool,
         mut visit: impl FnMut(Sample) -> Flow,
     ) -> bool {
@@ -117,17 +122,34 @@ impl RayMarch {
         // The per-sample state lives in locals (registers) and is written back when the walk
         // stops or ends.
         let (mut next, mut has_previous, mut samples) = (self.next, self.has_previous, 0u64);
-        while let Some(segment) = self.pending.take().or_else(|| self.dda.next()) {
+        while let Some(mut segment) = self.pending.take().or_else(|| self.dda.next()) {
             if !active(segment.brick) {
                 self.stats.bricks_skipped += 1;
                 continue;
             }
             self.stats.bricks_visited += 1;
+            while long {
+                let Some(following) = self.dda.next() else {
+                    break;
+                };
+                if !active(following.brick) {
+                    self.stats.bricks_skipped += 1;
+                    break;
+                }
+                self.stats.bricks_visited += 1;
+                segment.t1 = following.t1;
+            }
             let first = (self.index_at(segment.t0) - pad).max(next);
             let last = (self.index_at(segment.t1) + pad).min(self.end);
+            if first >= last {
+                continue;
+            }
+            let mut values = sampler.grid8(&self.grid, first, (last - first).min(8) as usize);
             for batch in (first..last).step_by(8) {
                 let count = (last - batch).min(8) as usize;
-                let values = sampler.grid8(&self.grid, batch, count);
+                let rest = last - batch - 8;
+                let ahead = (long && rest > 0)
+                    .then(|| sampler.grid8(&self.grid, batch + 8, rest.min(8) as usize));
                 for (n, &value) in (batch..).zip(&values[..count]) {
                     let sample = Sample {
                         t: self.grid.t_of(n),
@@ -142,9 +164,18 @@ impl RayMarch {
                         self.next = if flow == Flow::StopBefore { n } else { next };
                         self.has_previous = true;
                         self.stats.samples += samples;
-                        self.pending = Some(segment);
+                        if long {
+                            self.end = next.min(self.end);
+                        } else {
+                            self.pending = Some(segment);
+                        }
                         return true;
                     }
+                }
+                if rest > 0 {
+                    values = ahead.unwrap_or_else(|| {
+                        sampler.grid8(&self.grid, batch + 8, rest.min(8) as usize)
+                    });
                 }
             }
         }
