@@ -128,16 +128,8 @@ impl RayMarch {
                 continue;
             }
             self.stats.bricks_visited += 1;
-            while long {
-                let Some(following) = self.dda.next() else {
-                    break;
-                };
-                if !active(following.brick) {
-                    self.stats.bricks_skipped += 1;
-                    break;
-                }
-                self.stats.bricks_visited += 1;
-                segment.t1 = following.t1;
+            if long {
+                self.join_active(&mut segment, &mut active);
             }
             let first = (self.index_at(segment.t0) - pad).max(next);
             let last = (self.index_at(segment.t1) + pad).min(self.end);
@@ -183,5 +175,18 @@ impl RayMarch {
         self.has_previous = has_previous;
         self.stats.samples += samples;
         false
+    }
+
+    /// Extends `segment` over the active bricks that directly follow it (the first inactive
+    /// one is consumed as skipped).
+    fn join_active(&mut self, segment: &mut Segment, active: &mut impl FnMut(u32) -> bool) {
+        for following in self.dda.by_ref() {
+            if !active(following.brick) {
+                self.stats.bricks_skipped += 1;
+                return;
+            }
+            self.stats.bricks_visited += 1;
+            segment.t1 = following.t1;
+        }
     }
 }
