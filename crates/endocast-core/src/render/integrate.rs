@@ -375,9 +375,9 @@ impl Integrator<'_> {
     }
 }
 
-/// `levels` (1–4) bisection steps of the bracket `[before, after]` with one round of
-/// samples: the round holds the whole tree of midpoints those steps can visit (heap order,
-/// node `i`'s halves at `2i` and `2i + 1`), each computed as the step-by-step bisection
+/// `levels` (1–[`BISECTION_LEVELS`]) bisection steps of the bracket `[before, after]` with one
+/// batch of samples: the batch holds the whole tree of midpoints those steps can visit (heap
+/// order, node `i`'s halves at `2i` and `2i + 1`), each computed as the step-by-step bisection
 /// would, so the bracket ends the same, only without waiting on each sample in turn.
 fn bisect(
     sampler: &Sampler<'_>,
@@ -386,8 +386,9 @@ fn bisect(
     levels: u32,
     (before, after): (&mut (f32, f32), &mut (f32, f32)),
 ) {
+    debug_assert!((1..=BISECTION_LEVELS).contains(&levels));
     let nodes = 1usize << levels;
-    let (mut lo, mut hi, mut t) = ([0.0f32; 16], [0.0f32; 16], [0.0f32; 16]);
+    let (mut lo, mut hi, mut t) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
     (lo[1], hi[1]) = (before.0, after.0);
     t[1] = 0.5 * (lo[1] + hi[1]);
     for i in 2..nodes {
@@ -399,16 +400,21 @@ fn bisect(
         };
         t[i] = 0.5 * (lo[i] + hi[i]);
     }
-    let mut values = [0.0; 16];
-    if nodes == 2 {
-        values[1] = sampler.value(line.at(t[1]));
+    // One step is one sample; more fill a batch (lane 0 is unused).
+    let values = if nodes == 2 {
+        [
+            0.0,
+            sampler.value(line.at(t[1])),
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ]
     } else {
-        let lanes = nodes.next_multiple_of(8);
-        for (batch, times) in values[..lanes].chunks_exact_mut(8).zip(t.chunks_exact(8)) {
-            let points = std::array::from_fn(|i| line.at(times[i]));
-            batch.copy_from_slice(&sampler.points8(&points));
-        }
-    }
+        sampler.points8(&t.map(|t| line.at(t)))
+    };
     let mut node = 1;
     for _ in 0..levels {
         let m = (t[node], values[node]);

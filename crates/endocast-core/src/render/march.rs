@@ -136,15 +136,16 @@ impl RayMarch {
             if first >= last {
                 continue;
             }
-            let mut values = sampler.grid8(&self.grid, first, (last - first).min(8) as usize);
+            let grid = self.grid;
+            let fetch = |n: i32| sampler.grid8(&grid, n, (last - n).min(8) as usize);
+            let mut values = fetch(first);
             for batch in (first..last).step_by(8) {
                 let count = (last - batch).min(8) as usize;
-                let rest = last - batch - 8;
-                let ahead = (long && rest > 0)
-                    .then(|| sampler.grid8(&self.grid, batch + 8, rest.min(8) as usize));
+                let more = batch + 8 < last;
+                let ahead = (long && more).then(|| fetch(batch + 8));
                 for (n, &value) in (batch..).zip(&values[..count]) {
                     let sample = Sample {
-                        t: self.grid.t_of(n),
+                        t: grid.t_of(n),
                         value,
                         fresh: !(has_previous && n == next),
                     };
@@ -164,10 +165,8 @@ impl RayMarch {
                         return true;
                     }
                 }
-                if rest > 0 {
-                    values = ahead.unwrap_or_else(|| {
-                        sampler.grid8(&self.grid, batch + 8, rest.min(8) as usize)
-                    });
+                if more {
+                    values = ahead.unwrap_or_else(|| fetch(batch + 8));
                 }
             }
         }

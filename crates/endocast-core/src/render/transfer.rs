@@ -364,34 +364,34 @@ impl TfTable {
         lo < hi && self.opaque_before[hi] > self.opaque_before[lo]
     }
 
-    /// Entry index and interpolation weight of a (continuous) stored value, clamped.
+    /// Entry index and interpolation weight towards the next entry of a (continuous) stored
+    /// value, clamped to the table: one `i32` conversion (`as` saturates and maps NaN to 0; the
+    /// table has far fewer than 2³¹ entries).
     #[inline(always)]
-    fn locate(&self, stored: f32) -> (usize, usize, f32) {
+    fn locate(&self, stored: f32) -> (usize, f32) {
         let x = (stored - f32::from(self.first)).max(0.0);
-        let last = self.colors.len() - 1;
-        let i = (x as usize).min(last);
-        let frac = (x - i as f32).min(1.0);
-        (i, (i + 1).min(last), frac)
+        let i = (x as i32).min(self.colors.len() as i32 - 1);
+        (i as usize, (x - i as f32).min(1.0))
     }
 
-    /// Premultiplied colour and step-corrected opacity at a continuous stored value: one
-    /// `i32` conversion, the entry and its upper neighbour (always there: the table ends with a
-    /// copy of its last entry), one SIMD lerp of the four channels.
+    /// Premultiplied colour and step-corrected opacity at a continuous stored value: the entry
+    /// and its upper neighbour (always there: the table ends with a copy of its last entry),
+    /// one SIMD lerp of the four channels.
     #[inline(always)]
     pub fn lookup(&self, stored: f32) -> Vec4 {
-        let x = (stored - f32::from(self.first)).max(0.0);
-        // `as` saturates; the table has far fewer than 2³¹ entries.
-        let i = (x as i32).min(self.colors.len() as i32 - 1);
-        let frac = (x - i as f32).min(1.0);
-        let pair = &self.entries[i as usize..i as usize + 2];
-        pair[0] + (pair[1] - pair[0]) * frac
+        let (i, weight) = self.locate(stored);
+        let pair = &self.entries[i..i + 2];
+        pair[0] + (pair[1] - pair[0]) * weight
     }
 
     /// Plain colour at a continuous stored value (for maximum/minimum intensity projections).
     #[inline]
     pub fn color(&self, stored: f32) -> [f32; 3] {
-        let (i, j, t) = self.locate(stored);
-        let (a, b) = (self.colors[i], self.colors[j]);
+        let (i, t) = self.locate(stored);
+        let (a, b) = (
+            self.colors[i],
+            self.colors[(i + 1).min(self.colors.len() - 1)],
+        );
         [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * t)
     }
 }
