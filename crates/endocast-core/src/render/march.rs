@@ -122,27 +122,35 @@ impl RayMarch {
         // The per-sample state lives in locals (registers) and is written back when the walk
         // stops or ends.
         let (mut next, mut has_previous, mut samples) = (self.next, self.has_previous, 0u64);
-        while let Some(mut segment) = self.pending.take().or_else(|| self.dda.next()) {
+        while let Some(segment) = self.pending.take().or_else(|| self.dda.next()) {
             if !active(segment.brick) {
                 self.stats.bricks_skipped += 1;
                 continue;
             }
             self.stats.bricks_visited += 1;
-            if long {
-                self.join_active(&mut segment, &mut active);
-            }
             let first = (self.index_at(segment.t0) - pad).max(next);
-            let last = (self.index_at(segment.t1) + pad).min(self.end);
-            if first >= last {
+            // A long walk's run grows brick by brick while active ones follow, always at least a
+            // batch ahead of the one fetched (a ray that terminates early never steps the DDA
+            // through the rest of its bricks).
+            let mut run = Run {
+                segment,
+                last: (self.index_at(segment.t1) + pad).min(self.end),
+                open: long,
+            };
+            self.grow(&mut run, first + 8, pad, &mut active);
+            if first >= run.last {
                 continue;
             }
             let grid = self.grid;
-            let fetch = |n: i32| sampler.grid8(&grid, n, (last - n).min(8) as usize);
-            let mut values = fetch(first);
-            for batch in (first..last).step_by(8) {
+            let fetch = |n: i32, last: i32| sampler.grid8(&grid, n, (last - n).min(8) as usize);
+            let mut values = fetch(first, run.last);
+            let mut batch = first;
+            loop {
+                self.grow(&mut run, batch + 16, pad, &mut active);
+                let last = run.last;
                 let count = (last - batch).min(8) as usize;
                 let more = batch + 8 < last;
-                let ahead = (long && more).then(|| fetch(batch + 8));
+                let ahead = (long && more).then(|| fetch(batch + 8, last));
                 for (n, &value) in (batch..).zip(&values[..count]) {
                     let sample = Sample {
                         t: grid.t_of(n),
@@ -160,14 +168,16 @@ impl RayMarch {
                         if long {
                             self.end = next.min(self.end);
                         } else {
-                            self.pending = Some(segment);
+                            self.pending = Some(run.segment);
                         }
                         return true;
                     }
                 }
-                if more {
-                    values = ahead.unwrap_or_else(|| fetch(batch + 8));
+                if !more {
+                    break;
                 }
+                values = ahead.unwrap_or_else(|| fetch(batch + 8, last));
+                batch += 8;
             }
         }
         self.next = next;
@@ -176,16 +186,34 @@ impl RayMarch {
         false
     }
 
-    /// Extends `segment` over the active bricks that directly follow it (the first inactive
-    /// one is consumed as skipped).
-    fn join_active(&mut self, segment: &mut Segment, active: &mut impl FnMut(u32) -> bool) {
-        for following in self.dda.by_ref() {
+    /// Extends a long walk's `run` over the active bricks that follow until it reaches sample
+    /// `wanted` (exclusive); the first inactive brick is consumed as skipped and closes the run,
+    /// as does the end of the ray.
+    fn grow(&mut self, run: &mut Run, wanted: i32, pad: i32, active: &mut impl FnMut(u32) -> bool) {
+        while run.open && run.last < wanted {
+            let Some(following) = self.dda.next() else {
+                run.open = false;
+                return;
+            };
             if !active(following.brick) {
                 self.stats.bricks_skipped += 1;
+                run.open = false;
                 return;
             }
             self.stats.bricks_visited += 1;
-            segment.t1 = following.t1;
+            run.segment.t1 = following.t1;
+            run.last = (self.index_at(following.t1) + pad).min(self.end);
         }
     }
+}
+
+/// The samples a walk takes in one go: one active brick, or for a long walk the active bricks
+/// that follow each other.
+struct Run {
+    /// The bricks' extent along the ray (the last brick's index).
+    segment: Segment,
+    /// One past the run's last sample index.
+    last: i32,
+    /// Whether the run may still grow.
+    open: bool,
 }
