@@ -4,21 +4,26 @@
 //! termination) — over a [`RayMarch`].
 
 use super::bricks::{Activity, BrickGrid};
-use super::march::{Flow, RayMarch, Sample};
+use super::march::{Batch, Flow, RayMarch, Sample, Stopped};
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
 use super::transfer::TfTable;
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 use std::cell::Cell;
 
 /// Receives every sample an integrator composites or tests (the `--debug-pixel` trace). `()`
 /// ignores them at no cost.
 pub(crate) trait Probe {
+    /// Whether samples are traced (compositing then goes one sample at a time).
+    const TRACES: bool = true;
+
     /// A sample at `t` mm of stored value `value`; `alpha` is the opacity accumulated after it.
     fn sample(&mut self, t: f32, value: f32, alpha: f32);
 }
 
 impl Probe for () {
+    const TRACES: bool = false;
+
     #[inline]
     fn sample(&mut self, _t: f32, _value: f32, _alpha: f32) {}
 }
@@ -251,13 +256,13 @@ impl Integrator<'_> {
     }
 
     /// Front-to-back DVR in TF-active bricks onto `out`, until early termination.
-    fn composite(
+    fn composite<P: Probe>(
         &self,
         march: &mut RayMarch,
         out: &mut PixelOut,
         dir_world: Vec3,
         shade: bool,
-        probe: &mut impl Probe,
+        probe: &mut P,
     ) {
         let stop = self.params.early_termination;
         if out.accum.alpha() >= stop {
@@ -267,18 +272,57 @@ impl Integrator<'_> {
         // A local copy the compiler keeps in registers through the walk.
         let mut acc = out.accum;
         let line = march.grid();
-        let terminated = march.walk(
-            &self.sampler,
-            (false, true),
-            |b| self.tf_active(b),
-            |s: Sample| {
+        let mode = (false, true);
+        let active = |b| self.tf_active(b);
+        let terminated = if shade || P::TRACES {
+            march.walk(&self.sampler, mode, active, |s: Sample| {
                 self.add_sample(&mut acc, line, s, dir_world, shade);
                 probe.sample(s.t, s.value, acc.alpha());
                 until_opaque(acc.alpha(), stop)
-            },
-        );
+            })
+        } else {
+            march.walk_batches(&self.sampler, mode, active, |batch| {
+                self.composite_batch(&mut acc, &batch, stop)
+            })
+        };
         out.accum = acc;
         out.terminated = terminated;
+    }
+
+    /// Unshaded compositing of a whole batch, with the same operations in the same order as
+    /// one sample at a time, but without a test per sample: the opacity only grows, so the
+    /// batch is redone one by one only when it ends at or past `stop`, to stop at the exact
+    /// sample.
+    #[inline(always)]
+    fn composite_batch(&self, acc: &mut Accum, batch: &Batch, stop: f32) -> Option<Stopped> {
+        // Lanes past `count` composite a transparent black sample: exactly nothing.
+        let entries: [Vec4; 8] = std::array::from_fn(|k| {
+            if k < batch.count {
+                self.table.lookup(batch.values[k])
+            } else {
+                Vec4::ZERO
+            }
+        });
+        let mut whole = *acc;
+        for entry in &entries {
+            whole.under(Vec3A::from_vec4(*entry), entry.w);
+        }
+        if whole.alpha() < stop {
+            *acc = whole;
+            return None;
+        }
+        let mut taken = 0;
+        for entry in &entries[..batch.count] {
+            acc.under(Vec3A::from_vec4(*entry), entry.w);
+            taken += 1;
+            if acc.alpha() >= stop {
+                break;
+            }
+        }
+        Some(Stopped {
+            taken,
+            next: batch.first + taken as i32,
+        })
     }
 
     /// Two surfaces and DVR outside both: every sample is tested for a crossing of either

@@ -6,7 +6,7 @@
 //! may ask for padded runs: one extra sample before and after every active brick's samples,
 //! which puts both samples around any crossing inside an active brick into one run.
 
-use super::sample::{SampleGrid, Sampler};
+use super::sample::{Lanes, SampleGrid, Sampler};
 use super::traverse::{ray_f32, BrickDda, Segment, VoxelRay};
 
 /// One sample handed to a walk's visitor.
@@ -30,6 +30,28 @@ pub(crate) enum Flow {
     Stop,
     /// Stop the walk; the next walk starts again with this sample.
     StopBefore,
+}
+
+/// Up to eight consecutive samples of the grid, handed at once to a batch walk's visitor.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Batch {
+    /// Grid index of the first sample.
+    pub first: i32,
+    /// The trilinear stored values; lanes from `count` on are unspecified.
+    pub values: Lanes,
+    /// How many lanes hold samples (1–8).
+    pub count: usize,
+    /// Whether the first sample is fresh (see [`Sample::fresh`]); the others never are.
+    pub fresh: bool,
+}
+
+/// Where a batch visitor stopped its walk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Stopped {
+    /// Samples of the batch consumed (counted as taken).
+    pub taken: usize,
+    /// The grid index the next walk starts with.
+    pub next: i32,
 }
 
 /// Counters of one ray's walks.
@@ -114,12 +136,51 @@ impl RayMarch {
     pub fn walk(
         &mut self,
         sampler: &Sampler<'_>,
-        (padded, long): (bool, bool),
-        mut active: impl FnMut(u32) -> bool,
+        mode: (bool, bool),
+        active: impl FnMut(u32) -> bool,
         mut visit: impl FnMut(Sample) -> Flow,
     ) -> bool {
+        let grid = self.grid;
+        self.walk_batches(sampler, mode, active, |batch| {
+            for (i, &value) in batch.values[..batch.count].iter().enumerate() {
+                let n = batch.first + i as i32;
+                let sample = Sample {
+                    t: grid.t_of(n),
+                    value,
+                    fresh: batch.fresh && i == 0,
+                };
+                match visit(sample) {
+                    Flow::Continue => {}
+                    Flow::Stop => {
+                        return Some(Stopped {
+                            taken: i + 1,
+                            next: n + 1,
+                        })
+                    }
+                    Flow::StopBefore => {
+                        return Some(Stopped {
+                            taken: i + 1,
+                            next: n,
+                        })
+                    }
+                }
+            }
+            None
+        })
+    }
+
+    /// [`Self::walk`] a batch at a time: `visit` gets up to eight consecutive samples of one
+    /// run and says where it stopped, if it did.
+    #[inline]
+    pub fn walk_batches(
+        &mut self,
+        sampler: &Sampler<'_>,
+        (padded, long): (bool, bool),
+        mut active: impl FnMut(u32) -> bool,
+        mut visit: impl FnMut(Batch) -> Option<Stopped>,
+    ) -> bool {
         let pad = i32::from(padded);
-        // The per-sample state lives in locals (registers) and is written back when the walk
+        // The per-batch state lives in locals (registers) and is written back when the walk
         // stops or ends.
         let (mut next, mut has_previous, mut samples) = (self.next, self.has_previous, 0u64);
         while let Some(segment) = self.pending.take().or_else(|| self.dda.next()) {
@@ -151,28 +212,26 @@ impl RayMarch {
                 let count = (last - batch).min(8) as usize;
                 let more = batch + 8 < last;
                 let ahead = (long && more).then(|| fetch(batch + 8, last));
-                for (n, &value) in (batch..).zip(&values[..count]) {
-                    let sample = Sample {
-                        t: grid.t_of(n),
-                        value,
-                        fresh: !(has_previous && n == next),
-                    };
-                    samples += 1;
-                    next = n + 1;
-                    has_previous = true;
-                    let flow = visit(sample);
-                    if flow != Flow::Continue {
-                        self.next = if flow == Flow::StopBefore { n } else { next };
-                        self.has_previous = true;
-                        self.stats.samples += samples;
-                        if long {
-                            self.end = next.min(self.end);
-                        } else {
-                            self.pending = Some(run.segment);
-                        }
-                        return true;
+                let fresh = !(has_previous && batch == next);
+                if let Some(stopped) = visit(Batch {
+                    first: batch,
+                    values,
+                    count,
+                    fresh,
+                }) {
+                    self.next = stopped.next;
+                    self.has_previous = true;
+                    self.stats.samples += samples + stopped.taken as u64;
+                    if long {
+                        self.end = (batch + stopped.taken as i32).min(self.end);
+                    } else {
+                        self.pending = Some(run.segment);
                     }
+                    return true;
                 }
+                samples += count as u64;
+                next = batch + count as i32;
+                has_previous = true;
                 if !more {
                     break;
                 }

@@ -307,6 +307,8 @@ fn hybrid_at_full_opacity_is_iso_and_at_zero_is_dvr_from_the_hit() {
     assert!(a.alpha.iter().filter(|&&x| x > 0.5).count() > 32 * 32 / 2);
 }
 
+/// Also checks that compositing a batch at a time (the frame) gives exactly what one sample at
+/// a time gives (the trace).
 #[test]
 fn early_termination_stops_at_the_first_sample_past_the_threshold() {
     let (renderer, camera) = colon_view(128, 0.45, 12);
@@ -327,7 +329,9 @@ fn early_termination_stops_at_the_first_sample_past_the_threshold() {
                 let before = trace.samples[..first].last().map_or(0.0, |s| s.alpha);
                 assert!(before < 0.9);
             }
-            assert_eq!(trace.alpha, frame.alpha[x + 12 * y]);
+            let i = x + 12 * y;
+            assert_eq!(trace.alpha, frame.alpha[i]);
+            assert_eq!(trace.rgb[..], frame.rgb[3 * i..3 * i + 3]);
         }
     }
 }
