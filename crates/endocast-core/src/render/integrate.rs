@@ -4,7 +4,7 @@
 //! termination) — over a [`RayMarch`].
 
 use super::bricks::{Activity, BrickGrid};
-use super::march::{Batch, Flow, RayMarch, Sample, Stopped};
+use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
 use super::transfer::TfTable;
@@ -175,7 +175,7 @@ impl Integrator<'_> {
         let mut hit = None;
         march.walk(
             &self.sampler,
-            (true, false),
+            Walk::SEARCH,
             |b| self.iso_active(b),
             |s: Sample| {
                 probe.sample(s.t, s.value, 0.0);
@@ -272,7 +272,7 @@ impl Integrator<'_> {
         // A local copy the compiler keeps in registers through the walk.
         let mut acc = out.accum;
         let line = march.grid();
-        let mode = (false, true);
+        let mode = Walk::COMPOSITE;
         let active = |b| self.tf_active(b);
         let terminated = if shade || P::TRACES {
             march.walk(&self.sampler, mode, active, |s: Sample| {
@@ -338,7 +338,7 @@ impl Integrator<'_> {
         let depth = &mut out.depth_mm;
         let terminated = march.walk(
             &self.sampler,
-            (true, true),
+            Walk::COMPOSITE_CROSSINGS,
             |b| self.iso_active(b) || self.tf_active(b),
             |s: Sample| {
                 if !s.fresh {
@@ -389,7 +389,7 @@ impl Integrator<'_> {
         // the bricks before them (3.8× slower).
         march.walk(
             &self.sampler,
-            (false, false),
+            Walk::EXTREME,
             |b| {
                 let bound = if maximum {
                     self.grid.max(b as usize)

@@ -54,6 +54,49 @@ pub(crate) struct Stopped {
     pub next: i32,
 }
 
+/// How a walk runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Walk {
+    /// Runs include one sample before and after their active bricks' own samples, so both
+    /// samples around any crossing inside an active brick lie in one run (isosurfaces).
+    pub padded: bool,
+    /// Consecutive active bricks make one run (fewer part-filled batches at brick faces). Not
+    /// for walks whose activity changes as they go (MIP raises its extreme).
+    pub join: bool,
+    /// Compositing: many samples and no walk after it. Each batch is fetched while the one
+    /// before it is visited, so that its gathers are in flight meanwhile, and the walk ends
+    /// the ray when it stops. (A short walk, the isosurface search, would waste the batch
+    /// fetched ahead, and is resumed after its stop.)
+    pub long: bool,
+}
+
+impl Walk {
+    /// The isosurface search (resumed after its hit).
+    pub const SEARCH: Self = Self {
+        padded: true,
+        join: true,
+        long: false,
+    };
+    /// Front-to-back compositing.
+    pub const COMPOSITE: Self = Self {
+        padded: false,
+        join: true,
+        long: true,
+    };
+    /// Compositing that tests isosurface crossings too.
+    pub const COMPOSITE_CROSSINGS: Self = Self {
+        padded: true,
+        join: true,
+        long: true,
+    };
+    /// MIP/MinIP: bricks judged one by one against the extreme so far.
+    pub const EXTREME: Self = Self {
+        padded: false,
+        join: false,
+        long: false,
+    };
+}
+
 /// Counters of one ray's walks.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(crate) struct MarchStats {
@@ -125,23 +168,18 @@ impl RayMarch {
     }
 
     /// Samples, in order, the bricks for which `active(brick)` holds, handing each sample to
-    /// `visit` until it stops the walk (returns true) or the ray ends (returns false). With
-    /// `padded`, runs include one sample before and after each active brick's own samples.
-    ///
-    /// A `long` walk (compositing: many samples, no walk after it) joins consecutive active
-    /// bricks into one run and fetches each batch while the one before it is visited, so that
-    /// its gathers are in flight meanwhile; it ends the ray when it stops. (A short walk, the
-    /// isosurface search, would waste the batch fetched ahead, and is resumed after its stop.)
+    /// `visit` until it stops the walk (returns true) or the ray ends (returns false), as
+    /// `walk` says (see [`Walk`]).
     #[inline]
     pub fn walk(
         &mut self,
         sampler: &Sampler<'_>,
-        mode: (bool, bool),
+        walk: Walk,
         active: impl FnMut(u32) -> bool,
         mut visit: impl FnMut(Sample) -> Flow,
     ) -> bool {
         let grid = self.grid;
-        self.walk_batches(sampler, mode, active, |batch| {
+        self.walk_batches(sampler, walk, active, |batch| {
             for (i, &value) in batch.values[..batch.count].iter().enumerate() {
                 let n = batch.first + i as i32;
                 let sample = Sample {
@@ -175,7 +213,7 @@ impl RayMarch {
     pub fn walk_batches(
         &mut self,
         sampler: &Sampler<'_>,
-        (padded, long): (bool, bool),
+        Walk { padded, join, long }: Walk,
         mut active: impl FnMut(u32) -> bool,
         mut visit: impl FnMut(Batch) -> Option<Stopped>,
     ) -> bool {
@@ -183,20 +221,20 @@ impl RayMarch {
         // The per-batch state lives in locals (registers) and is written back when the walk
         // stops or ends.
         let (mut next, mut has_previous, mut samples) = (self.next, self.has_previous, 0u64);
-        while let Some(segment) = self.pending.take().or_else(|| self.dda.next()) {
-            if !active(segment.brick) {
+        while let Some((segment, resumed)) = self.next_segment() {
+            if !resumed && !active(segment.brick) {
                 self.stats.bricks_skipped += 1;
                 continue;
             }
             self.stats.bricks_visited += 1;
             let first = (self.index_at(segment.t0) - pad).max(next);
-            // A long walk's run grows brick by brick while active ones follow, always at least a
-            // batch ahead of the one fetched (a ray that terminates early never steps the DDA
-            // through the rest of its bricks).
+            // A joining walk's run grows brick by brick while active ones follow, as far as
+            // its batches need (a ray that terminates early never steps the DDA through the
+            // rest of its bricks).
             let mut run = Run {
                 segment,
                 last: (self.index_at(segment.t1) + pad).min(self.end),
-                open: long,
+                open: join,
             };
             self.grow(&mut run, first + 8, pad, &mut active);
             if first >= run.last {
@@ -207,7 +245,10 @@ impl RayMarch {
             let mut values = fetch(first, run.last);
             let mut batch = first;
             loop {
-                self.grow(&mut run, batch + 16, pad, &mut active);
+                // Enough to know this batch and whether another follows; a long walk's next
+                // batch, fetched ahead, needs all of it.
+                let reach = if long { 16 } else { 9 };
+                self.grow(&mut run, batch + reach, pad, &mut active);
                 let last = run.last;
                 let count = (last - batch).min(8) as usize;
                 let more = batch + 8 < last;
@@ -235,7 +276,13 @@ impl RayMarch {
                 if !more {
                     break;
                 }
-                values = ahead.unwrap_or_else(|| fetch(batch + 8, last));
+                values = match ahead {
+                    Some(values) => values,
+                    None => {
+                        self.grow(&mut run, batch + 16, pad, &mut active);
+                        fetch(batch + 8, run.last)
+                    }
+                };
                 batch += 8;
             }
         }
@@ -245,7 +292,18 @@ impl RayMarch {
         false
     }
 
-    /// Extends a long walk's `run` over the active bricks that follow until it reaches sample
+    /// The run a stopped walk was in (`true`: sampled whatever the activity, as it may span
+    /// several bricks; an inactive brick's samples add nothing, so the image is the same),
+    /// else the next brick.
+    #[inline]
+    fn next_segment(&mut self) -> Option<(Segment, bool)> {
+        match self.pending.take() {
+            Some(run) => Some((run, true)),
+            None => self.dda.next().map(|s| (s, false)),
+        }
+    }
+
+    /// Extends a joining walk's `run` over the active bricks that follow until it reaches sample
     /// `wanted` (exclusive); the first inactive brick is consumed as skipped and closes the run,
     /// as does the end of the ray.
     fn grow(&mut self, run: &mut Run, wanted: i32, pad: i32, active: &mut impl FnMut(u32) -> bool) {
@@ -266,8 +324,8 @@ impl RayMarch {
     }
 }
 
-/// The samples a walk takes in one go: one active brick, or for a long walk the active bricks
-/// that follow each other.
+/// The samples a walk takes in one go: one active brick, or for a joining walk the active
+/// bricks that follow each other.
 struct Run {
     /// The bricks' extent along the ray (the last brick's index).
     segment: Segment,
