@@ -94,6 +94,9 @@ pub(crate) struct Integrator<'a> {
     pub table: &'a TfTable,
     pub shader: Shader,
     pub params: Params,
+    /// The eye (voxel space) and the crossing side of the lower isovalue for rays starting
+    /// there.
+    pub eye_side: Option<(Vec3, bool)>,
 }
 
 impl Integrator<'_> {
@@ -152,11 +155,23 @@ impl Integrator<'_> {
     /// auto mode the value at the start decides; a brick that cannot hold `iso` tells which side
     /// it lies on without a sample.
     fn rising(&self, march: &RayMarch, iso: f32) -> bool {
+        let grid = march.grid();
+        match self.eye_side {
+            Some((eye, rising))
+                if grid.t_start == 0.0 && grid.origin == eye && iso == self.params.lower.iso =>
+            {
+                rising
+            }
+            _ => self.rising_at(grid.at(grid.t_start), iso),
+        }
+    }
+
+    /// [`Self::rising`] for a ray starting at voxel position `start`.
+    pub fn rising_at(&self, start: Vec3, iso: f32) -> bool {
         match self.params.crossing {
             Crossing::Rising => true,
             Crossing::Falling => false,
             Crossing::Auto => {
-                let start = march.grid().at(march.grid().t_start);
                 let brick = self.grid.brick_at(start);
                 if self.activity.iso.get(brick) {
                     self.sampler.value(start) < iso

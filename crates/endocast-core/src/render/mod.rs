@@ -219,22 +219,29 @@ impl Prepared<'_> {
         self.step_mm
     }
 
-    fn integrator(&self) -> Integrator<'_> {
-        Integrator {
+    /// The integrators for frames of `camera`.
+    fn integrator(&self, camera: &Camera) -> Integrator<'_> {
+        let mut integrator = Integrator {
             sampler: Sampler::new(&self.renderer.volume),
             grid: &self.renderer.grid,
             activity: &self.activity,
             table: &self.table,
             shader: self.shader,
             params: self.params,
-        }
+            eye_side: None,
+        };
+        // Every ray starting at the eye (t = 0) shares its crossing side: decided once.
+        let eye = VoxelRay::new(&self.voxel_from_world, camera.eye_mm(), DVec3::Z).origin;
+        let rising = integrator.rising_at(eye.as_vec3(), self.params.lower.iso);
+        integrator.eye_side = Some((eye.as_vec3(), rising));
+        integrator
     }
 
     /// Renders one frame, tiles in parallel on the current rayon pool.
     pub fn render(&self, camera: &Camera) -> Frame {
         let start = Instant::now();
         let [width, height] = camera.size();
-        let integrator = self.integrator();
+        let integrator = self.integrator(camera);
         let mut pixels = vec![PixelOut::default(); width * height];
         let stats = pixels
             .par_chunks_mut(width * TILE)
@@ -263,7 +270,7 @@ impl Prepared<'_> {
 
     /// Traces pixel `(x, y)` of `camera` and returns every sample (the `--debug-pixel` aid).
     pub fn trace_pixel(&self, camera: &Camera, x: usize, y: usize) -> PixelTrace {
-        let integrator = self.integrator();
+        let integrator = self.integrator(camera);
         let mut samples = Vec::new();
         let mut stats = RenderStats::default();
         let out = self.pixel(&integrator, camera, x, y, &mut stats, &mut samples);
