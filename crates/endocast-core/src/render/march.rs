@@ -306,7 +306,21 @@ impl RayMarch {
     /// Extends a joining walk's `run` over the active bricks that follow until it reaches sample
     /// `wanted` (exclusive); the first inactive brick is consumed as skipped and closes the run,
     /// as does the end of the ray.
+    #[inline(always)]
     fn grow(&mut self, run: &mut Run, wanted: i32, pad: i32, active: &mut impl FnMut(u32) -> bool) {
+        if run.open && run.last < wanted {
+            self.extend(run, wanted, pad, active);
+        }
+    }
+
+    /// [`Self::grow`] past its test: steps the DDA.
+    fn extend(
+        &mut self,
+        run: &mut Run,
+        wanted: i32,
+        pad: i32,
+        active: &mut impl FnMut(u32) -> bool,
+    ) {
         while run.open && run.last < wanted {
             let Some(following) = self.dda.next() else {
                 run.open = false;
