@@ -221,6 +221,8 @@ impl Default for Lighting {
 pub struct Shader {
     world_from_gradient: Mat3,
     lighting: Lighting,
+    /// The specular exponent when it is a whole number (the usual case).
+    whole_shininess: Option<u32>,
 }
 
 impl Shader {
@@ -229,6 +231,8 @@ impl Shader {
         Self {
             world_from_gradient: linear.inverse().transpose().as_mat3(),
             lighting,
+            whole_shininess: (lighting.shininess.fract() == 0.0 && lighting.shininess >= 0.0)
+                .then_some(lighting.shininess as u32),
         }
     }
 
@@ -244,14 +248,29 @@ impl Shader {
     pub fn shade(&self, base: Vec3, normal: Vec3, ray_dir_world: Vec3) -> Vec3 {
         let l = &self.lighting;
         let n_dot_l = normal.dot(ray_dir_world).abs();
-        // Integer exponents (the usual case) by repeated squaring: no libm call per hit.
-        let power = if l.shininess.fract() == 0.0 {
-            n_dot_l.powi(l.shininess as i32)
-        } else {
-            n_dot_l.powf(l.shininess)
+        let power = match self.whole_shininess {
+            Some(n) => power_by_squaring(n_dot_l, n),
+            None => n_dot_l.powf(l.shininess),
         };
         let specular = l.specular * power;
         (base * (l.ambient + l.diffuse * n_dot_l) + Vec3::splat(specular)).min(Vec3::ONE)
+    }
+}
+
+/// `x`ⁿ by repeated squaring, inline (`powi` is a library call per hit), in the order of
+/// compiler-rt's `__powisf2`, so it gives what `powi` gave.
+#[inline]
+fn power_by_squaring(mut x: f32, mut n: u32) -> f32 {
+    let mut r = 1.0;
+    loop {
+        if n & 1 == 1 {
+            r *= x;
+        }
+        n /= 2;
+        if n == 0 {
+            return r;
+        }
+        x *= x;
     }
 }
 
@@ -379,6 +398,19 @@ mod tests {
             shader.shade(Vec3::ONE, Vec3::ZERO, Vec3::Z),
             Vec3::splat(0.25)
         );
+    }
+
+    #[test]
+    fn power_by_squaring_is_powi() {
+        for n in 0..70 {
+            for k in 0..=100 {
+                let x = k as f32 / 100.0;
+                assert_eq!(
+                    power_by_squaring(x, n).to_bits(),
+                    x.powi(n as i32).to_bits()
+                );
+            }
+        }
     }
 
     #[test]

@@ -95,7 +95,9 @@ impl BrickDda {
             bricks,
         };
         for axis in 0..3 {
-            let cell = (start[axis].floor() as i32).clamp(0, bricks[axis] - 1);
+            // Truncation instead of `floor` (a library call on baseline x86-64): the two differ
+            // only below 0, which the clamp maps to brick 0 either way.
+            let cell = (start[axis] as i32).clamp(0, bricks[axis] - 1);
             dda.cell[axis] = cell;
             let (o, d) = (ray.origin[axis], ray.direction[axis]);
             if d > 0.0 {
