@@ -3,7 +3,7 @@
 //! Sample `n` sits at `t_n = t_start + (n + offset) · Δt` whatever is skipped, so an image is the
 //! same with and without empty-space skipping: a skipped brick holds only samples that would
 //! have contributed nothing. For isosurfaces a crossing lies *between* two samples, so a walk
-//! may ask for padded runs: one extra sample before and after every active brick's samples,
+//! may ask for padded runs: one extra sample before and after each run of active bricks,
 //! which puts both samples around any crossing inside an active brick into one run.
 
 use super::sample::{Lanes, SampleGrid, Sampler};
