@@ -187,20 +187,11 @@ impl RayMarch {
                     value,
                     fresh: batch.fresh && i == 0,
                 };
-                match visit(sample) {
-                    Flow::Continue => {}
-                    Flow::Stop => {
-                        return Some(Stopped {
-                            taken: i + 1,
-                            next: n + 1,
-                        })
-                    }
-                    Flow::StopBefore => {
-                        return Some(Stopped {
-                            taken: i + 1,
-                            next: n,
-                        })
-                    }
+                let flow = visit(sample);
+                if flow != Flow::Continue {
+                    // `StopBefore` hands this sample to the next walk.
+                    let next = if flow == Flow::StopBefore { n } else { n + 1 };
+                    return Some(Stopped { taken: i + 1, next });
                 }
             }
             None
@@ -243,11 +234,11 @@ impl RayMarch {
             let grid = self.grid;
             let fetch = |n: i32, last: i32| sampler.grid8(&grid, n, (last - n).min(8) as usize);
             let mut values = fetch(first, run.last);
+            // Samples a run must reach past a batch's start: enough to know the batch and
+            // whether another follows; a long walk's next batch, fetched ahead, needs all of it.
+            let reach = if long { 16 } else { 9 };
             let mut batch = first;
             loop {
-                // Enough to know this batch and whether another follows; a long walk's next
-                // batch, fetched ahead, needs all of it.
-                let reach = if long { 16 } else { 9 };
                 self.grow(&mut run, batch + reach, pad, &mut active);
                 let last = run.last;
                 let count = (last - batch).min(8) as usize;
@@ -341,7 +332,7 @@ impl RayMarch {
 /// The samples a walk takes in one go: one active brick, or for a joining walk the active
 /// bricks that follow each other.
 struct Run {
-    /// The bricks' extent along the ray (the last brick's index).
+    /// The bricks' extent along the ray; `brick` is the first brick's index.
     segment: Segment,
     /// One past the run's last sample index.
     last: i32,

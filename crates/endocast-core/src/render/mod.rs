@@ -231,9 +231,13 @@ impl Prepared<'_> {
             eye_side: None,
         };
         // Every ray starting at the eye (t = 0) shares its crossing side: decided once.
-        let eye = VoxelRay::new(&self.voxel_from_world, camera.eye_mm(), DVec3::Z).origin;
-        let rising = integrator.rising_at(eye.as_vec3(), self.params.lower.iso);
-        integrator.eye_side = Some((eye.as_vec3(), rising));
+        // (The origin every ray's `VoxelRay::new` computes, in the sample grid's f32.)
+        let eye = self
+            .voxel_from_world
+            .transform_point3(camera.eye_mm())
+            .as_vec3();
+        let rising = integrator.rising_at(eye, self.params.lower.iso);
+        integrator.eye_side = Some((eye, rising));
         integrator
     }
 
