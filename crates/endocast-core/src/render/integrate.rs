@@ -184,15 +184,15 @@ impl Integrator<'_> {
 
     /// The first crossing of `iso` in iso-active bricks, refined; the march is left so that the
     /// next walk starts with the first sample past the crossing.
-    fn first_hit(&self, march: &mut RayMarch, iso: f32, probe: &mut impl Probe) -> Option<Hit> {
+    fn first_hit<P: Probe>(&self, march: &mut RayMarch, iso: f32, probe: &mut P) -> Option<Hit> {
         let rising = self.rising(march, iso);
+        let active = |b| self.iso_active(b);
+        let grid = march.grid();
+        // The sample before the one under test, and the bracket once a crossing is found.
         let mut previous = (0.0f32, 0.0f32);
         let mut hit = None;
-        march.walk(
-            &self.sampler,
-            Walk::SEARCH,
-            |b| self.iso_active(b),
-            |s: Sample| {
+        if P::TRACES {
+            march.walk(&self.sampler, Walk::SEARCH, active, |s: Sample| {
                 probe.sample(s.t, s.value, 0.0);
                 if !s.fresh && crosses(previous.1, s.value, iso, rising) {
                     hit = Some(previous);
@@ -201,10 +201,31 @@ impl Integrator<'_> {
                 }
                 previous = (s.t, s.value);
                 Flow::Continue
-            },
-        );
+            });
+        } else {
+            march.walk_batches(&self.sampler, Walk::SEARCH, active, |batch| {
+                let Some(k) = first_crossing(&batch, previous.1, iso, rising) else {
+                    previous.1 = batch.values[batch.count - 1];
+                    return None;
+                };
+                let n = batch.first + k as i32;
+                let before = if k == 0 {
+                    previous.1
+                } else {
+                    batch.values[k - 1]
+                };
+                hit = Some((grid.t_of(n - 1), before));
+                previous = (grid.t_of(n), batch.values[k]);
+                // As the one-by-one walk's `StopBefore`: the sample after the crossing is
+                // counted and the next walk starts with it.
+                Some(Stopped {
+                    taken: k + 1,
+                    next: n,
+                })
+            });
+        }
         let before = hit?;
-        let t = self.refine(march.grid(), iso, rising, before, previous);
+        let t = self.refine(grid, iso, rising, before, previous);
         Some(Hit { t })
     }
 
@@ -485,6 +506,23 @@ fn bisect(
             node += 1;
         }
     }
+}
+
+/// The first lane of `batch` whose value crossed `iso` (in the given direction) since the
+/// sample before it: the previous lane, or `previous` (the walk's last sample) for lane 0 unless
+/// the batch starts fresh. All lanes are tested at once, branch-free.
+#[inline(always)]
+fn first_crossing(batch: &Batch, previous: f32, iso: f32, rising: bool) -> Option<usize> {
+    let v = &batch.values;
+    let mut mask = 0u32;
+    for k in 0..8 {
+        let before = if k == 0 { previous } else { v[k - 1] };
+        mask |= u32::from(crosses(before, v[k], iso, rising)) << k;
+    }
+    // Lanes past `count` hold no samples; lane 0 has nothing before it when fresh.
+    mask &= (1u32 << batch.count) - 1;
+    mask &= !u32::from(batch.fresh);
+    (mask != 0).then(|| mask.trailing_zeros() as usize)
 }
 
 /// Whether the value goes from `before` to `after` across `iso` in the given direction.
