@@ -493,7 +493,7 @@ fn bisect(
             0.0,
         ]
     } else {
-        sampler.points8(&t.map(|t| line.at(t)))
+        sampler.along8(&line, &t)
     };
     let mut node = 1;
     for _ in 0..levels {

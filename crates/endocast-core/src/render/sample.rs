@@ -107,16 +107,28 @@ impl<'a> Sampler<'a> {
         out
     }
 
-    /// The values at eight positions.
+    /// The values at eight positions given as their x, y and z lanes.
     #[inline]
     #[allow(unsafe_code)]
-    pub fn points8(&self, points: &[Vec3; 8]) -> Lanes {
+    pub fn points8(&self, [x, y, z]: &[Lanes; 3]) -> Lanes {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: as in `grid8`.
-            return unsafe { avx2::points8(self, points) };
+            return unsafe { avx2::points8(self, [x, y, z]) };
         }
-        points.map(|p| self.value(p))
+        std::array::from_fn(|k| self.value(Vec3::new(x[k], y[k], z[k])))
+    }
+
+    /// The values at `line.at(t[k])` for the eight distances `t`.
+    #[inline]
+    #[allow(unsafe_code)]
+    pub fn along8(&self, line: &SampleGrid, t: &Lanes) -> Lanes {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: as in `grid8`.
+            return unsafe { avx2::along8(self, line, t) };
+        }
+        t.map(|t| self.value(line.at(t)))
     }
 
     /// The trilinearly interpolated stored value at voxel position `p`.
@@ -163,16 +175,16 @@ impl<'a> Sampler<'a> {
     /// voxel, in voxel index space (the six samples as one batch).
     #[inline]
     pub fn gradient(&self, p: Vec3) -> Vec3 {
-        let [xp, xm, yp, ym, zp, zm, _, _] = self.points8(&[
-            p + Vec3::X,
-            p - Vec3::X,
-            p + Vec3::Y,
-            p - Vec3::Y,
-            p + Vec3::Z,
-            p - Vec3::Z,
-            p,
-            p,
-        ]);
+        // Lanes: +x, −x, +y, −y, +z, −z (and two unused); `p ± 1` along one axis, `p` along the
+        // others.
+        let plus_minus = |a: f32, lane: usize| {
+            let mut lanes = [a; 8];
+            lanes[lane] = a + 1.0;
+            lanes[lane + 1] = a - 1.0;
+            lanes
+        };
+        let [xp, xm, yp, ym, zp, zm, _, _] =
+            self.points8(&[plus_minus(p.x, 0), plus_minus(p.y, 2), plus_minus(p.z, 4)]);
         Vec3::new(xp - xm, yp - ym, zp - zm) * 0.5
     }
 }
@@ -376,10 +388,13 @@ mod tests {
                 assert_eq!(lanes.to_vec(), expected, "{grid:?} {n}");
                 assert_eq!(scalar.grid8(&grid, n, 8).to_vec(), expected);
             }
-            let points: [Vec3; 8] = std::array::from_fn(|i| grid.at(grid.t_of(i as i32 * 7)));
-            assert_eq!(wide.points8(&points), points.map(|p| scalar.value(p)));
+            let t: Lanes = std::array::from_fn(|i| grid.t_of(i as i32 * 7));
+            let expected = t.map(|t| scalar.value(grid.at(t)));
+            assert_eq!(wide.along8(&grid, &t), expected);
+            assert_eq!(scalar.along8(&grid, &t), expected);
         }
-        assert_eq!(wide.points8(&[Vec3::NAN; 8]), [scalar.value(Vec3::NAN); 8]);
+        let nan = [[f32::NAN; 8]; 3];
+        assert_eq!(wide.points8(&nan), [scalar.value(Vec3::NAN); 8]);
     }
 
     #[test]

@@ -5,12 +5,11 @@
 //! multiply-add — so the lanes equal the scalar values bit for bit.
 
 use super::{Lanes, SampleGrid, Sampler};
-use glam::Vec3;
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_cvtepi32_ps,
-    _mm256_cvttps_epi32, _mm256_i32gather_epi32, _mm256_max_ps, _mm256_min_epi32, _mm256_min_ps,
-    _mm256_mul_ps, _mm256_mullo_epi32, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32,
-    _mm256_setr_ps, _mm256_setzero_ps, _mm256_srli_epi32, _mm256_storeu_ps, _mm256_sub_ps,
+    _mm256_cvttps_epi32, _mm256_i32gather_epi32, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_epi32,
+    _mm256_min_ps, _mm256_mul_ps, _mm256_mullo_epi32, _mm256_set1_epi32, _mm256_set1_ps,
+    _mm256_setr_epi32, _mm256_setzero_ps, _mm256_srli_epi32, _mm256_storeu_ps, _mm256_sub_ps,
 };
 
 /// Samples `n .. n + 8` of `grid`.
@@ -26,21 +25,34 @@ pub(super) fn grid8(sampler: &Sampler<'_>, grid: &SampleGrid, n: i32) -> Lanes {
         _mm256_set1_ps(grid.t_start),
         _mm256_mul_ps(grid_steps, _mm256_set1_ps(grid.step)),
     );
-    let x = along(grid.origin.x, grid.direction.x, t);
-    let y = along(grid.origin.y, grid.direction.y, t);
-    let z = along(grid.origin.z, grid.direction.z, t);
+    at_distances(sampler, grid, t)
+}
+
+/// The values at `line.at(t[k])`.
+#[target_feature(enable = "avx2")]
+#[allow(unsafe_code)]
+pub(super) fn along8(sampler: &Sampler<'_>, line: &SampleGrid, t: &Lanes) -> Lanes {
+    // SAFETY: `t` holds exactly eight f32; unaligned loads are allowed.
+    at_distances(sampler, line, unsafe { _mm256_loadu_ps(t.as_ptr()) })
+}
+
+/// The values at `line.at(t)` per lane.
+#[target_feature(enable = "avx2")]
+#[inline]
+fn at_distances(sampler: &Sampler<'_>, line: &SampleGrid, t: __m256) -> Lanes {
+    let x = along(line.origin.x, line.direction.x, t);
+    let y = along(line.origin.y, line.direction.y, t);
+    let z = along(line.origin.z, line.direction.z, t);
     store(trilinear(sampler, x, y, z))
 }
 
-/// The values at eight positions.
+/// The values at eight positions given as their x, y and z lanes.
 #[target_feature(enable = "avx2")]
-pub(super) fn points8(sampler: &Sampler<'_>, p: &[Vec3; 8]) -> Lanes {
-    let axis = |a: usize| {
-        _mm256_setr_ps(
-            p[0][a], p[1][a], p[2][a], p[3][a], p[4][a], p[5][a], p[6][a], p[7][a],
-        )
-    };
-    store(trilinear(sampler, axis(0), axis(1), axis(2)))
+#[allow(unsafe_code)]
+pub(super) fn points8(sampler: &Sampler<'_>, [x, y, z]: [&Lanes; 3]) -> Lanes {
+    // SAFETY: each array holds exactly eight f32; unaligned loads are allowed.
+    let load = |lanes: &Lanes| unsafe { _mm256_loadu_ps(lanes.as_ptr()) };
+    store(trilinear(sampler, load(x), load(y), load(z)))
 }
 
 /// `origin + direction · t` per lane, as `SampleGrid::at`.
