@@ -8,7 +8,7 @@ use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
 use super::transfer::TfTable;
-use glam::{Vec3, Vec3A, Vec4};
+use glam::{Vec3, Vec3A};
 use std::cell::Cell;
 
 /// Receives every sample an integrator composites or tests (the `--debug-pixel` trace). `()`
@@ -332,13 +332,7 @@ impl Integrator<'_> {
     #[inline(always)]
     fn composite_batch(&self, acc: &mut Accum, batch: &Batch, stop: f32) -> Option<Stopped> {
         // Lanes past `count` composite a transparent black sample: exactly nothing.
-        let entries: [Vec4; 8] = std::array::from_fn(|k| {
-            if k < batch.count {
-                self.table.lookup(batch.values[k])
-            } else {
-                Vec4::ZERO
-            }
-        });
+        let entries = self.table.lookup8(&batch.values, batch.count);
         let mut whole = *acc;
         for entry in &entries {
             whole.under(Vec3A::from_vec4(*entry), entry.w);
