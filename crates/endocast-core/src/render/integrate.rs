@@ -331,10 +331,10 @@ impl Integrator<'_> {
     /// sample.
     #[inline(always)]
     fn composite_batch(&self, acc: &mut Accum, batch: &Batch, stop: f32) -> Option<Stopped> {
-        // Lanes past `count` composite a transparent black sample: exactly nothing.
-        let entries = self.table.lookup8(&batch.values, batch.count);
+        let entries = self.table.lookup8(&batch.values);
+        let entries = &entries[..batch.count];
         let mut whole = *acc;
-        for entry in &entries {
+        for entry in entries {
             whole.under(Vec3A::from_vec4(*entry), entry.w);
         }
         if whole.alpha() < stop {
@@ -342,7 +342,7 @@ impl Integrator<'_> {
             return None;
         }
         let mut taken = 0;
-        for entry in &entries[..batch.count] {
+        for entry in entries {
             acc.under(Vec3A::from_vec4(*entry), entry.w);
             taken += 1;
             if acc.alpha() >= stop {
