@@ -1,7 +1,7 @@
 //! The integrators: one small function per render mode, each a composition of the shared
-//! pieces — [`Integrator::first_hit`] (the isosurface search of §3.3), [`Integrator::surface`]
-//! (gradient, normal, Blinn-Phong), [`Integrator::composite`] (front-to-back DVR with early
-//! termination) — over a [`RayMarch`].
+//! pieces — [`Integrator::search`] and [`Integrator::refine`] (the isosurface hit of §3.3),
+//! [`Integrator::surface`] (gradient, normal, Blinn-Phong), [`Integrator::composite`]
+//! (front-to-back DVR with early termination) — over a [`RayMarch`].
 
 use super::bricks::{Activity, BrickGrid};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
@@ -80,10 +80,34 @@ impl Default for PixelOut {
     }
 }
 
-/// A refined isosurface hit.
+/// The samples `(t, value)` just before and just after an isosurface crossing, and its side.
 #[derive(Debug, Clone, Copy)]
-struct Hit {
-    t: f32,
+struct Bracket {
+    before: (f32, f32),
+    after: (f32, f32),
+    rising: bool,
+}
+
+/// One ray of a group rendered phase by phase ([`Integrator::run_group`]): its march, unit world
+/// direction and result, and what its phases hand on.
+#[derive(Debug, Clone)]
+pub(crate) struct RayTask {
+    pub march: RayMarch,
+    pub dir_world: Vec3,
+    pub out: PixelOut,
+    bracket: Option<Bracket>,
+}
+
+impl RayTask {
+    /// A ray not yet rendered.
+    pub fn new(march: RayMarch, dir_world: Vec3) -> Self {
+        Self {
+            march,
+            dir_world,
+            out: PixelOut::default(),
+            bracket: None,
+        }
+    }
 }
 
 /// The per-frame context of the integrators.
@@ -128,6 +152,43 @@ impl Integrator<'_> {
         !self.params.skip_empty || self.activity.tf.get(b as usize)
     }
 
+    /// Renders a group of rays, each as [`Self::run`] would. Iso and hybrid go phase by phase
+    /// (every ray's search, then every refinement, then every shading, then the volume behind):
+    /// each ray's phases are a chain of dependent steps, while the rays are independent, so
+    /// taking one phase across the group lets the CPU overlap their chains.
+    pub fn run_group(&self, tasks: &mut [RayTask]) {
+        let volume_behind = match self.params.mode {
+            Mode::Iso => false,
+            Mode::Hybrid => true,
+            _ => {
+                for task in tasks {
+                    task.out = self.run(&mut task.march, task.dir_world, &mut ());
+                }
+                return;
+            }
+        };
+        let surface = self.params.lower;
+        for task in tasks.iter_mut() {
+            task.bracket = self.search(&mut task.march, surface.iso, &mut ());
+        }
+        for task in tasks.iter_mut() {
+            if let Some(bracket) = task.bracket {
+                task.out.depth_mm = self.refine(task.march.grid(), surface.iso, bracket);
+            }
+        }
+        for task in tasks.iter_mut() {
+            if task.bracket.is_some() {
+                self.lit_surface(&task.march, task.dir_world, &mut task.out);
+            }
+        }
+        if volume_behind {
+            for task in tasks.iter_mut().filter(|task| task.bracket.is_some()) {
+                let out = &mut task.out;
+                self.composite(&mut task.march, out, task.dir_world, false, &mut ());
+            }
+        }
+    }
+
     /// Iso and hybrid: the first hit, the shaded surface weighted by its opacity, then (hybrid)
     /// unshaded DVR behind it from that opacity on (§3.3).
     fn iso(
@@ -138,17 +199,23 @@ impl Integrator<'_> {
         volume_behind: bool,
     ) -> PixelOut {
         let mut out = PixelOut::default();
-        let surface = self.params.lower;
-        let Some(hit) = self.first_hit(march, surface.iso, probe) else {
+        let iso = self.params.lower.iso;
+        let Some(bracket) = self.search(march, iso, probe) else {
             return out;
         };
-        out.depth_mm = hit.t;
-        let lit = self.surface(march.grid().at(hit.t), surface.color, dir_world);
-        out.accum.under_surface(lit, surface.opacity);
+        out.depth_mm = self.refine(march.grid(), iso, bracket);
+        self.lit_surface(march, dir_world, &mut out);
         if volume_behind {
             self.composite(march, &mut out, dir_world, false, probe);
         }
         out
+    }
+
+    /// Composites the lower isosurface, shaded at the hit `out.depth_mm`, onto `out`.
+    fn lit_surface(&self, march: &RayMarch, dir_world: Vec3, out: &mut PixelOut) {
+        let surface = self.params.lower;
+        let lit = self.surface(march.grid().at(out.depth_mm), surface.color, dir_world);
+        out.accum.under_surface(lit, surface.opacity);
     }
 
     /// Whether the value rises through `iso` at the surface, for a ray starting at `march`. In
@@ -182,9 +249,9 @@ impl Integrator<'_> {
         }
     }
 
-    /// The first crossing of `iso` in iso-active bricks, refined; the march is left so that the
-    /// next walk starts with the first sample past the crossing.
-    fn first_hit<P: Probe>(&self, march: &mut RayMarch, iso: f32, probe: &mut P) -> Option<Hit> {
+    /// The first crossing of `iso` in iso-active bricks; the march is left so that the next walk
+    /// starts with the first sample past the crossing.
+    fn search<P: Probe>(&self, march: &mut RayMarch, iso: f32, probe: &mut P) -> Option<Bracket> {
         let rising = self.rising(march, iso);
         let active = |b| self.iso_active(b);
         let grid = march.grid();
@@ -224,22 +291,22 @@ impl Integrator<'_> {
                 })
             });
         }
-        let before = hit?;
-        let t = self.refine(grid, iso, rising, before, previous);
-        Some(Hit { t })
+        hit.map(|before| Bracket {
+            before,
+            after: previous,
+            rising,
+        })
     }
 
     /// Bisection of the bracket `(t, value)` before and after a crossing (the two samples the
     /// march took, so their values are not fetched again), then linear interpolation inside the
     /// final bracket (no refinement: the sample after the crossing).
-    fn refine(
-        &self,
-        line: SampleGrid,
-        iso: f32,
-        rising: bool,
-        mut before: (f32, f32),
-        mut after: (f32, f32),
-    ) -> f32 {
+    fn refine(&self, line: SampleGrid, iso: f32, bracket: Bracket) -> f32 {
+        let Bracket {
+            mut before,
+            mut after,
+            rising,
+        } = bracket;
         if self.params.refine_steps == 0 {
             return after.0;
         }
@@ -375,8 +442,12 @@ impl Integrator<'_> {
                     let mut hits = [lower, upper].map(|surface| {
                         let rising = previous.1 < surface.iso;
                         crosses(previous.1, s.value, surface.iso, rising).then(|| {
-                            let t =
-                                self.refine(line, surface.iso, rising, previous, (s.t, s.value));
+                            let bracket = Bracket {
+                                before: previous,
+                                after: (s.t, s.value),
+                                rising,
+                            };
+                            let t = self.refine(line, surface.iso, bracket);
                             (t, surface)
                         })
                     });

@@ -53,7 +53,7 @@ pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
 use frame::to_u8;
 use glam::{DAffine3, DVec3, Vec3};
-use integrate::{Integrator, Params, PixelOut, Probe, Surface};
+use integrate::{Integrator, Params, PixelOut, Probe, RayTask, Surface};
 use march::RayMarch;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -252,12 +252,25 @@ impl Prepared<'_> {
             .enumerate()
             .map(|(band, rows)| {
                 let mut stats = RenderStats::default();
+                // One tile row's rays, rendered as a group (pixels whose ray misses the volume
+                // keep the default).
+                let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
                 for x0 in (0..width).step_by(TILE) {
                     let x1 = (x0 + TILE).min(width);
                     for (dy, row) in rows.chunks_mut(width).enumerate() {
                         let y = band * TILE + dy;
-                        for (x, out) in (x0..x1).zip(&mut row[x0..x1]) {
-                            *out = self.pixel(&integrator, camera, x, y, &mut stats, &mut ());
+                        columns.clear();
+                        tasks.clear();
+                        for x in x0..x1 {
+                            if let Some(task) = self.task(camera, x, y) {
+                                columns.push(x);
+                                tasks.push(task);
+                            }
+                        }
+                        integrator.run_group(&mut tasks);
+                        for (&x, task) in columns.iter().zip(&tasks) {
+                            row[x] = task.out;
+                            count_ray(&mut stats, task);
                         }
                     }
                 }
@@ -327,22 +340,21 @@ impl Prepared<'_> {
         stats: &mut RenderStats,
         probe: &mut impl Probe,
     ) -> PixelOut {
-        let dir = camera.pixel_direction(x, y);
-        let (ray, range) = self.ray_along(camera, dir);
-        let Some(range) = range else {
+        let Some(mut task) = self.task(camera, x, y) else {
             return PixelOut::default();
         };
+        task.out = integrator.run(&mut task.march, task.dir_world, probe);
+        count_ray(stats, &task);
+        task.out
+    }
+
+    /// The ray of pixel `(x, y)` ready to render, or `None` where it misses the volume.
+    fn task(&self, camera: &Camera, x: usize, y: usize) -> Option<RayTask> {
+        let dir = camera.pixel_direction(x, y);
+        let (ray, range) = self.ray_along(camera, dir);
         let bricks = self.renderer.grid.bricks();
-        let mut march = RayMarch::new(&ray, range, bricks, self.step_mm as f32, self.offset(x, y));
-        let dir_world = dir.as_vec3();
-        let out = integrator.run(&mut march, dir_world, probe);
-        stats.rays += 1;
-        stats.samples += march.stats.samples;
-        stats.bricks_visited += march.stats.bricks_visited;
-        stats.bricks_skipped += march.stats.bricks_skipped;
-        stats.terminated_early += u64::from(out.terminated);
-        stats.iso_hits += u64::from(!out.depth_mm.is_nan());
-        out
+        let march = RayMarch::new(&ray, range?, bricks, self.step_mm as f32, self.offset(x, y));
+        Some(RayTask::new(march, dir.as_vec3()))
     }
 
     /// A composited pixel over the background, as 8-bit colour.
@@ -371,6 +383,17 @@ impl Prepared<'_> {
             stats,
         }
     }
+}
+
+/// Adds a rendered ray's counters to `stats`.
+fn count_ray(stats: &mut RenderStats, task: &RayTask) {
+    let (march, out) = (&task.march.stats, &task.out);
+    stats.rays += 1;
+    stats.samples += march.samples;
+    stats.bricks_visited += march.bricks_visited;
+    stats.bricks_skipped += march.bricks_skipped;
+    stats.terminated_early += u64::from(out.terminated);
+    stats.iso_hits += u64::from(!out.depth_mm.is_nan());
 }
 
 /// A deterministic value in [0, 1) per pixel (a 32-bit integer hash), the sample-grid offset
