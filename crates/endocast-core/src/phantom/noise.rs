@@ -38,7 +38,7 @@ fn gaussian_pair(seed: u64, pair: u64) -> (f64, f64) {
 #[cfg(test)]
 pub(crate) fn gaussian(seed: u64, index: u64) -> f64 {
     let (even, odd) = gaussian_pair(seed, index / 2);
-    if index % 2 == 0 {
+    if index.is_multiple_of(2) {
         even
     } else {
         odd
