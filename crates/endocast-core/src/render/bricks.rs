@@ -8,11 +8,11 @@ use crate::Volume;
 use rayon::prelude::*;
 
 /// Edge of a brick in voxels: the paper's 8³. 4³ was measured too (colon phantom 512×512×478,
-/// 60 frames of the benchmark path): the isosurface walk next to the wall takes half the
-/// samples, but long DVR rays take twice the brick steps, and on the paper's protocol 4³ lost
-/// (iso-only 7.0 vs 7.5 fps, hybrid 50 % complex TF 2.5 vs 1.7 s per frame). A 4³ level
-/// consulted only by the isosurface walk inside active bricks halved its samples but not its
-/// time (BENCHMARKS.md), so there is one level.
+/// 60 frames of the benchmark path; BENCHMARKS.md): with today's walks it is faster from the eye
+/// (iso 0.94×, DVR ramp 0.92×, complex 0.94×) but slower behind the wall, where every brick is
+/// active and 4³ only doubles the DDA steps (hybrid 50 % complex TF 1.06×). A 4³ level consulted
+/// only by the isosurface walk inside active bricks halved its samples but not its time, so
+/// there is one level.
 pub const BRICK_VOX: usize = 8;
 
 /// Minimum and maximum stored value per brick. Brick `b` along an axis covers the positions
