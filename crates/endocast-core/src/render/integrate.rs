@@ -172,10 +172,8 @@ impl Integrator<'_> {
             task.bracket = self.search(&mut task.march, surface.iso, &mut ());
         }
         self.refine_group(tasks, surface.iso);
-        for task in tasks.iter_mut() {
-            if task.bracket.is_some() {
-                self.lit_surface(&task.march, task.dir_world, &mut task.out);
-            }
+        for chunk in tasks.chunks_mut(8) {
+            self.lit_surfaces(chunk);
         }
         if volume_behind {
             for task in tasks.iter_mut().filter(|task| task.bracket.is_some()) {
@@ -205,6 +203,26 @@ impl Integrator<'_> {
             self.composite(march, &mut out, dir_world, false, probe);
         }
         out
+    }
+
+    /// [`Self::lit_surface`] for each ray of up to eight that hit, their gradients in batches
+    /// across the rays.
+    fn lit_surfaces(&self, tasks: &mut [RayTask]) {
+        let mut points = [Vec3::ZERO; 8];
+        for (point, task) in points.iter_mut().zip(tasks.iter()) {
+            if task.bracket.is_some() {
+                *point = task.march.grid().at(task.out.depth_mm);
+            }
+        }
+        let gradients = self.sampler.gradients8(&points);
+        let surface = self.params.lower;
+        for (gradient, task) in gradients.iter().zip(tasks.iter_mut()) {
+            if task.bracket.is_some() {
+                let normal = self.shader.normal(*gradient);
+                let lit = self.shader.shade(surface.color, normal, task.dir_world);
+                task.out.accum.under_surface(lit, surface.opacity);
+            }
+        }
     }
 
     /// Composites the lower isosurface, shaded at the hit `out.depth_mm`, onto `out`.

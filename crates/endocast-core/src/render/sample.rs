@@ -187,6 +187,26 @@ impl<'a> Sampler<'a> {
             self.points8(&[plus_minus(p.x, 0), plus_minus(p.y, 2), plus_minus(p.z, 4)]);
         Vec3::new(xp - xm, yp - ym, zp - zm) * 0.5
     }
+
+    /// [`Self::gradient`] at eight points: six batches, one per stencil offset, instead of one
+    /// batch (with two idle lanes) per point.
+    pub fn gradients8(&self, points: &[Vec3; 8]) -> [Vec3; 8] {
+        let at = |axis: usize, offset: f32| {
+            let mut lanes = [0.0; 3].map(|_| [0.0f32; 8]);
+            for (k, p) in points.iter().enumerate() {
+                let mut q = p.to_array();
+                q[axis] += offset;
+                (lanes[0][k], lanes[1][k], lanes[2][k]) = (q[0], q[1], q[2]);
+            }
+            self.points8(&lanes)
+        };
+        let difference = |axis: usize| {
+            let (plus, minus) = (at(axis, 1.0), at(axis, -1.0));
+            std::array::from_fn::<f32, 8, _>(|k| plus[k] - minus[k])
+        };
+        let [dx, dy, dz] = [0, 1, 2].map(difference);
+        std::array::from_fn(|k| Vec3::new(dx[k], dy[k], dz[k]) * 0.5)
+    }
 }
 
 /// Whether this CPU runs the AVX2 batches.
@@ -393,6 +413,14 @@ mod tests {
             assert_eq!(wide.along8(&grid, &t), expected);
             assert_eq!(scalar.along8(&grid, &t), expected);
         }
+        let points: [Vec3; 8] =
+            std::array::from_fn(|k| Vec3::new(k as f32 * 2.7, 5.5, 30.1 - k as f32));
+        let each = points.map(|p| wide.gradient(p).to_array().map(f32::to_bits));
+        assert_eq!(
+            wide.gradients8(&points)
+                .map(|g| g.to_array().map(f32::to_bits)),
+            each
+        );
         let nan = [[f32::NAN; 8]; 3];
         assert_eq!(wide.points8(&nan), [scalar.value(Vec3::NAN); 8]);
     }
