@@ -218,8 +218,7 @@ impl Integrator<'_> {
         let surface = self.params.lower;
         for (gradient, task) in gradients.iter().zip(tasks.iter_mut()) {
             if task.bracket.is_some() {
-                let normal = self.shader.normal(*gradient);
-                let lit = self.shader.shade(surface.color, normal, task.dir_world);
+                let lit = self.shaded(*gradient, surface.color, task.dir_world);
                 task.out.accum.under_surface(lit, surface.opacity);
             }
         }
@@ -407,8 +406,14 @@ impl Integrator<'_> {
 
     /// The shaded colour of a surface of base colour `color` at voxel position `p`.
     fn surface(&self, p: Vec3, color: Vec3, dir_world: Vec3) -> Vec3 {
-        let normal = self.shader.normal(self.sampler.gradient(p));
-        self.shader.shade(color, normal, dir_world)
+        self.shaded(self.sampler.gradient(p), color, dir_world)
+    }
+
+    /// The shaded colour of a surface of base colour `color` whose voxel-space gradient is
+    /// `gradient`.
+    fn shaded(&self, gradient: Vec3, color: Vec3, dir_world: Vec3) -> Vec3 {
+        self.shader
+            .shade(color, self.shader.normal(gradient), dir_world)
     }
 
     /// Composites one DVR sample through the transfer function, shaded on request.

@@ -192,7 +192,7 @@ impl<'a> Sampler<'a> {
     /// batch (with two idle lanes) per point.
     pub fn gradients8(&self, points: &[Vec3; 8]) -> [Vec3; 8] {
         let at = |axis: usize, offset: f32| {
-            let mut lanes = [0.0; 3].map(|_| [0.0f32; 8]);
+            let mut lanes = [[0.0f32; 8]; 3];
             for (k, p) in points.iter().enumerate() {
                 let mut q = p.to_array();
                 q[axis] += offset;
