@@ -6,6 +6,9 @@ use glam::{DMat3, Mat3, Vec3, Vec3A, Vec4};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod bricked;
+
+pub use bricked::BrickedVoxels;
 
 /// A ray's fixed sample grid in voxel space: sample `n` lies `t_n = t_start + (n + offset) · step`
 /// mm from the eye, at voxel position `origin + direction · t_n` (`Copy`, so closures can read
@@ -61,6 +64,8 @@ pub struct Sampler<'a> {
     max_base: [i32; 3],
     /// Memory strides to the next voxel per axis; 0 along an axis of one voxel.
     stride: [usize; 3],
+    /// The voxels brick by brick, where the batches read them that way, and bricks per axis.
+    bricked: Option<(&'a [u16], [i32; 3])>,
     /// Whether batches run on AVX2 (the CPU has it, x has two voxels or more for the paired
     /// gathers, and every index fits the gathers' `i32`).
     avx2: bool,
@@ -79,7 +84,25 @@ impl<'a> Sampler<'a> {
             extent: Vec3::new((nx - 1) as f32, (ny - 1) as f32, (nz - 1) as f32),
             max_base,
             stride: [step(nx, 1), step(ny, nx), step(nz, nx * ny)],
+            bricked: None,
             avx2: nx >= 2 && i32::try_from(voxels.len()).is_ok() && avx2_available(),
+        }
+    }
+
+    /// A sampler whose batches read `bricked`, the same voxels brick by brick (bit-identical
+    /// values; the single samples read the volume).
+    /// Falls back to [`Self::new`] where `bricked` holds another shape or too many voxels for
+    /// the gathers' `i32` indices.
+    pub fn with_bricks(volume: &'a Volume, bricked: &'a BrickedVoxels) -> Self {
+        let plain = Self::new(volume);
+        if !bricked.fits(volume.dims()) || !avx2_available() {
+            return plain;
+        }
+        let bricks = bricked.bricks().map(|b| b as i32);
+        Self {
+            bricked: Some((bricked.voxels(), bricks)),
+            avx2: true,
+            ..plain
         }
     }
 
@@ -389,7 +412,25 @@ mod tests {
             ..Default::default()
         };
         let (volume, _) = phantom::sphere_shell(&options);
-        let (wide, scalar) = (Sampler::new(&volume), Sampler::new(&volume).scalar());
+        let bricked = BrickedVoxels::new(&volume);
+        let scalar = Sampler::new(&volume).scalar();
+        check_batches(Sampler::new(&volume), scalar);
+        check_batches(Sampler::with_bricks(&volume, &bricked), scalar);
+        // One voxel along x (no x-pairs in the linear layout) and partial bricks.
+        let thin = Volume::new(
+            Geometry::axis_aligned([1, 21, 35], DVec3::ONE, DVec3::ZERO).unwrap(),
+            (0..21 * 35).map(|n| (n * 7919 % 1013) as u16).collect(),
+            ValueMap::IDENTITY,
+            Modality::Unknown,
+        )
+        .unwrap();
+        let bricked = BrickedVoxels::new(&thin);
+        let scalar = Sampler::new(&thin).scalar();
+        check_batches(Sampler::with_bricks(&thin, &bricked), scalar);
+    }
+
+    /// Asserts that `wide`'s batches equal `scalar`'s single samples bit for bit.
+    fn check_batches(wide: Sampler<'_>, scalar: Sampler<'_>) {
         for k in 0..500u16 {
             let f = f32::from(k);
             // Rays from inside and outside the volume, some leaving it (clamped positions).

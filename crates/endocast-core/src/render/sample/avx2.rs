@@ -4,12 +4,14 @@
 //! operation for operation — clamp, truncate, the same lerps in the same order, no fused
 //! multiply-add — so the lanes equal the scalar values bit for bit.
 
+use super::bricked::{BRICK_LEN, EDGE, VOX};
 use super::{Lanes, SampleGrid, Sampler};
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_cvtepi32_ps,
     _mm256_cvttps_epi32, _mm256_i32gather_epi32, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_epi32,
     _mm256_min_ps, _mm256_mul_ps, _mm256_mullo_epi32, _mm256_set1_epi32, _mm256_set1_ps,
-    _mm256_setr_epi32, _mm256_setzero_ps, _mm256_srli_epi32, _mm256_storeu_ps, _mm256_sub_ps,
+    _mm256_setr_epi32, _mm256_setzero_ps, _mm256_slli_epi32, _mm256_srli_epi32, _mm256_storeu_ps,
+    _mm256_sub_ps,
 };
 
 /// Samples `n .. n + 8` of `grid`.
@@ -93,28 +95,66 @@ fn trilinear(s: &Sampler<'_>, x: __m256, y: __m256, z: __m256) -> __m256 {
     let (bx, fx) = cell(x, s.extent.x, s.max_base[0]);
     let (by, fy) = cell(y, s.extent.y, s.max_base[1]);
     let (bz, fz) = cell(z, s.extent.z, s.max_base[2]);
-    // `Sampler::new` enables this path only when every index fits an i32.
-    let [_, sy, sz] = s.stride.map(|stride| stride as i32);
-    let base = _mm256_add_epi32(
-        bx,
-        _mm256_add_epi32(
-            _mm256_mullo_epi32(by, _mm256_set1_epi32(sy)),
-            _mm256_mullo_epi32(bz, _mm256_set1_epi32(sz)),
-        ),
-    );
+    let (voxels, base, sy, sz) = match s.bricked {
+        Some((voxels, bricks)) => {
+            let (base, sy, sz) = bricked_base(bricks, bx, by, bz);
+            (voxels, base, sy, sz)
+        }
+        None => {
+            // `Sampler::new` enables this path only when every index fits an i32.
+            let [_, sy, sz] = s.stride.map(|stride| stride as i32);
+            let base = _mm256_add_epi32(
+                bx,
+                _mm256_add_epi32(
+                    _mm256_mullo_epi32(by, _mm256_set1_epi32(sy)),
+                    _mm256_mullo_epi32(bz, _mm256_set1_epi32(sz)),
+                ),
+            );
+            (s.voxels, base, sy, sz)
+        }
+    };
     let pair = |offset: i32| {
         let index = _mm256_add_epi32(base, _mm256_set1_epi32(offset));
-        // SAFETY: the base lies in [0, len − 1 − (1 + sy + sz)] (bx ≤ nx − 2, by ≤ ny − 2 or
-        // sy = 0, bz ≤ nz − 2 or sz = 0; x has two voxels or more, so the x stride is 1), so
-        // the four bytes at u16 index `base + offset` (offset ≤ sy + sz) are inside the slice.
-        // Gathers need no alignment.
-        let both = unsafe { _mm256_i32gather_epi32::<2>(s.voxels.as_ptr().cast::<i32>(), index) };
+        // SAFETY: linear: the base lies in [0, len − 1 − (1 + sy + sz)] (bx ≤ nx − 2, by ≤ ny − 2
+        // or sy = 0, bz ≤ nz − 2 or sz = 0; x has two voxels or more, so the x stride is 1);
+        // bricked: the cell's brick holds its whole footprint (local index + 1 + sy + sz <
+        // BRICK_LEN). Either way the four bytes at u16 index `base + offset` (offset ≤ sy + sz)
+        // are inside the slice. Gathers need no alignment.
+        let both = unsafe { _mm256_i32gather_epi32::<2>(voxels.as_ptr().cast::<i32>(), index) };
         let low = _mm256_cvtepi32_ps(_mm256_and_si256(both, _mm256_set1_epi32(0xFFFF)));
         let high = _mm256_cvtepi32_ps(_mm256_srli_epi32::<16>(both));
         lerp(low, high, fx)
     };
     let (c00, c10, c01, c11) = (pair(0), pair(sy), pair(sz), pair(sy + sz));
     lerp(lerp(c00, c10, fy), lerp(c01, c11, fy), fz)
+}
+
+/// The bricked index of cells with base `(bx, by, bz)` and the y and z strides inside a brick:
+/// the brick's offset as three independent products (not a chain of them), the cell's inside
+/// it by shifts.
+#[target_feature(enable = "avx2")]
+#[inline]
+fn bricked_base(bricks: [i32; 3], bx: __m256i, by: __m256i, bz: __m256i) -> (__m256i, i32, i32) {
+    const SHIFT: i32 = VOX.trailing_zeros() as i32;
+    let (edge, len) = (EDGE as i32, BRICK_LEN as i32);
+    let offset = |c: __m256i, stride: i32| {
+        _mm256_mullo_epi32(_mm256_srli_epi32::<SHIFT>(c), _mm256_set1_epi32(stride))
+    };
+    let brick = _mm256_add_epi32(
+        offset(bx, len),
+        _mm256_add_epi32(
+            offset(by, len * bricks[0]),
+            offset(bz, len * bricks[0] * bricks[1]),
+        ),
+    );
+    // EDGE = 2^SHIFT + 1: l · EDGE = (l << SHIFT) + l.
+    let local = |c: __m256i| _mm256_and_si256(c, _mm256_set1_epi32(VOX as i32 - 1));
+    let times_edge = |c: __m256i| _mm256_add_epi32(_mm256_slli_epi32::<SHIFT>(c), c);
+    let inside = _mm256_add_epi32(
+        local(bx),
+        times_edge(_mm256_add_epi32(local(by), times_edge(local(bz)))),
+    );
+    (_mm256_add_epi32(brick, inside), edge, edge * edge)
 }
 
 /// The lanes as an array.
