@@ -143,7 +143,7 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
             });
         }
     }
-    Ok((Renderer::new(volume), poses, cells))
+    Ok((Renderer::for_many_frames(volume), poses, cells))
 }
 
 /// A scan, the path the user gave, and the one setting the options describe.
@@ -158,7 +158,7 @@ fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, 
         name: format!("{} {}", volume.display(), settings.mode.name()),
         settings,
     };
-    Ok((Renderer::new(loaded.volume), poses, vec![cell]))
+    Ok((Renderer::for_many_frames(loaded.volume), poses, vec![cell]))
 }
 
 /// Reads a camera path file: a JSON list of {"eye", "look_at", "up"} (world mm, the format the

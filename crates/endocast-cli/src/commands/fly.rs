@@ -102,7 +102,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     } else {
         None
     };
-    let renderer = Renderer::new(loaded.volume);
+    let renderer = Renderer::for_many_frames(loaded.volume);
     let options = FlightOptions {
         size: args.size,
         fov_deg: args.fov,

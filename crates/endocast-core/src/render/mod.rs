@@ -2,9 +2,9 @@
 //! Rendering for Virtual Endoscopy Applications" (EuroVis 2006), on the CPU.
 //!
 //! Three objects with three lifetimes (as in Open VKL):
-//! - [`Renderer`]: the volume, its [`BrickGrid`] (min/max per brick of `BRICK_VOX`³ voxels) and
-//!   the copy of its voxels brick by brick that the sample batches read ([`BrickedVoxels`]),
-//!   built once;
+//! - [`Renderer`]: the volume, its [`BrickGrid`] (min/max per brick of `BRICK_VOX`³ voxels) and,
+//!   for many frames, a copy of its voxels brick by brick for the sample batches
+//!   ([`BrickedVoxels`]), built once;
 //! - [`Prepared`]: what the settings imply — the transfer function's [`TfTable`] and the
 //!   brick [`Activity`] — rebuilt in milliseconds whenever an isovalue or the TF changes;
 //! - [`Camera`]: one per frame.
@@ -66,25 +66,34 @@ use crate::Volume;
 /// Edge of the square pixel tiles rendered as one task.
 const TILE: usize = 16;
 
-/// A volume ready for rendering: the volume, its brick grid and its bricked voxels (built
-/// once; the bricked copy takes 1.2× the volume's memory).
+/// A volume ready for rendering: the volume and its brick grid (built once), and for sessions
+/// of many frames its voxels brick by brick.
 #[derive(Debug, Clone)]
 pub struct Renderer {
     volume: Volume,
     grid: BrickGrid,
-    bricked: BrickedVoxels,
+    bricked: Option<BrickedVoxels>,
 }
 
 impl Renderer {
-    /// Builds the brick grid and the bricked voxels of `volume` (two parallel passes over the
-    /// voxels).
+    /// Builds the brick grid of `volume` (one parallel pass over the voxels).
     pub fn new(volume: Volume) -> Self {
         let grid = BrickGrid::new(&volume);
-        let bricked = BrickedVoxels::new(&volume);
         Self {
             volume,
             grid,
-            bricked,
+            bricked: None,
+        }
+    }
+
+    /// [`Self::new`], plus a copy of the voxels brick by brick for the sample batches (1.2× the
+    /// volume's memory, a parallel copy): a few per cent faster frames, for sessions that render
+    /// many (fly-throughs, benchmarks) rather than one.
+    pub fn for_many_frames(volume: Volume) -> Self {
+        let bricked = BrickedVoxels::new(&volume);
+        Self {
+            bricked: Some(bricked),
+            ..Self::new(volume)
         }
     }
 
@@ -232,7 +241,10 @@ impl Prepared<'_> {
     /// The integrators for frames of `camera`.
     fn integrator(&self, camera: &Camera) -> Integrator<'_> {
         let mut integrator = Integrator {
-            sampler: Sampler::with_bricks(&self.renderer.volume, &self.renderer.bricked),
+            sampler: match &self.renderer.bricked {
+                Some(bricked) => Sampler::with_bricks(&self.renderer.volume, bricked),
+                None => Sampler::new(&self.renderer.volume),
+            },
             grid: &self.renderer.grid,
             activity: &self.activity,
             table: &self.table,

@@ -251,6 +251,24 @@ fn skipping_gives_the_same_image_with_several_times_fewer_samples() {
 }
 
 #[test]
+fn bricked_voxels_give_the_same_image() {
+    let (renderer, camera) = colon_view(100, 0.6, 40);
+    let bricked = Renderer::for_many_frames(renderer.volume().clone());
+    for mode in [Mode::Iso, Mode::Hybrid, Mode::Dvr, Mode::TwoIso, Mode::Mip] {
+        let s = RenderSettings {
+            mode,
+            iso_opacity: 0.5,
+            tf: TransferFunction::preset("complex").unwrap(),
+            ..Default::default()
+        };
+        let plain = renderer.prepare(&s).unwrap().render(&camera);
+        let other = bricked.prepare(&s).unwrap().render(&camera);
+        assert_same_image(&plain, &other, mode.name());
+        assert!(plain.stats.samples > 0, "{}", mode.name());
+    }
+}
+
+#[test]
 fn skipping_takes_several_times_fewer_samples_inside_a_cavity() {
     let (volume, shell) = phantom::sphere_shell(&options(128));
     let renderer = Renderer::new(volume);

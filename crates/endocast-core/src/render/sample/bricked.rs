@@ -42,10 +42,12 @@ impl BrickedVoxels {
                     b / (bricks[0] * bricks[1]),
                 ];
                 let at = |axis: usize, l: usize| (index[axis] * VOX + l).min(dims[axis] - 1);
-                for z in 0..EDGE {
-                    for y in 0..EDGE {
-                        let row = dims[0] * (at(1, y) + dims[1] * at(2, z));
-                        let out = &mut brick[EDGE * (y + EDGE * z)..][..EDGE];
+                let x0 = index[0] * VOX;
+                for (yz, out) in brick.chunks_exact_mut(EDGE).enumerate() {
+                    let row = dims[0] * (at(1, yz % EDGE) + dims[1] * at(2, yz / EDGE));
+                    if x0 + EDGE <= dims[0] {
+                        out.copy_from_slice(&source[row + x0..][..EDGE]);
+                    } else {
                         for (x, v) in out.iter_mut().enumerate() {
                             *v = source[row + at(0, x)];
                         }
