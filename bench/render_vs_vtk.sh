@@ -6,7 +6,8 @@
 #
 # Usage (repository root, ../shared/peers beside it, VTK from ../shared/peers/install_vtk.sh):
 #   bench/render_vs_vtk.sh [FRAMES]
-# Prints endocast's table (paper protocol + the DVR runs on the peer's path), then the peer's.
+# Prints endocast's table (paper protocol + the DVR runs on the peer's path), then the peer's,
+# then endocast's peer-path runs again and the ratios against both (bench/ratio_table.py).
 set -euo pipefail
 frames=${1:-60}
 out=${OUT:-bench/out}
@@ -22,11 +23,21 @@ rm -f "$out/endocast.jsonl"
 
 echo "== endocast: the paper's protocol (Tables 1 and 2) on the colon phantom"
 $bin bench --size 512 --frames "$frames" --json "$out/endocast.jsonl"
+# peer_runs FILE: endocast's runs on the peer's path and transfer functions, appended to FILE.
+peer_runs() {
+  for tf in ramp complex; do
+    $bin bench "$nii" --path "$path" --mode dvr --tf "bench/tf/colon_$tf.json" --json "$1"
+  done
+  $bin bench "$nii" --path "$path" --mode iso --iso -500 --json "$1"
+  $bin bench "$nii" --path "$path" --mode mip --json "$1"
+}
 echo "== endocast: the peer's runs, same path and transfer functions"
-for tf in ramp complex; do
-  $bin bench "$nii" --path "$path" --mode dvr --tf "bench/tf/colon_$tf.json" --json "$out/endocast.jsonl"
-done
-$bin bench "$nii" --path "$path" --mode iso --iso -500 --json "$out/endocast.jsonl"
-$bin bench "$nii" --path "$path" --mode mip --json "$out/endocast.jsonl"
+peer_runs "$out/endocast.jsonl"
 echo "== VTK fixed-point CPU ray caster, same frames"
 bash bench/vtk_peer.sh "$frames"
+# The host's speed drifts over minutes: endocast again after the peer, the ratio against both.
+echo "== endocast: the peer's runs again, after the peer"
+rm -f "$out/endocast_after.jsonl"
+peer_runs "$out/endocast_after.jsonl"
+echo "== VTK ÷ endocast on the same frames (endocast measured before and after VTK)"
+python3 bench/ratio_table.py "$out/endocast.jsonl" "$out/endocast_after.jsonl" "$out/vtk_peer.jsonl"

@@ -521,31 +521,11 @@ impl Integrator<'_> {
             Walk::COMPOSITE_CROSSINGS,
             |b| self.iso_active(b) || self.tf_active(b),
             |s: Sample| {
-                if !s.fresh {
-                    let mut hits = [lower, upper].map(|surface| {
-                        let rising = previous.1 < surface.iso;
-                        crosses(previous.1, s.value, surface.iso, rising).then(|| {
-                            let bracket = Bracket {
-                                before: previous,
-                                after: (s.t, s.value),
-                                rising,
-                            };
-                            let t = self.refine(line, surface.iso, bracket);
-                            (t, surface)
-                        })
-                    });
-                    if let [Some(a), Some(b)] = &hits {
-                        if b.0 < a.0 {
-                            hits.swap(0, 1);
-                        }
-                    }
-                    for (t, surface) in hits.into_iter().flatten() {
-                        if depth.is_nan() {
-                            *depth = t;
-                        }
-                        let lit = self.surface(line.at(t), surface.color, dir_world);
-                        acc.under_surface(lit, surface.opacity);
-                    }
+                // The test every sample takes stays small; the rare crossing is handled aside.
+                let crossed = |iso: f32| (previous.1 < iso) != (s.value < iso);
+                if !s.fresh && (crossed(lower.iso) || crossed(upper.iso)) {
+                    let after = (s.t, s.value);
+                    self.add_crossed_surfaces(acc, depth, (line, dir_world), previous, after);
                 }
                 if s.value < lower.iso || s.value > upper.iso {
                     self.add_sample(acc, line, s, dir_world, self.params.shade_dvr);
@@ -557,6 +537,43 @@ impl Integrator<'_> {
         );
         out.terminated = terminated;
         out
+    }
+
+    /// Two-iso: the surfaces crossed between samples `before` and `after` (`(t, value)`),
+    /// refined and shaded, composited in depth order; the first one's depth into `depth`.
+    #[cold]
+    #[inline(never)]
+    fn add_crossed_surfaces(
+        &self,
+        acc: &mut Accum,
+        depth: &mut f32,
+        (line, dir_world): (SampleGrid, Vec3),
+        before: (f32, f32),
+        after: (f32, f32),
+    ) {
+        let mut hits = [self.params.lower, self.params.upper].map(|surface| {
+            let rising = before.1 < surface.iso;
+            crosses(before.1, after.1, surface.iso, rising).then(|| {
+                let bracket = Bracket {
+                    before,
+                    after,
+                    rising,
+                };
+                (self.refine(line, surface.iso, bracket), surface)
+            })
+        });
+        if let [Some(a), Some(b)] = &hits {
+            if b.0 < a.0 {
+                hits.swap(0, 1);
+            }
+        }
+        for (t, surface) in hits.into_iter().flatten() {
+            if depth.is_nan() {
+                *depth = t;
+            }
+            let lit = self.surface(line.at(t), surface.color, dir_world);
+            acc.under_surface(lit, surface.opacity);
+        }
     }
 
     /// MIP (`better = >`) or MinIP (`better = <`): the extreme sample; bricks whose range cannot
