@@ -87,12 +87,13 @@ impl Renderer {
     }
 
     /// [`Self::new`], plus a copy of the voxels brick by brick for the sample batches (1.2× the
-    /// volume's memory, a parallel copy): a few per cent faster frames, for sessions that render
-    /// many (fly-throughs, benchmarks) rather than one.
+    /// volume's memory, a parallel copy; none where the batches could not use it): a few per
+    /// cent faster frames, for sessions that render many (fly-throughs, benchmarks) rather
+    /// than one.
     pub fn for_many_frames(volume: Volume) -> Self {
         let bricked = BrickedVoxels::new(&volume);
         Self {
-            bricked: Some(bricked),
+            bricked,
             ..Self::new(volume)
         }
     }

@@ -27,11 +27,17 @@ pub struct BrickedVoxels {
 
 impl BrickedVoxels {
     /// Copies `volume`'s voxels into bricks (in parallel, brick slabs along z).
-    pub fn new(volume: &Volume) -> Self {
+    /// `None` where the batches could not read the copy — no AVX2 on this CPU, or more voxels
+    /// than their `i32` indices reach — so no memory goes to it.
+    pub fn new(volume: &Volume) -> Option<Self> {
         let dims = volume.dims();
         let bricks = bricks_for(dims);
+        let len = bricks[0] * bricks[1] * bricks[2] * BRICK_LEN;
+        if !super::avx2_available() || i32::try_from(len).is_err() {
+            return None;
+        }
         let source = volume.voxels();
-        let mut voxels = vec![0u16; bricks[0] * bricks[1] * bricks[2] * BRICK_LEN];
+        let mut voxels = vec![0u16; len];
         voxels
             .par_chunks_mut(BRICK_LEN)
             .enumerate()
@@ -54,7 +60,7 @@ impl BrickedVoxels {
                     }
                 }
             });
-        Self { bricks, voxels }
+        Some(Self { bricks, voxels })
     }
 
     /// Whether these are the bricks of a volume of `dims` voxels, each index of which fits the
