@@ -31,7 +31,7 @@ impl BrickGrid {
     /// Scans the volume once, slabs of bricks in parallel.
     pub fn new(volume: &Volume) -> Self {
         let dims = volume.dims();
-        let bricks = dims.map(bricks_along);
+        let bricks = dims.map(|n| bricks_along(n, BRICK_VOX));
         let voxels = volume.voxels();
         let slab = bricks[0] * bricks[1];
         let mut min = vec![0u16; slab * bricks[2]];
@@ -96,9 +96,9 @@ impl BrickGrid {
     }
 }
 
-/// Bricks needed along an axis of `n` voxels: positions run over `[0, n − 1]`.
-fn bricks_along(n: usize) -> usize {
-    (n.saturating_sub(1)).div_ceil(BRICK_VOX).max(1)
+/// Bricks of `edge` cells needed along an axis of `n` voxels: positions run over `[0, n − 1]`.
+pub(super) fn bricks_along(n: usize, edge: usize) -> usize {
+    (n.saturating_sub(1)).div_ceil(edge).max(1)
 }
 
 /// Min and max over voxels `8b ..= 8b + 8` (clamped to the grid) of brick `b`.

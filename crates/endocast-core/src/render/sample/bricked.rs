@@ -6,6 +6,7 @@
 //! layout's time, DVR complex TF 0.91–0.92; 8³ bricks (1.42× memory) gained less, 32³ about
 //! as much (iso 0.97, DVR 0.94), so 16³ at 1.2× memory.
 
+use super::super::bricks::bricks_along;
 use crate::Volume;
 use rayon::prelude::*;
 
@@ -26,14 +27,16 @@ pub struct BrickedVoxels {
 }
 
 impl BrickedVoxels {
-    /// Copies `volume`'s voxels into bricks (in parallel, brick slabs along z).
-    /// `None` where the batches could not read the copy — no AVX2 on this CPU, or more voxels
+    /// Copies `volume`'s voxels into bricks (bricks in parallel, rows by slices); `None` where the batches could not read the copy — no AVX2 on this CPU, or more voxels
     /// than their `i32` indices reach — so no memory goes to it.
     pub fn new(volume: &Volume) -> Option<Self> {
         let dims = volume.dims();
         let bricks = bricks_for(dims);
-        let len = bricks[0] * bricks[1] * bricks[2] * BRICK_LEN;
-        if !super::avx2_available() || i32::try_from(len).is_err() {
+        let len = bricks
+            .iter()
+            .try_fold(BRICK_LEN, |len, &b| len.checked_mul(b))
+            .filter(|&len| i32::try_from(len).is_ok())?;
+        if !super::avx2_available() {
             return None;
         }
         let source = volume.voxels();
@@ -80,7 +83,7 @@ impl BrickedVoxels {
     }
 }
 
-/// Bricks needed per axis for `dims` voxels (positions `[0, n − 1]`).
+/// Bricks needed per axis for `dims` voxels.
 fn bricks_for(dims: [usize; 3]) -> [usize; 3] {
-    dims.map(|n| n.saturating_sub(1).div_ceil(VOX).max(1))
+    dims.map(|n| bricks_along(n, VOX))
 }
