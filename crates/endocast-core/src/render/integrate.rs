@@ -5,7 +5,7 @@
 
 use super::bricks::{Activity, BrickGrid};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
-use super::sample::{Accum, SampleGrid, Sampler, Shader};
+use super::sample::{Accum, Lanes, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
 use super::transfer::TfTable;
 use glam::{Vec3, Vec3A};
@@ -675,19 +675,57 @@ fn bisect(
 
 /// The first lane of `batch` whose value crossed `iso` (in the given direction) since the
 /// sample before it: the previous lane, or `previous` (the walk's last sample) for lane 0 unless
-/// the batch starts fresh. All lanes are tested at once, branch-free.
+/// the batch starts fresh. All lanes are compared at once, branch-free, as [`crosses`] compares.
 #[inline(always)]
 fn first_crossing(batch: &Batch, previous: f32, iso: f32, rising: bool) -> Option<usize> {
-    let v = &batch.values;
-    let mut mask = 0u32;
-    for k in 0..8 {
-        let before = if k == 0 { previous } else { v[k - 1] };
-        mask |= u32::from(crosses(before, v[k], iso, rising)) << k;
-    }
+    let (below, above) = sides(&batch.values, iso);
+    // Bit k: the side of the sample before lane k.
+    let below_before = below << 1 | u32::from(previous < iso);
+    let above_before = above << 1 | u32::from(previous >= iso);
+    let mut mask = if rising {
+        below_before & above
+    } else {
+        above_before & below
+    };
     // Lanes past `count` hold no samples; lane 0 has nothing before it when fresh.
     mask &= (1u32 << batch.count) - 1;
     mask &= !u32::from(batch.fresh);
     (mask != 0).then(|| mask.trailing_zeros() as usize)
+}
+
+/// The lanes of `values` below `iso` and at or above it, as bit masks (lane k, bit k; ordered
+/// comparisons, so a NaN is in neither).
+#[inline(always)]
+fn sides(values: &Lanes, iso: f32) -> (u32, u32) {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    // SAFETY: SSE is part of the x86-64 baseline every build targets.
+    unsafe {
+        use std::arch::x86_64::{
+            __m128, _mm_cmpge_ps, _mm_cmplt_ps, _mm_movemask_ps, _mm_set1_ps, _mm_setr_ps,
+        };
+        let v = values;
+        let (low, high) = (
+            _mm_setr_ps(v[0], v[1], v[2], v[3]),
+            _mm_setr_ps(v[4], v[5], v[6], v[7]),
+        );
+        let iso = _mm_set1_ps(iso);
+        let bits =
+            |low: __m128, high: __m128| (_mm_movemask_ps(low) | _mm_movemask_ps(high) << 4) as u32;
+        (
+            bits(_mm_cmplt_ps(low, iso), _mm_cmplt_ps(high, iso)),
+            bits(_mm_cmpge_ps(low, iso), _mm_cmpge_ps(high, iso)),
+        )
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let (mut below, mut above) = (0u32, 0u32);
+        for (k, &v) in values.iter().enumerate() {
+            below |= u32::from(v < iso) << k;
+            above |= u32::from(v >= iso) << k;
+        }
+        (below, above)
+    }
 }
 
 /// Whether the value goes from `before` to `after` across `iso` in the given direction.
@@ -733,6 +771,34 @@ mod tests {
             }
         }
         (a, b)
+    }
+
+    #[test]
+    fn batch_crossing_test_equals_the_sample_by_sample_one() {
+        // Values on a coarse grid around the isovalue, so equalities and repeats are common.
+        let mut state = 12345u32;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 29) as f32 - 3.0
+        };
+        for round in 0..4000 {
+            let values: Lanes = std::array::from_fn(|_| next());
+            let previous = if round % 97 == 0 { f32::NAN } else { next() };
+            let batch = Batch {
+                first: 0,
+                values,
+                count: 1 + round % 8,
+                fresh: round % 5 == 0,
+            };
+            for rising in [true, false] {
+                let expected = (0..batch.count).find(|&k| {
+                    let before = if k == 0 { previous } else { values[k - 1] };
+                    !(k == 0 && batch.fresh) && crosses(before, values[k], 0.0, rising)
+                });
+                let found = first_crossing(&batch, previous, 0.0, rising);
+                assert_eq!(found, expected, "{values:?} {previous} {rising}");
+            }
+        }
     }
 
     #[test]
