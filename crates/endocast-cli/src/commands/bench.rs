@@ -10,7 +10,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
-use endocast_core::render::{Camera, Mode, RenderSettings, Renderer, TransferFunction};
+use endocast_core::render::{Camera, Frame, Mode, RenderSettings, Renderer, TransferFunction};
 use endocast_io::OpenOptions;
 use glam::DVec3;
 use serde_json::json;
@@ -90,8 +90,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 ms: Vec::with_capacity(cameras.len()),
                 samples: 0,
             };
+            let mut frame = Frame::default();
             for camera in &cameras {
-                let frame = prepared.render(camera);
+                prepared.render_into(camera, &mut frame);
                 m.ms.push(frame.stats.time.as_secs_f64() * 1e3);
                 m.samples += frame.stats.samples;
             }

@@ -35,8 +35,9 @@ impl RenderStats {
     }
 }
 
-/// A rendered frame: row 0 is the top; pixel `(x, y)` is at index `x + width · y`.
-#[derive(Debug, Clone, PartialEq)]
+/// A rendered frame: row 0 is the top; pixel `(x, y)` is at index `x + width · y`. The default
+/// is an empty 0×0 frame (to render into).
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Frame {
     /// Width in pixels.
     pub width: usize,

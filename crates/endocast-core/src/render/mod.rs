@@ -40,6 +40,7 @@ mod integrate;
 mod march;
 mod sample;
 mod settings;
+mod tiles;
 mod transfer;
 pub mod traverse;
 
@@ -57,14 +58,11 @@ use frame::to_u8;
 use glam::{DAffine3, DVec3, Vec3};
 use integrate::{Integrator, Params, PixelOut, Probe, RayTask, Surface};
 use march::RayMarch;
-use rayon::prelude::*;
 use std::time::Instant;
+use tiles::{Pixel, Tile, TileRect, Tiling, TILE};
 use traverse::VoxelRay;
 
 use crate::Volume;
-
-/// Edge of the square pixel tiles rendered as one task.
-const TILE: usize = 16;
 
 /// A volume ready for rendering: the volume and its brick grid (built once), and for sessions
 /// of many frames its voxels brick by brick.
@@ -266,46 +264,47 @@ impl Prepared<'_> {
 
     /// Renders one frame, tiles in parallel on the current rayon pool.
     pub fn render(&self, camera: &Camera) -> Frame {
-        let start = Instant::now();
-        let [width, height] = camera.size();
-        let integrator = self.integrator(camera);
-        let mut pixels = vec![PixelOut::default(); width * height];
-        let stats = pixels
-            .par_chunks_mut(width * TILE)
-            .enumerate()
-            .map(|(band, rows)| {
-                let mut stats = RenderStats::default();
-                // One tile row's rays, rendered as a group (pixels whose ray misses the volume
-                // keep the default).
-                let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
-                for x0 in (0..width).step_by(TILE) {
-                    let x1 = (x0 + TILE).min(width);
-                    for (dy, row) in rows.chunks_mut(width).enumerate() {
-                        let y = band * TILE + dy;
-                        columns.clear();
-                        tasks.clear();
-                        for x in x0..x1 {
-                            if let Some(task) = self.task(camera, x, y) {
-                                columns.push(x);
-                                tasks.push(task);
-                            }
-                        }
-                        integrator.run_group(&mut tasks);
-                        for (&x, task) in columns.iter().zip(&tasks) {
-                            row[x] = task.out;
-                            count_ray(&mut stats, task);
-                        }
-                    }
-                }
-                stats
-            })
-            .reduce(RenderStats::default, |mut a, b| {
-                a.add(&b);
-                a
-            });
-        let mut frame = self.finish(width, height, &pixels, stats);
-        frame.stats.time = start.elapsed();
+        let mut frame = Frame::default();
+        self.render_into(camera, &mut frame);
         frame
+    }
+
+    /// [`Self::render`] into `frame`, reusing its buffers (a loop over many frames of one size
+    /// then allocates none: fresh buffers cost about 2 ms a frame in page faults).
+    pub fn render_into(&self, camera: &Camera, frame: &mut Frame) {
+        let start = Instant::now();
+        let integrator = self.integrator(camera);
+        let tile = |rect| self.tile(&integrator, camera, rect);
+        Tiling::new(camera.size()).render_into(tile, frame);
+        frame.stats.time = start.elapsed();
+    }
+
+    /// Renders the pixels of `rect`, each row's rays as one group.
+    fn tile(&self, integrator: &Integrator<'_>, camera: &Camera, rect: TileRect) -> Tile {
+        let mut tile = Tile {
+            pixels: Vec::with_capacity((rect.x1 - rect.x0) * (rect.y1 - rect.y0)),
+            stats: RenderStats::default(),
+        };
+        let missed = self.pixel_of(&PixelOut::default());
+        let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
+        for y in rect.y0..rect.y1 {
+            columns.clear();
+            tasks.clear();
+            for x in rect.x0..rect.x1 {
+                if let Some(task) = self.task(camera, x, y) {
+                    columns.push(x);
+                    tasks.push(task);
+                }
+            }
+            integrator.run_group(&mut tasks);
+            let row = tile.pixels.len();
+            tile.pixels.resize(row + rect.x1 - rect.x0, missed);
+            for (&x, task) in columns.iter().zip(&tasks) {
+                tile.pixels[row + x - rect.x0] = self.pixel_of(&task.out);
+                count_ray(&mut tile.stats, task);
+            }
+        }
+        tile
     }
 
     /// Traces pixel `(x, y)` of `camera` and returns every sample (the `--debug-pixel` aid).
@@ -387,23 +386,14 @@ impl Prepared<'_> {
         [to_u8(c.x), to_u8(c.y), to_u8(c.z)]
     }
 
-    fn finish(
-        &self,
-        width: usize,
-        height: usize,
-        pixels: &[PixelOut],
-        stats: RenderStats,
-    ) -> Frame {
+    /// A ray's result as the frame stores it.
+    fn pixel_of(&self, out: &PixelOut) -> Pixel {
         let map = self.renderer.volume.value_map();
-        let physical = |v: f32| (f64::from(v) * map.scale() + map.offset()) as f32;
-        Frame {
-            width,
-            height,
-            rgb: pixels.iter().flat_map(|p| self.display(&p.accum)).collect(),
-            alpha: pixels.iter().map(|p| p.accum.alpha()).collect(),
-            depth_mm: pixels.iter().map(|p| p.depth_mm).collect(),
-            value: pixels.iter().map(|p| physical(p.value)).collect(),
-            stats,
+        Pixel {
+            rgb: self.display(&out.accum),
+            alpha: out.accum.alpha(),
+            depth_mm: out.depth_mm,
+            value: (f64::from(out.value) * map.scale() + map.offset()) as f32,
         }
     }
 }
