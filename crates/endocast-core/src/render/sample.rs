@@ -214,14 +214,17 @@ impl<'a> Sampler<'a> {
     /// [`Self::gradient`] at eight points: six batches, one per stencil offset, instead of one
     /// batch (with two idle lanes) per point.
     pub fn gradients8(&self, points: &[Vec3; 8]) -> [Vec3; 8] {
+        // The points as x, y and z lanes once; each stencil moves one axis's lanes.
+        let mut lanes = [[0.0f32; 8]; 3];
+        for (k, p) in points.iter().enumerate() {
+            (lanes[0][k], lanes[1][k], lanes[2][k]) = (p.x, p.y, p.z);
+        }
         let at = |axis: usize, offset: f32| {
-            let mut lanes = [[0.0f32; 8]; 3];
-            for (k, p) in points.iter().enumerate() {
-                let mut q = p.to_array();
-                q[axis] += offset;
-                (lanes[0][k], lanes[1][k], lanes[2][k]) = (q[0], q[1], q[2]);
+            let mut moved = lanes;
+            for v in &mut moved[axis] {
+                *v += offset;
             }
-            self.points8(&lanes)
+            self.points8(&moved)
         };
         let difference = |axis: usize| {
             let (plus, minus) = (at(axis, 1.0), at(axis, -1.0));
