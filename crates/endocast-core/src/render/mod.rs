@@ -35,6 +35,7 @@
 
 mod bricks;
 mod camera;
+mod crossing;
 mod frame;
 mod integrate;
 mod march;

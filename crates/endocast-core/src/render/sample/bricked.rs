@@ -27,8 +27,9 @@ pub struct BrickedVoxels {
 }
 
 impl BrickedVoxels {
-    /// Copies `volume`'s voxels into bricks (bricks in parallel, rows by slices); `None` where the batches could not read the copy — no AVX2 on this CPU, or more voxels
-    /// than their `i32` indices reach — so no memory goes to it.
+    /// Copies `volume`'s voxels into bricks (bricks in parallel, rows by slices); `None` where
+    /// the batches could not read the copy — no AVX2 on this CPU, or more voxels than their
+    /// `i32` indices reach — so no memory goes to it.
     pub fn new(volume: &Volume) -> Option<Self> {
         let dims = volume.dims();
         let bricks = bricks_for(dims);
