@@ -150,6 +150,11 @@ impl BitSet {
             .is_some_and(|w| w >> (index % 64) & 1 == 1)
     }
 
+    /// The bits, 64 to a word, bit `i` of word `w` standing for index `64 w + i`.
+    pub(crate) fn words(&self) -> &[u64] {
+        &self.words
+    }
+
     /// Number of set bits.
     pub fn count(&self) -> usize {
         self.words.iter().map(|w| w.count_ones() as usize).sum()

@@ -7,6 +7,8 @@
 use super::bricks::{Activity, BrickGrid};
 use super::crossing::{bisect, crosses, first_crossing, Bracket, BISECTION_LEVELS};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
+#[cfg(target_arch = "x86_64")]
+use super::packet;
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
 use super::transfer::TfTable;
@@ -158,9 +160,7 @@ impl Integrator<'_> {
             }
         };
         let surface = self.params.lower;
-        for task in tasks.iter_mut() {
-            task.bracket = self.search(&mut task.march, surface.iso, &mut ());
-        }
+        self.search_group(tasks, surface.iso);
         self.refine_group(tasks, surface.iso);
         for chunk in tasks.chunks_mut(8) {
             self.lit_surfaces(chunk);
@@ -170,6 +170,31 @@ impl Integrator<'_> {
                 let out = &mut task.out;
                 self.composite(&mut task.march, out, task.dir_world, false, &mut ());
             }
+        }
+    }
+
+    /// [`Self::search`] for each ray of a group, eight at once on AVX2 ([`packet::search8`]).
+    #[allow(unsafe_code)]
+    fn search_group(&self, tasks: &mut [RayTask], iso: f32) {
+        #[cfg(target_arch = "x86_64")]
+        if self.sampler.avx2() {
+            let active = self.params.skip_empty.then(|| self.activity.iso.words());
+            for chunk in tasks.chunks_mut(8) {
+                let mut rising = [false; 8];
+                for (r, task) in rising.iter_mut().zip(chunk.iter()) {
+                    *r = self.rising(&task.march, iso);
+                }
+                // SAFETY: the sampler runs AVX2 batches only where the CPU has AVX2.
+                let brackets =
+                    unsafe { packet::search8(&self.sampler, active, iso, chunk, rising) };
+                for (task, bracket) in chunk.iter_mut().zip(brackets) {
+                    task.bracket = bracket;
+                }
+            }
+            return;
+        }
+        for task in tasks.iter_mut() {
+            task.bracket = self.search(&mut task.march, iso, &mut ());
         }
     }
 
@@ -320,31 +345,15 @@ impl Integrator<'_> {
         self.hit_in(iso, before, after)
     }
 
-    /// [`Self::refine`] for every bracketed ray of a group, into its `out.depth_mm`: the same
-    /// rounds of bisection, but a round of one step (the last of four) takes one batch for the
-    /// midpoints of eight rays instead of one sample per ray.
+    /// [`Self::refine`] for every bracketed ray of a group, into its `out.depth_mm`: each step
+    /// takes one batch for the midpoints of eight rays (the rays' steps are independent, so
+    /// this is a quarter of the samples [`bisect`]'s tree of midpoints takes, with no longer a
+    /// chain of dependent samples per batch).
     fn refine_group(&self, tasks: &mut [RayTask], iso: f32) {
-        let mut left = self.params.refine_steps;
-        while left > 0 {
-            let levels = left.min(BISECTION_LEVELS);
-            if levels == 1 {
-                for chunk in tasks.chunks_mut(8) {
-                    self.bisect_across(chunk, iso);
-                }
-            } else {
-                for task in tasks.iter_mut() {
-                    if let Some(Bracket {
-                        before,
-                        after,
-                        rising,
-                    }) = &mut task.bracket
-                    {
-                        let line = task.march.grid();
-                        bisect(&self.sampler, line, (iso, *rising), levels, (before, after));
-                    }
-                }
+        for _ in 0..self.params.refine_steps {
+            for chunk in tasks.chunks_mut(8) {
+                self.bisect_across(chunk, iso);
             }
-            left -= levels;
         }
         for task in tasks.iter_mut() {
             if let Some(b) = task.bracket {

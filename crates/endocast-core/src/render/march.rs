@@ -167,6 +167,29 @@ impl RayMarch {
         self.grid
     }
 
+    /// The brick walk, the sample grid and one past the last sample index of a march not yet
+    /// walked, for a search run outside it ([`super::packet`]).
+    pub(crate) fn parts(&self) -> (&BrickDda, SampleGrid, i32) {
+        (&self.dda, self.grid, self.end)
+    }
+
+    /// Leaves the march as a search walk would have: its brick walk at `dda`, `next` the first
+    /// sample not yet taken (the one after a crossing, counted as taken), `pending` the brick to
+    /// resume in, and the counters of what was walked.
+    pub(crate) fn searched(
+        &mut self,
+        dda: BrickDda,
+        next: i32,
+        pending: Option<Segment>,
+        stats: MarchStats,
+    ) {
+        self.dda = dda;
+        self.next = next;
+        self.has_previous = stats.samples > 0;
+        self.pending = pending;
+        self.stats = stats;
+    }
+
     /// Samples, in order, the bricks for which `active(brick)` holds, handing each sample to
     /// `visit` until it stops the walk (returns true) or the ray ends (returns false), as
     /// `walk` says (see [`Walk`]).

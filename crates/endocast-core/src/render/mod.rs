@@ -39,6 +39,8 @@ mod crossing;
 mod frame;
 mod integrate;
 mod march;
+#[cfg(target_arch = "x86_64")]
+mod packet;
 mod sample;
 mod settings;
 mod tiles;

@@ -5,7 +5,7 @@ use crate::Volume;
 use glam::{DMat3, Mat3, Vec3, Vec3A, Vec4};
 
 #[cfg(target_arch = "x86_64")]
-mod avx2;
+pub(crate) mod avx2;
 mod bricked;
 
 pub use bricked::BrickedVoxels;
@@ -104,6 +104,11 @@ impl<'a> Sampler<'a> {
             avx2: true,
             ..plain
         }
+    }
+
+    /// Whether batches run on AVX2.
+    pub(crate) fn avx2(&self) -> bool {
+        self.avx2
     }
 
     /// The same sampler without the AVX2 batches (to compare both paths).

@@ -250,6 +250,50 @@ fn skipping_gives_the_same_image_with_several_times_fewer_samples() {
     }
 }
 
+/// Rays rendered a row at a time (the eight-ray search, bisection across rays, gradients in
+/// batches) give every pixel exactly what the one-ray path (the `--debug-pixel` trace) gives.
+#[test]
+fn grouped_rays_give_the_one_ray_pixels() {
+    let (renderer, camera) = colon_view(120, 0.45, 40);
+    let bricked = Renderer::for_many_frames(renderer.volume().clone());
+    for (mode, crossing, jitter, skip_empty) in [
+        (Mode::Iso, Crossing::Auto, false, true),
+        (Mode::Iso, Crossing::Falling, true, true),
+        (Mode::Iso, Crossing::Auto, true, false),
+        (Mode::Hybrid, Crossing::Auto, true, true),
+        (Mode::Hybrid, Crossing::Rising, false, false),
+    ] {
+        let s = RenderSettings {
+            mode,
+            crossing,
+            jitter,
+            skip_empty,
+            iso_opacity: 0.6,
+            tf: TransferFunction::preset("complex").unwrap(),
+            ..settings(mode)
+        };
+        for renderer in [&renderer, &bricked] {
+            let prepared = renderer.prepare(&s).unwrap();
+            let frame = prepared.render(&camera);
+            let [w, h] = camera.size();
+            let mut hits = 0;
+            for (y, x) in (0..h).flat_map(|y| (0..w).map(move |x| (y, x))) {
+                let trace = prepared.trace_pixel(&camera, x, y);
+                let what =
+                    format!("{mode:?} {crossing:?} jitter {jitter} skip {skip_empty} ({x}, {y})");
+                let i = x + w * y;
+                assert_eq!(trace.rgb[..], frame.rgb[3 * i..3 * i + 3], "{what}");
+                assert_eq!(trace.alpha, frame.alpha[i], "{what}");
+                let depth = frame.depth_mm[i];
+                assert_eq!(trace.depth_mm.to_bits(), depth.to_bits(), "{what}");
+                hits += usize::from(depth.is_finite());
+            }
+            // A falling crossing is met only by rays that leave the wall into another cavity.
+            assert!(hits > w * h / 20, "{mode:?} {crossing:?}: {hits} hits");
+        }
+    }
+}
+
 #[test]
 fn bricked_voxels_give_the_same_image() {
     let (renderer, camera) = colon_view(100, 0.6, 40);

@@ -69,13 +69,20 @@ pub struct Segment {
 /// stack; no allocation.
 #[derive(Debug, Clone, Copy)]
 pub struct BrickDda {
-    cell: [i32; 3],
-    step: [i32; 3],
-    t_next: [f32; 3],
-    t_delta: [f32; 3],
-    t: f32,
-    t_end: f32,
-    bricks: [i32; 3],
+    /// The brick the walk is in.
+    pub(crate) cell: [i32; 3],
+    /// −1, 0 or +1 per axis: the direction the walk moves in.
+    pub(crate) step: [i32; 3],
+    /// Where the ray meets the next brick face per axis, mm.
+    pub(crate) t_next: [f32; 3],
+    /// Distance between brick faces per axis, mm.
+    pub(crate) t_delta: [f32; 3],
+    /// Where the walk is, mm.
+    pub(crate) t: f32,
+    /// Where the walk ends, mm.
+    pub(crate) t_end: f32,
+    /// Bricks per axis.
+    pub(crate) bricks: [i32; 3],
 }
 
 impl BrickDda {

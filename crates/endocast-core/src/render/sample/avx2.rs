@@ -87,11 +87,12 @@ fn cell(p: __m256, extent: f32, max_base: i32) -> (__m256i, __m256) {
     (base, _mm256_sub_ps(p, _mm256_cvtepi32_ps(base)))
 }
 
-/// Eight trilinear values at voxel positions `(x, y, z)`.
+/// Eight trilinear values at voxel positions `(x, y, z)` (lanes: any positions, they are
+/// clamped to the volume).
 #[target_feature(enable = "avx2")]
 #[inline]
 #[allow(unsafe_code)]
-fn trilinear(s: &Sampler<'_>, x: __m256, y: __m256, z: __m256) -> __m256 {
+pub(crate) fn trilinear(s: &Sampler<'_>, x: __m256, y: __m256, z: __m256) -> __m256 {
     let (bx, fx) = cell(x, s.extent.x, s.max_base[0]);
     let (by, fy) = cell(y, s.extent.y, s.max_base[1]);
     let (bz, fz) = cell(z, s.extent.z, s.max_base[2]);
