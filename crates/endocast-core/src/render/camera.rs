@@ -121,6 +121,11 @@ impl Camera {
         self.up
     }
 
+    /// Tangent of half the vertical field of view.
+    pub(crate) fn tan_half_fov(&self) -> f64 {
+        self.tan_half_fov
+    }
+
     /// Vertical field of view, degrees.
     pub fn fov_deg(&self) -> f64 {
         2.0 * self.tan_half_fov.atan().to_degrees()

@@ -132,22 +132,29 @@ impl RayMarch {
         offset: f32,
     ) -> Self {
         let (origin, direction) = ray_f32(ray);
+        let grid = SampleGrid {
+            origin,
+            direction,
+            t_start: range.0 as f32,
+            offset,
+            step: step_mm,
+        };
+        Self::started(BrickDda::new(ray, range, bricks), grid, range.1 as f32)
+    }
+
+    /// The march with the brick walk `dda` and sample grid `grid` (as [`Self::new`] makes
+    /// them) of a ray ending at `t_end` mm.
+    pub(crate) fn started(dda: BrickDda, grid: SampleGrid, t_end: f32) -> Self {
         let mut march = Self {
-            dda: BrickDda::new(ray, range, bricks),
+            dda,
             pending: None,
-            grid: SampleGrid {
-                origin,
-                direction,
-                t_start: range.0 as f32,
-                offset,
-                step: step_mm,
-            },
+            grid,
             next: 0,
             end: 0,
             has_previous: false,
             stats: MarchStats::default(),
         };
-        march.end = march.index_at(range.1 as f32).max(0);
+        march.end = march.index_at(t_end).max(0);
         march
     }
 

@@ -250,12 +250,24 @@ fn skipping_gives_the_same_image_with_several_times_fewer_samples() {
     }
 }
 
-/// Rays rendered a row at a time (the eight-ray search, bisection across rays, gradients in
-/// batches) give every pixel exactly what the one-ray path (the `--debug-pixel` trace) gives.
+/// Rays set up four at a time and rendered a row at a time (the eight-ray search, bisection
+/// across rays, gradients in batches) give every pixel exactly what the one-ray path (the
+/// `--debug-pixel` trace) gives: from inside, past a near plane, and from outside the volume
+/// on an image whose width is no multiple of four.
 #[test]
 fn grouped_rays_give_the_one_ray_pixels() {
-    let (renderer, camera) = colon_view(120, 0.45, 40);
+    let (renderer, inside) = colon_view(120, 0.45, 40);
     let bricked = Renderer::for_many_frames(renderer.volume().clone());
+    let g = renderer.volume().geometry();
+    let outside = Camera::look_at(
+        g.world_of(DVec3::new(-40.0, 50.0, 70.0)),
+        g.world_of(DVec3::splat(60.0)),
+        DVec3::Z,
+        70.0,
+        [37, 23],
+    )
+    .unwrap();
+    let cameras = [inside, inside.with_near_mm(4.0).unwrap(), outside];
     for (mode, crossing, jitter, skip_empty) in [
         (Mode::Iso, Crossing::Auto, false, true),
         (Mode::Iso, Crossing::Falling, true, true),
@@ -272,13 +284,14 @@ fn grouped_rays_give_the_one_ray_pixels() {
             tf: TransferFunction::preset("complex").unwrap(),
             ..settings(mode)
         };
-        for renderer in [&renderer, &bricked] {
+        let views = cameras.iter().flat_map(|c| [(&renderer, c), (&bricked, c)]);
+        for (renderer, camera) in views {
             let prepared = renderer.prepare(&s).unwrap();
-            let frame = prepared.render(&camera);
+            let frame = prepared.render(camera);
             let [w, h] = camera.size();
             let mut hits = 0;
             for (y, x) in (0..h).flat_map(|y| (0..w).map(move |x| (y, x))) {
-                let trace = prepared.trace_pixel(&camera, x, y);
+                let trace = prepared.trace_pixel(camera, x, y);
                 let what =
                     format!("{mode:?} {crossing:?} jitter {jitter} skip {skip_empty} ({x}, {y})");
                 let i = x + w * y;

@@ -1,0 +1,303 @@
+//! Ray set-up for four pixels of a row at once (AVX2, `f64`): the camera ray, its voxel-space
+//! direction, its part inside the volume past the near plane and the start of its brick walk.
+//! Every lane repeats the one-ray set-up ([`Camera::direction`], [`VoxelRay::new`],
+//! [`VoxelRay::clip`], [`BrickDda::new`]) operation for operation, in the same order and with
+//! the same comparisons, so it gives the same bits; only the per-ray bookkeeping is shared.
+
+use super::camera::Camera;
+use super::traverse::{BrickDda, VoxelRay};
+use super::BRICK_VOX;
+use glam::{DAffine3, DVec3};
+use std::arch::x86_64::{
+    __m256d, _mm256_add_pd, _mm256_and_pd, _mm256_andnot_pd, _mm256_blendv_pd, _mm256_cmp_pd,
+    _mm256_cvttpd_epi32, _mm256_div_pd, _mm256_max_pd, _mm256_min_pd, _mm256_mul_pd,
+    _mm256_set1_pd, _mm256_setr_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
+    _mm_storeu_si128, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_LE_OQ, _CMP_NEQ_OQ,
+};
+
+/// What a frame's rays share: the camera's frame and the volume's.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RaySetup {
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    tan_half_fov: f64,
+    size: (f64, f64),
+    near_mm: f64,
+    /// The world-to-voxel matrix's columns.
+    axes: [DVec3; 3],
+    /// The eye in voxel space (every ray's origin).
+    origin: DVec3,
+    /// The voxel positions' box, `[0, extent]`.
+    extent: DVec3,
+    bricks: [i32; 3],
+}
+
+/// One lane's ray: its voxel-space form, its part inside the volume and the start of its walk.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LaneRay {
+    pub ray: VoxelRay,
+    /// Unit world direction.
+    pub dir_world: DVec3,
+    pub range: (f64, f64),
+    pub dda: BrickDda,
+}
+
+impl RaySetup {
+    /// The set-up of `camera`'s rays through a volume of `dims` voxels in `bricks` bricks.
+    pub fn new(
+        camera: &Camera,
+        voxel_from_world: &DAffine3,
+        dims: [usize; 3],
+        bricks: [usize; 3],
+    ) -> Self {
+        let [w, h] = camera.size();
+        let m = voxel_from_world.matrix3;
+        Self {
+            forward: camera.forward(),
+            right: camera.right(),
+            up: camera.up(),
+            tan_half_fov: camera.tan_half_fov(),
+            size: (w as f64, h as f64),
+            near_mm: camera.near_mm(),
+            axes: [m.x_axis, m.y_axis, m.z_axis],
+            origin: voxel_from_world.transform_point3(camera.eye_mm()),
+            extent: DVec3::from(dims.map(|n| (n - 1) as f64)),
+            bricks: bricks.map(|b| i32::try_from(b).unwrap_or(i32::MAX)),
+        }
+    }
+
+    /// The rays of pixels `x0 .. x0 + 4` of row `y` (`None` where a ray misses the volume; lanes
+    /// past the image's right edge are computed all the same).
+    #[target_feature(enable = "avx2")]
+    pub fn rays4(&self, x0: usize, y: usize) -> [Option<LaneRay>; 4] {
+        let splat = _mm256_set1_pd;
+        let (w, h) = self.size;
+        // As `Camera::pixel_direction` and `Camera::direction`.
+        let column = |k: usize| (x0 + k) as f64;
+        let x = _mm256_add_pd(
+            _mm256_setr_pd(column(0), column(1), column(2), column(3)),
+            splat(0.5),
+        );
+        let y = y as f64 + 0.5;
+        let sy = (1.0 - 2.0 * y / h) * self.tan_half_fov;
+        let sx = _mm256_div_pd(
+            _mm256_mul_pd(
+                _mm256_mul_pd(
+                    _mm256_sub_pd(
+                        _mm256_div_pd(_mm256_mul_pd(splat(2.0), x), splat(w)),
+                        splat(1.0),
+                    ),
+                    splat(self.tan_half_fov),
+                ),
+                splat(w),
+            ),
+            splat(h),
+        );
+        let v: [__m256d; 3] = std::array::from_fn(|c| {
+            let along_right = _mm256_add_pd(
+                splat(self.forward[c]),
+                _mm256_mul_pd(splat(self.right[c]), sx),
+            );
+            _mm256_add_pd(along_right, splat(self.up[c] * sy))
+        });
+        let length = _mm256_sqrt_pd(dot(v, v));
+        let recip = _mm256_div_pd(splat(1.0), length);
+        let dir = v.map(|vc| _mm256_mul_pd(vc, recip));
+        // As `VoxelRay::new` (`DAffine3::transform_vector3`).
+        let dir_vox: [__m256d; 3] = std::array::from_fn(|c| {
+            let [ax, ay, az] = self.axes;
+            _mm256_add_pd(
+                _mm256_add_pd(
+                    _mm256_mul_pd(splat(ax[c]), dir[0]),
+                    _mm256_mul_pd(splat(ay[c]), dir[1]),
+                ),
+                _mm256_mul_pd(splat(az[c]), dir[2]),
+            )
+        });
+        let t_min = self.near_distance(dir);
+        let (t0, t1, inside) = self.clip(dir_vox, t_min);
+        let walk = self.walk_start(dir_vox, t0);
+        let (dir, dir_vox, t0, t1, inside) = (
+            dir.map(|v| doubles(v)),
+            dir_vox.map(|v| doubles(v)),
+            doubles(t0),
+            doubles(t1),
+            doubles(inside),
+        );
+        std::array::from_fn(|k| {
+            (inside[k] != 0.0).then(|| {
+                let direction = DVec3::new(dir_vox[0][k], dir_vox[1][k], dir_vox[2][k]);
+                LaneRay {
+                    ray: VoxelRay {
+                        origin: self.origin,
+                        direction,
+                    },
+                    dir_world: DVec3::new(dir[0][k], dir[1][k], dir[2][k]),
+                    range: (t0[k], t1[k]),
+                    dda: walk.lane(k, (t0[k], t1[k]), self.bricks),
+                }
+            })
+        })
+    }
+
+    /// As `Camera::near_distance_along`.
+    #[target_feature(enable = "avx2")]
+    fn near_distance(&self, dir: [__m256d; 3]) -> __m256d {
+        if self.near_mm == 0.0 {
+            return _mm256_set1_pd(0.0);
+        }
+        let f = self.forward;
+        let forward = [
+            _mm256_set1_pd(f.x),
+            _mm256_set1_pd(f.y),
+            _mm256_set1_pd(f.z),
+        ];
+        let cos = dot(dir, forward);
+        // `cos.max(1e-9)`: a NaN gives 1e-9, as `f64::max` does.
+        _mm256_div_pd(
+            _mm256_set1_pd(self.near_mm),
+            _mm256_max_pd(cos, _mm256_set1_pd(1e-9)),
+        )
+    }
+
+    /// As `VoxelRay::clip(extent, t_min)`: the lanes' `t0`, `t1` and a mask of the lanes whose
+    /// interval is not empty.
+    #[target_feature(enable = "avx2")]
+    fn clip(&self, dir: [__m256d; 3], t_min: __m256d) -> (__m256d, __m256d, __m256d) {
+        let (mut t0, mut t1) = (t_min, _mm256_set1_pd(f64::INFINITY));
+        let mut missed = _mm256_set1_pd(0.0);
+        for (axis, &d) in dir.iter().enumerate() {
+            let (o, hi) = (self.origin[axis], self.extent[axis]);
+            let parallel = _mm256_cmp_pd::<_CMP_EQ_OQ>(d, _mm256_set1_pd(0.0));
+            if o < 0.0 || o > hi {
+                missed = _mm256_blendv_pd(missed, parallel, parallel);
+            }
+            let a = _mm256_div_pd(_mm256_set1_pd(0.0 - o), d);
+            let b = _mm256_div_pd(_mm256_set1_pd(hi - o), d);
+            // `t0.max(a.min(b))` and `t1.min(a.max(b))`; a NaN operand yields the other, as
+            // `f64::max` and `f64::min` do.
+            let entered = _mm256_max_pd(_mm256_min_pd(a, b), t0);
+            let left = _mm256_min_pd(_mm256_max_pd(a, b), t1);
+            t0 = _mm256_blendv_pd(entered, t0, parallel);
+            t1 = _mm256_blendv_pd(left, t1, parallel);
+        }
+        let ordered = _mm256_cmp_pd::<_CMP_LE_OQ>(t0, t1);
+        let finite = _mm256_cmp_pd::<_CMP_NEQ_OQ>(
+            _mm256_and_pd(t1, _mm256_set1_pd(f64::INFINITY)),
+            _mm256_set1_pd(f64::INFINITY),
+        );
+        let inside = _mm256_andnot_pd(missed, _mm256_and_pd(ordered, finite));
+        (t0, t1, inside)
+    }
+
+    /// As `BrickDda::new`, but for the fields shared by every lane.
+    #[target_feature(enable = "avx2")]
+    fn walk_start(&self, dir: [__m256d; 3], t_start: __m256d) -> WalkStart {
+        let brick = BRICK_VOX as f64;
+        let splat = _mm256_set1_pd;
+        let mut start = WalkStart {
+            cell: [[0; 4]; 3],
+            t_next: [[f32::INFINITY; 4]; 3],
+            t_delta: [[f32::INFINITY; 4]; 3],
+            step: [[0; 4]; 3],
+        };
+        for (axis, &d) in dir.iter().enumerate() {
+            let o = self.origin[axis];
+            let at = _mm256_div_pd(
+                _mm256_add_pd(splat(o), _mm256_mul_pd(d, t_start)),
+                splat(brick),
+            );
+            let cell = truncate(at).map(|c| c.clamp(0, self.bricks[axis] - 1));
+            // The face ahead: `cell + 1` going up, `cell` going down.
+            let up = doubles(_mm256_cmp_pd::<_CMP_GE_OQ>(d, splat(0.0)));
+            let face = _mm256_setr_pd(
+                face_of(cell[0], up[0]),
+                face_of(cell[1], up[1]),
+                face_of(cell[2], up[2]),
+                face_of(cell[3], up[3]),
+            );
+            let t_next = doubles(_mm256_div_pd(
+                _mm256_sub_pd(_mm256_mul_pd(face, splat(brick)), splat(o)),
+                d,
+            ));
+            let forward = doubles(_mm256_div_pd(splat(brick), d));
+            let backward = doubles(_mm256_div_pd(splat(-brick), d));
+            let d = doubles(d);
+            for k in 0..4 {
+                start.cell[axis][k] = cell[k];
+                if d[k] > 0.0 {
+                    start.step[axis][k] = 1;
+                    start.t_next[axis][k] = t_next[k] as f32;
+                    start.t_delta[axis][k] = forward[k] as f32;
+                } else if d[k] < 0.0 {
+                    start.step[axis][k] = -1;
+                    start.t_next[axis][k] = t_next[k] as f32;
+                    start.t_delta[axis][k] = backward[k] as f32;
+                }
+            }
+        }
+        start
+    }
+}
+
+/// The per-lane start of the brick walks.
+struct WalkStart {
+    cell: [[i32; 4]; 3],
+    step: [[i32; 4]; 3],
+    t_next: [[f32; 4]; 3],
+    t_delta: [[f32; 4]; 3],
+}
+
+impl WalkStart {
+    /// Lane `k`'s walk over `(t_start, t_end)`.
+    fn lane(&self, k: usize, (t_start, t_end): (f64, f64), bricks: [i32; 3]) -> BrickDda {
+        BrickDda {
+            cell: self.cell.map(|c| c[k]),
+            step: self.step.map(|s| s[k]),
+            t_next: self.t_next.map(|t| t[k]),
+            t_delta: self.t_delta.map(|t| t[k]),
+            t: t_start as f32,
+            t_end: t_end as f32,
+            bricks,
+        }
+    }
+}
+
+/// The brick face ahead of `cell` in `f64`: `cell + 1` where the ray goes up (`up` non-zero).
+fn face_of(cell: i32, up: f64) -> f64 {
+    if up != 0.0 {
+        f64::from(cell + 1)
+    } else {
+        f64::from(cell)
+    }
+}
+
+/// `a · b` per lane, as `DVec3::dot`.
+#[target_feature(enable = "avx2")]
+fn dot(a: [__m256d; 3], b: [__m256d; 3]) -> __m256d {
+    _mm256_add_pd(
+        _mm256_add_pd(_mm256_mul_pd(a[0], b[0]), _mm256_mul_pd(a[1], b[1])),
+        _mm256_mul_pd(a[2], b[2]),
+    )
+}
+
+/// `v as i32` per lane (truncation; out of range gives `i32::MIN`, which the callers clamp).
+#[target_feature(enable = "avx2")]
+#[allow(unsafe_code)]
+fn truncate(v: __m256d) -> [i32; 4] {
+    let mut out = [0i32; 4];
+    // SAFETY: 16 bytes are written to an array of 16 bytes.
+    unsafe { _mm_storeu_si128(out.as_mut_ptr().cast(), _mm256_cvttpd_epi32(v)) };
+    out
+}
+
+/// The lanes of `v`.
+#[target_feature(enable = "avx2")]
+#[allow(unsafe_code)]
+fn doubles(v: __m256d) -> [f64; 4] {
+    let mut out = [0.0; 4];
+    // SAFETY: four f64 are written to an array of four.
+    unsafe { _mm256_storeu_pd(out.as_mut_ptr(), v) };
+    out
+}
