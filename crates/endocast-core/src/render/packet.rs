@@ -32,9 +32,9 @@ use std::arch::x86_64::{
 type Mask = __m256i;
 
 /// The first crossings of `iso` of up to eight rays whose marches have not been walked yet, as
-/// [`super::integrate::Integrator::search`] finds them one ray at a time; `directions[k]` (rising) is ray
-/// `k`'s crossing direction and `active` the isovalue's brick bits (`None`: every brick is
-/// searched). Each march is left as that search leaves it.
+/// [`super::integrate::Integrator::search`] finds them one ray at a time. `directions[k]` says
+/// whether ray `k`'s crossing is rising, `active` holds the isovalue's brick bits (`None`: every
+/// brick is searched). Each march is left as that search leaves it.
 #[target_feature(enable = "avx2")]
 pub(crate) fn search8(
     sampler: &Sampler<'_>,
@@ -88,7 +88,7 @@ pub(crate) fn search8(
         lanes.next = _mm256_blendv_epi8(lanes.next, after, take);
         lanes.n = _mm256_blendv_epi8(lanes.n, after, take);
     }
-    found.store(&lanes, &dda, tasks, rising_bits(rising))
+    found.store(&lanes, &dda, tasks, bits(rising))
 }
 
 /// What each lane had when it found its crossing (at sample `n`, between the values `before`
@@ -463,7 +463,7 @@ fn mask(on: impl Fn(usize) -> bool) -> Mask {
 /// The lanes of `m` as bits.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn rising_bits(m: Mask) -> u32 {
+fn bits(m: Mask) -> u32 {
     _mm256_movemask_ps(_mm256_castsi256_ps(m)) as u32
 }
 
