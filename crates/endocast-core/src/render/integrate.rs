@@ -346,9 +346,8 @@ impl Integrator<'_> {
     }
 
     /// [`Self::refine`] for every bracketed ray of a group, into its `out.depth_mm`: each step
-    /// takes one batch for the midpoints of eight rays (the rays' steps are independent, so
-    /// this is a quarter of the samples [`bisect`]'s tree of midpoints takes, with no longer a
-    /// chain of dependent samples per batch).
+    /// takes one batch for the midpoints of eight rays (the rays' steps are independent), under
+    /// half the samples of [`bisect`]'s tree of midpoints per ray, and the same brackets.
     fn refine_group(&self, tasks: &mut [RayTask], iso: f32) {
         for _ in 0..self.params.refine_steps {
             for chunk in tasks.chunks_mut(8) {

@@ -131,6 +131,18 @@ impl RayMarch {
         step_mm: f32,
         offset: f32,
     ) -> Self {
+        let dda = BrickDda::new(ray, range, bricks);
+        Self::with_walk(dda, ray, range, step_mm, offset)
+    }
+
+    /// [`Self::new`] with the brick walk `dda` already set up (as `BrickDda::new` sets it up).
+    pub(crate) fn with_walk(
+        dda: BrickDda,
+        ray: &VoxelRay,
+        range: (f64, f64),
+        step_mm: f32,
+        offset: f32,
+    ) -> Self {
         let (origin, direction) = ray_f32(ray);
         let grid = SampleGrid {
             origin,
@@ -139,12 +151,6 @@ impl RayMarch {
             offset,
             step: step_mm,
         };
-        Self::started(BrickDda::new(ray, range, bricks), grid, range.1 as f32)
-    }
-
-    /// The march with the brick walk `dda` and sample grid `grid` (as [`Self::new`] makes
-    /// them) of a ray ending at `t_end` mm.
-    pub(crate) fn started(dda: BrickDda, grid: SampleGrid, t_end: f32) -> Self {
         let mut march = Self {
             dda,
             pending: None,
@@ -154,7 +160,7 @@ impl RayMarch {
             has_previous: false,
             stats: MarchStats::default(),
         };
-        march.end = march.index_at(t_end).max(0);
+        march.end = march.index_at(range.1 as f32).max(0);
         march
     }
 

@@ -67,7 +67,7 @@ use march::RayMarch;
 use rays4::RaySetup;
 use std::time::Instant;
 use tiles::{Pixel, Tile, TileRect, Tiling, TILE};
-use traverse::{ray_f32, VoxelRay};
+use traverse::VoxelRay;
 
 use crate::Volume;
 
@@ -402,15 +402,8 @@ impl Prepared<'_> {
                 let lanes = unsafe { setup.rays4(x0, y) };
                 for (x, lane) in (x0..xs.end).zip(lanes) {
                     let Some(lane) = lane else { continue };
-                    let (origin, direction) = ray_f32(&lane.ray);
-                    let grid = SampleGrid {
-                        origin,
-                        direction,
-                        t_start: lane.range.0 as f32,
-                        offset: self.offset(x, y),
-                        step: self.step_mm as f32,
-                    };
-                    let march = RayMarch::started(lane.dda, grid, lane.range.1 as f32);
+                    let (step, offset) = (self.step_mm as f32, self.offset(x, y));
+                    let march = RayMarch::with_walk(lane.dda, &lane.ray, lane.range, step, offset);
                     columns.push(x);
                     tasks.push(RayTask::new(march, lane.dir_world.as_vec3()));
                 }

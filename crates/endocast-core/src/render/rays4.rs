@@ -191,7 +191,7 @@ impl RaySetup {
         (t0, t1, inside)
     }
 
-    /// As `BrickDda::new`, but for the fields shared by every lane.
+    /// As `BrickDda::new`: each lane's first brick, step directions and face distances.
     #[target_feature(enable = "avx2")]
     fn walk_start(&self, dir: [__m256d; 3], t_start: __m256d) -> WalkStart {
         let brick = BRICK_VOX as f64;
