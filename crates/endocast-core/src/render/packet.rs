@@ -1,6 +1,6 @@
 //! The isosurface search for eight rays at once, one ray per AVX2 lane (ray-parallel SIMD, as
 //! packet ray tracers run): every lane walks its own bricks ([`BrickDda`] step for step) and
-//! takes its own samples, one per lane and loop, so the per-ray bookkeeping of the walk — brick
+//! takes its own samples, two per lane and loop, so the per-ray bookkeeping of the walk — brick
 //! steps, activity tests, sample ranges, crossing tests — is done for eight rays by each
 //! instruction instead of one.
 //!
@@ -66,30 +66,35 @@ pub(crate) fn search8(
         if !any(take) {
             continue;
         }
-        let t = grid.t_of(lanes.n);
-        let value = trilinear(
-            sampler,
-            along(grid.origin[0], grid.direction[0], t),
-            along(grid.origin[1], grid.direction[1], t),
-            along(grid.origin[2], grid.direction[2], t),
-        );
-        lanes.samples = _mm256_sub_epi32(lanes.samples, take);
-        // Tested against the sample before it on the grid, if that one was taken.
+        // Two samples per lane and round (the second where the brick has one more): the
+        // round's bookkeeping is shared by both, and the second is tested against the first.
+        let second = _mm256_add_epi32(lanes.n, one);
+        let take2 = _mm256_and_si256(take, _mm256_cmpgt_epi32(lanes.hi, second));
+        let (v1, v2) = (grid.sample(sampler, lanes.n), grid.sample(sampler, second));
+        let counted1 = _mm256_sub_epi32(lanes.samples, take);
+        lanes.samples = _mm256_sub_epi32(counted1, take2);
+        // The first is tested against the sample before it on the grid, if that one was taken.
         let follows = _mm256_cmpeq_epi32(lanes.n, lanes.next);
         let tested = _mm256_and_si256(take, _mm256_and_si256(lanes.has_previous, follows));
-        let crossed = crossings(lanes.previous, value, iso, rising);
-        let hit = _mm256_andnot_si256(found.on, _mm256_and_si256(tested, crossed));
-        if any(hit) {
-            found.record(hit, &lanes, &dda, value);
+        let hit1 = _mm256_and_si256(tested, crossings(lanes.previous, v1, iso, rising));
+        let hit2 = _mm256_and_si256(take2, crossings(v1, v2, iso, rising));
+        if any(_mm256_andnot_si256(found.on, _mm256_or_si256(hit1, hit2))) {
+            let first = (lanes.n, lanes.previous, v1, counted1);
+            found.record(hit1, first, &lanes, &dda);
+            found.record(hit2, (second, v1, v2, lanes.samples), &lanes, &dda);
         }
-        lanes.previous = blend_ps(lanes.previous, value, take);
+        lanes.previous = blend_ps(blend_ps(lanes.previous, v1, take), v2, take2);
         lanes.has_previous = _mm256_or_si256(lanes.has_previous, take);
-        let after = _mm256_add_epi32(lanes.n, one);
+        let after = _mm256_sub_epi32(second, take2);
         lanes.next = _mm256_blendv_epi8(lanes.next, after, take);
         lanes.n = _mm256_blendv_epi8(lanes.n, after, take);
     }
     found.store(&lanes, &dda, tasks, bits(rising))
 }
+
+/// A sample that crossed, per lane: its index, the values before it and at it, and the
+/// samples counted up to it.
+type Crossing = (__m256i, __m256, __m256, __m256i);
 
 /// What each lane had when it found its crossing (at sample `n`, between the values `before`
 /// and `after`): where its walk was and what it had counted.
@@ -123,15 +128,17 @@ impl Found {
         unsafe { std::mem::zeroed() }
     }
 
-    /// Records the lanes of `hit`, whose sample `lanes.n` of value `after` crossed.
+    /// Records the lanes of `hit` not recorded yet, whose sample crossed as `crossing` says.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn record(&mut self, hit: Mask, lanes: &Lanes, dda: &Dda, after: __m256) {
+    fn record(&mut self, hit: Mask, crossing: Crossing, lanes: &Lanes, dda: &Dda) {
+        let (n, before, after, samples) = crossing;
+        let hit = _mm256_andnot_si256(self.on, hit);
         let int = |old: __m256i, new: __m256i| _mm256_blendv_epi8(old, new, hit);
         let float = |old: __m256, new: __m256| blend_ps(old, new, hit);
         self.on = _mm256_or_si256(self.on, hit);
-        self.n = int(self.n, lanes.n);
-        self.before = float(self.before, lanes.previous);
+        self.n = int(self.n, n);
+        self.before = float(self.before, before);
         self.after = float(self.after, after);
         self.t0 = float(self.t0, lanes.t0);
         self.t1 = float(self.t1, lanes.t1);
@@ -141,7 +148,7 @@ impl Found {
             self.t_next[axis] = float(self.t_next[axis], dda.t_next[axis]);
         }
         self.t = float(self.t, dda.t);
-        self.samples = int(self.samples, lanes.samples);
+        self.samples = int(self.samples, samples);
         self.visited = int(self.visited, lanes.visited);
         self.skipped = int(self.skipped, lanes.skipped);
     }
@@ -317,6 +324,15 @@ impl Grid {
     fn t_of(&self, n: __m256i) -> __m256 {
         let steps = _mm256_add_ps(_mm256_cvtepi32_ps(n), self.offset);
         _mm256_add_ps(self.t_start, _mm256_mul_ps(steps, self.step))
+    }
+
+    /// Sample `n` of each lane's grid.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn sample(&self, sampler: &Sampler<'_>, n: __m256i) -> __m256 {
+        let t = self.t_of(n);
+        let at = |axis: usize| along(self.origin[axis], self.direction[axis], t);
+        trilinear(sampler, at(0), at(1), at(2))
     }
 
     /// The first sample index at or after `t` per lane, as `RayMarch::index_at`.
