@@ -87,7 +87,7 @@ pub(crate) struct RayTask {
     pub march: RayMarch,
     pub dir_world: Vec3,
     pub out: PixelOut,
-    bracket: Option<Bracket>,
+    pub(crate) bracket: Option<Bracket>,
 }
 
 impl RayTask {
@@ -345,18 +345,34 @@ impl Integrator<'_> {
         self.hit_in(iso, before, after)
     }
 
-    /// [`Self::refine`] for every bracketed ray of a group, into its `out.depth_mm`: each step
-    /// takes one batch for the midpoints of eight rays (the rays' steps are independent), under
-    /// half the samples of [`bisect`]'s tree of midpoints per ray, and the same brackets.
+    /// [`Self::refine`] for every bracketed ray of a group, into its `out.depth_mm`: the same
+    /// brackets, eight rays' midpoints per batch (the rays' steps are independent), under half
+    /// the samples of [`bisect`]'s tree of midpoints per ray.
     fn refine_group(&self, tasks: &mut [RayTask], iso: f32) {
-        for _ in 0..self.params.refine_steps {
-            for chunk in tasks.chunks_mut(8) {
-                self.bisect_across(chunk, iso);
-            }
-        }
+        self.bisect_group(tasks, iso);
         for task in tasks.iter_mut() {
             if let Some(b) = task.bracket {
                 task.out.depth_mm = self.hit_in(iso, b.before, b.after);
+            }
+        }
+    }
+
+    /// Every bisection step of each bracketed ray of a group: on AVX2 all steps of eight rays
+    /// in registers ([`packet::refine8`]), else a step at a time across eight rays.
+    #[allow(unsafe_code)]
+    fn bisect_group(&self, tasks: &mut [RayTask], iso: f32) {
+        let steps = self.params.refine_steps;
+        #[cfg(target_arch = "x86_64")]
+        if self.sampler.avx2() {
+            for chunk in tasks.chunks_mut(8) {
+                // SAFETY: the sampler runs AVX2 batches only where the CPU has AVX2.
+                unsafe { packet::refine8(&self.sampler, iso, chunk, steps) };
+            }
+            return;
+        }
+        for _ in 0..steps {
+            for chunk in tasks.chunks_mut(8) {
+                self.bisect_across(chunk, iso);
             }
         }
     }

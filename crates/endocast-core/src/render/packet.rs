@@ -92,6 +92,41 @@ pub(crate) fn search8(
     found.store(&lanes, &dda, tasks, bits(rising))
 }
 
+/// `steps` bisection steps of the brackets of up to eight rays (rays without one are left
+/// alone), all steps in registers: each midpoint computed, sampled and kept as
+/// [`super::integrate::Integrator::refine`] keeps a single ray's.
+#[target_feature(enable = "avx2")]
+pub(crate) fn refine8(sampler: &Sampler<'_>, iso: f32, tasks: &mut [RayTask], steps: u32) {
+    debug_assert!(tasks.len() <= 8 && sampler.avx2());
+    let grid = Grid::load(tasks);
+    let bracket = |f: fn(&Bracket) -> f32| lanes_f32(tasks, |t| t.bracket.as_ref().map_or(0.0, f));
+    let (mut t0, mut v0) = (bracket(|b| b.before.0), bracket(|b| b.before.1));
+    let (mut t1, mut v1) = (bracket(|b| b.after.0), bracket(|b| b.after.1));
+    let rising = mask(|k| {
+        tasks
+            .get(k)
+            .and_then(|t| t.bracket)
+            .is_some_and(|b| b.rising)
+    });
+    let (iso, half) = (_mm256_set1_ps(iso), _mm256_set1_ps(0.5));
+    for _ in 0..steps {
+        let t = _mm256_mul_ps(half, _mm256_add_ps(t0, t1));
+        let at = |axis: usize| along(grid.origin[axis], grid.direction[axis], t);
+        let v = trilinear(sampler, at(0), at(1), at(2));
+        // The midpoint replaces the end on its side: `(v >= iso) == rising`.
+        let above = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(v, iso));
+        let to_after = _mm256_cmpeq_epi32(above, rising);
+        (t1, v1) = (blend_ps(t1, t, to_after), blend_ps(v1, v, to_after));
+        (t0, v0) = (blend_ps(t, t0, to_after), blend_ps(v, v0, to_after));
+    }
+    let (t0, v0, t1, v1) = (floats(t0), floats(v0), floats(t1), floats(v1));
+    for (k, task) in tasks.iter_mut().enumerate() {
+        if let Some(b) = &mut task.bracket {
+            (b.before, b.after) = ((t0[k], v0[k]), (t1[k], v1[k]));
+        }
+    }
+}
+
 /// A sample that crossed, per lane: its index, the values before it and at it, and the
 /// samples counted up to it.
 type Crossing = (__m256i, __m256, __m256, __m256i);
