@@ -1,8 +1,8 @@
-//! The isosurface search for eight rays at once, one ray per AVX2 lane (ray-parallel SIMD, as
-//! packet ray tracers run): every lane walks its own bricks ([`BrickDda`] step for step) and
-//! takes its own samples, two per lane and loop, so the per-ray bookkeeping of the walk — brick
-//! steps, activity tests, sample ranges, crossing tests — is done for eight rays by each
-//! instruction instead of one.
+//! The isosurface search (and its refinement, [`refine8`]) for eight rays at once, one ray per
+//! AVX2 lane (ray-parallel SIMD, as packet ray tracers run): every lane walks its own bricks
+//! ([`BrickDda`] step for step) and takes its own samples, two per lane and loop, so the per-ray
+//! bookkeeping of the walk — brick steps, activity tests, sample ranges, crossing tests — is
+//! done for eight rays by each instruction instead of one.
 //!
 //! A lane takes exactly the samples the one-ray walk ([`super::march::Walk::SEARCH`]) takes:
 //! in each active brick, from the last sample before it to the first at or after its end
@@ -111,8 +111,7 @@ pub(crate) fn refine8(sampler: &Sampler<'_>, iso: f32, tasks: &mut [RayTask], st
     let (iso, half) = (_mm256_set1_ps(iso), _mm256_set1_ps(0.5));
     for _ in 0..steps {
         let t = _mm256_mul_ps(half, _mm256_add_ps(t0, t1));
-        let at = |axis: usize| along(grid.origin[axis], grid.direction[axis], t);
-        let v = trilinear(sampler, at(0), at(1), at(2));
+        let v = grid.value_at(sampler, t);
         // The midpoint replaces the end on its side: `(v >= iso) == rising`.
         let above = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(v, iso));
         let to_after = _mm256_cmpeq_epi32(above, rising);
@@ -365,7 +364,13 @@ impl Grid {
     #[target_feature(enable = "avx2")]
     #[inline]
     fn sample(&self, sampler: &Sampler<'_>, n: __m256i) -> __m256 {
-        let t = self.t_of(n);
+        self.value_at(sampler, self.t_of(n))
+    }
+
+    /// The value at distance `t` along each lane's line, as `SampleGrid::at` places it.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn value_at(&self, sampler: &Sampler<'_>, t: __m256) -> __m256 {
         let at = |axis: usize| along(self.origin[axis], self.direction[axis], t);
         trilinear(sampler, at(0), at(1), at(2))
     }
