@@ -78,6 +78,9 @@ pub struct Renderer {
     volume: Volume,
     grid: BrickGrid,
     bricked: Option<BrickedVoxels>,
+    /// Whether the AVX2 paths run where the CPU has them (tests turn them off to check the
+    /// paths other CPUs take against them).
+    simd: bool,
 }
 
 impl Renderer {
@@ -88,6 +91,16 @@ impl Renderer {
             volume,
             grid,
             bricked: None,
+            simd: true,
+        }
+    }
+
+    /// The same renderer on the paths for CPUs without AVX2.
+    #[cfg(test)]
+    pub(crate) fn without_simd(self) -> Self {
+        Self {
+            simd: false,
+            ..self
         }
     }
 
@@ -100,6 +113,19 @@ impl Renderer {
         Self {
             bricked,
             ..Self::new(volume)
+        }
+    }
+
+    /// The sampler of the voxels for the integrators.
+    fn sampler(&self) -> Sampler<'_> {
+        let sampler = match &self.bricked {
+            Some(bricked) => Sampler::with_bricks(&self.volume, bricked),
+            None => Sampler::new(&self.volume),
+        };
+        if self.simd {
+            sampler
+        } else {
+            sampler.scalar()
         }
     }
 
@@ -247,10 +273,7 @@ impl Prepared<'_> {
     /// The integrators for frames of `camera`.
     fn integrator(&self, camera: &Camera) -> Integrator<'_> {
         let mut integrator = Integrator {
-            sampler: match &self.renderer.bricked {
-                Some(bricked) => Sampler::with_bricks(&self.renderer.volume, bricked),
-                None => Sampler::new(&self.renderer.volume),
-            },
+            sampler: self.renderer.sampler(),
             grid: &self.renderer.grid,
             activity: &self.activity,
             table: &self.table,

@@ -313,6 +313,33 @@ fn grouped_rays_give_the_one_ray_pixels() {
     }
 }
 
+/// The paths CPUs without AVX2 take (one-ray searches, bisection a step at a time across the
+/// rays, scalar samples) give the AVX2 paths' images and counters.
+#[test]
+fn scalar_paths_give_the_simd_images() {
+    let (renderer, camera) = colon_view(100, 0.6, 40);
+    let scalar = Renderer::new(renderer.volume().clone()).without_simd();
+    for mode in [
+        Mode::Iso,
+        Mode::Hybrid,
+        Mode::Dvr,
+        Mode::TwoIso,
+        Mode::Mip,
+        Mode::Minip,
+    ] {
+        let s = RenderSettings {
+            mode,
+            iso_opacity: 0.5,
+            tf: TransferFunction::preset("complex").unwrap(),
+            ..settings(mode)
+        };
+        let simd = renderer.prepare(&s).unwrap().render(&camera);
+        let other = scalar.prepare(&s).unwrap().render(&camera);
+        assert_same_image(&simd, &other, mode.name());
+        assert_eq!(simd.stats.samples, other.stats.samples, "{}", mode.name());
+    }
+}
+
 #[test]
 fn bricked_voxels_give_the_same_image() {
     let (renderer, camera) = colon_view(100, 0.6, 40);
