@@ -5,7 +5,7 @@ use super::Shot;
 use crate::coverage::{Coverage, CoverageError};
 use crate::path::PathError;
 use crate::render::SettingsError;
-use crate::render::{Camera, CameraError, Prepared, RenderSettings, RenderStats, Renderer};
+use crate::render::{Camera, CameraError, Frame, Prepared, RenderSettings, RenderStats, Renderer};
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
 use crate::views::{Image, Rgb, ViewError};
@@ -82,6 +82,8 @@ pub struct Flight<'a> {
     dashboard: Option<DashboardParts>,
     coverage: Option<Coverage>,
     prepared: Option<Prepared<'a>>,
+    /// The frame rendered into, its buffers reused from shot to shot.
+    frame: Frame,
 }
 
 impl<'a> Flight<'a> {
@@ -94,6 +96,7 @@ impl<'a> Flight<'a> {
             dashboard: None,
             coverage: None,
             prepared: None,
+            frame: Frame::default(),
         }
     }
 
@@ -152,25 +155,19 @@ impl<'a> Flight<'a> {
             fov,
             self.options.size,
         )?;
-        let frame = self.prepared(settings)?.render(&camera);
+        prepared(&mut self.prepared, self.renderer, settings)?
+            .render_into(&camera, &mut self.frame);
+        let frame = &self.frame;
         if let Some(coverage) = &mut self.coverage {
-            coverage.record(&camera, &frame)?;
+            coverage.record(&camera, frame)?;
         }
-        let endoscope = Image::from_frame(&frame)?;
+        let endoscope = Image::from_frame(frame)?;
+        let stats = frame.stats;
         let image = match self.options.layout {
             Layout::Endoscope => endoscope,
             Layout::Dashboard => self.dashboard_frame(index, shot, &camera, &endoscope)?,
         };
-        Ok((image, frame.stats))
-    }
-
-    /// The prepared renderer for `settings`, re-prepared only when they change.
-    fn prepared(&mut self, settings: &RenderSettings) -> Result<&Prepared<'a>, FlightError> {
-        let prepared = match self.prepared.take() {
-            Some(p) if p.settings() == settings => p,
-            _ => self.renderer.prepare(settings)?,
-        };
-        Ok(self.prepared.insert(prepared))
+        Ok((image, stats))
     }
 
     fn dashboard_frame(
@@ -228,4 +225,17 @@ fn cross_options(slices: &SliceOptions) -> SliceOptions {
         field_mm: Some(CROSS_SECTION_FIELD_MM),
         ..slices.clone()
     }
+}
+
+/// The prepared renderer in `slot` for `settings`, re-prepared only when they change.
+fn prepared<'s, 'a>(
+    slot: &'s mut Option<Prepared<'a>>,
+    renderer: &'a Renderer,
+    settings: &RenderSettings,
+) -> Result<&'s Prepared<'a>, FlightError> {
+    let prepared = match slot.take() {
+        Some(p) if p.settings() == settings => p,
+        _ => renderer.prepare(settings)?,
+    };
+    Ok(slot.insert(prepared))
 }
