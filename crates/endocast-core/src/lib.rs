@@ -11,6 +11,7 @@
 //! ```
 
 pub mod animation;
+pub mod camera;
 pub mod coverage;
 pub mod flight;
 pub mod geometry;

@@ -34,7 +34,7 @@
 //! ```
 
 mod bricks;
-mod camera;
+
 mod crossing;
 mod frame;
 mod integrate;
@@ -52,8 +52,8 @@ pub mod traverse;
 #[cfg(test)]
 mod tests;
 
+pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
 pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
-pub use camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
 pub use frame::{Frame, RenderStats};
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
 pub use settings::{Crossing, Mode, RenderSettings, SettingsError};

@@ -4,9 +4,9 @@
 //! [`VoxelRay::clip`], [`BrickDda::new`]) operation for operation, in the same order and with
 //! the same comparisons, so it gives the same bits; only the per-ray bookkeeping is shared.
 
-use super::camera::Camera;
 use super::traverse::{BrickDda, VoxelRay};
 use super::BRICK_VOX;
+use crate::camera::Camera;
 use glam::{DAffine3, DVec3};
 use std::arch::x86_64::{
     __m256d, _mm256_add_pd, _mm256_and_pd, _mm256_andnot_pd, _mm256_blendv_pd, _mm256_cmp_pd,

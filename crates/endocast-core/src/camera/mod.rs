@@ -36,6 +36,48 @@ pub enum CameraError {
     BadNear(f64),
 }
 
+/// How a camera maps view directions to image positions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Projection {
+    /// Perspective (a rectilinear lens): straight lines stay straight; field of view < 180°.
+    #[default]
+    Pinhole,
+    /// Fisheye, equidistant: the image radius grows with the angle from the axis (r = f·θ).
+    Equidistant,
+    /// Fisheye, equisolid-angle: r = 2f·sin(θ/2), equal solid angles get equal areas.
+    Equisolid,
+    /// Parallel rays along the view direction (overviews and checks); the field of view is a
+    /// height in mm.
+    Orthographic,
+}
+
+impl Projection {
+    /// Every projection, in a fixed order.
+    pub const ALL: [Projection; 4] = [
+        Self::Pinhole,
+        Self::Equidistant,
+        Self::Equisolid,
+        Self::Orthographic,
+    ];
+
+    /// The name the CLI uses: `pinhole`, `equidistant`, `equisolid`, `orthographic`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Pinhole => "pinhole",
+            Self::Equidistant => "equidistant",
+            Self::Equisolid => "equisolid",
+            Self::Orthographic => "orthographic",
+        }
+    }
+
+    /// The projection called `name` (ASCII case ignored).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name().eq_ignore_ascii_case(name.trim()))
+    }
+}
+
 /// A pinhole perspective camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
