@@ -195,7 +195,7 @@ impl Coverage {
     }
 
     /// Marks what the rays of `frame` (rendered with `camera`) hit: for every pixel with a
-    /// finite depth, the point `eye + direction · depth`. Returns how many wall voxels were
+    /// finite depth, the point `depth` along its ray. Returns how many wall voxels were
     /// newly seen.
     pub fn record(&mut self, camera: &Camera, frame: &Frame) -> Result<usize, CoverageError> {
         let [w, h] = camera.size();
@@ -208,8 +208,9 @@ impl Coverage {
         let mut newly = 0;
         for (n, depth) in frame.depth_mm.iter().enumerate() {
             if depth.is_finite() {
-                let dir = camera.pixel_direction(n % w, n / w);
-                newly += self.mark_point(camera.eye_mm() + dir * f64::from(*depth));
+                if let Some(hit) = camera.point_at(n % w, n / w, f64::from(*depth)) {
+                    newly += self.mark_point(hit);
+                }
             }
         }
         Ok(newly)
@@ -278,7 +279,9 @@ impl Coverage {
                 continue;
             }
             let (x, y) = (n % w, n / w);
-            let hit = camera.eye_mm() + camera.pixel_direction(x, y) * f64::from(*depth);
+            let Some(hit) = camera.point_at(x, y, f64::from(*depth)) else {
+                continue;
+            };
             let unseen = self
                 .cell_corners(hit)
                 .into_iter()

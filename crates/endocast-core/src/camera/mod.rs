@@ -1,13 +1,39 @@
-//! The pinhole camera: a pose in world millimetres (LPS) and a perspective projection.
+//! The camera: a pose in world millimetres (LPS), a [`Projection`] with an optional real
+//! [`Lens`], an image size and a near distance — and the one definition of pixel → ray
+//! ([`Camera::ray`]) that the renderer, the slice views, coverage and animation share, with its
+//! inverse ([`Camera::project`]). A [`StereoRig`] makes the two off-axis eyes of a stereo pair.
 //!
 //! The convention is the one the VTK peer uses (see `shared/peers/check_projection.py`):
 //! `right = forward × up`, the field of view is the *vertical* one, row 0 is the top of the
 //! image, and pixel `(x, y)` is sampled through its centre `(x + ½, y + ½)`.
+//!
+//! Image positions are normalised before projecting: `(u, v)` with the centre at `(0, 0)`,
+//! `v = 1` at the top edge and `u` in the same unit (half the image height). Per projection,
+//! with `φ` half the field:
+//! - pinhole: the ray through `forward + right·u·tan φ + up·v·tan φ`;
+//! - equidistant fisheye: the angle from the axis is `θ = r·φ` (`r = |(u, v)|`);
+//! - equisolid fisheye: `r = sin(θ/2) / sin(φ/2)`;
+//! - orthographic: parallel rays along `forward` from `eye + right·u·h + up·v·h`, `h` half the
+//!   view height in mm.
+//!
+//! A fisheye's image is the circle `r ≤ 1` (a real endoscope's round picture); pixels outside it
+//! have no ray. The lens's distortion acts on `(u, v)` before the projection (see [`lens`]).
+
+pub mod lens;
+mod projection;
+mod stereo;
+
+#[cfg(test)]
+mod tests;
+
+pub use lens::Lens;
+pub use projection::Projection;
+pub use stereo::{disparity_px, StereoRig};
 
 use glam::DVec3;
 use thiserror::Error;
 
-/// Smallest and largest vertical field of view accepted, degrees.
+/// Smallest and largest vertical field of view of a pinhole camera, degrees.
 pub const FOV_RANGE_DEG: (f64, f64) = (10.0, 170.0);
 /// Largest image edge accepted, pixels.
 pub const MAX_IMAGE_EDGE: usize = 16384;
@@ -28,75 +54,103 @@ pub enum CameraError {
     /// The field of view lies outside [`FOV_RANGE_DEG`].
     #[error("vertical field of view {0}° lies outside 10°–170°")]
     BadFov(f64),
+    /// The field lies outside its projection's range ([`Projection::field_range`]).
+    #[error("a {projection} field of {field} lies outside {min}–{max} {unit}")]
+    BadField {
+        /// The projection's name.
+        projection: &'static str,
+        /// The rejected field.
+        field: f64,
+        /// Smallest accepted.
+        min: f64,
+        /// Largest accepted.
+        max: f64,
+        /// Degrees or mm.
+        unit: &'static str,
+    },
+    /// A lens parameter is not finite or outside its range.
+    #[error("lens {0} = {1} is outside {2}")]
+    BadLens(&'static str, f64, &'static str),
     /// An image edge is zero or larger than [`MAX_IMAGE_EDGE`].
     #[error("image size {0}×{1} must be between 1 and 16384 pixels per edge")]
     BadSize(usize, usize),
     /// The near distance is negative or not finite.
     #[error("near distance {0} mm must be finite and not negative")]
     BadNear(f64),
+    /// A stereo eye cannot be made.
+    #[error("stereo: {0}")]
+    BadStereo(String),
 }
 
-/// How a camera maps view directions to image positions.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum Projection {
-    /// Perspective (a rectilinear lens): straight lines stay straight; field of view < 180°.
-    #[default]
-    Pinhole,
-    /// Fisheye, equidistant: the image radius grows with the angle from the axis (r = f·θ).
-    Equidistant,
-    /// Fisheye, equisolid-angle: r = 2f·sin(θ/2), equal solid angles get equal areas.
-    Equisolid,
-    /// Parallel rays along the view direction (overviews and checks); the field of view is a
-    /// height in mm.
-    Orthographic,
+/// A ray in world millimetres: where it starts and its unit direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    /// Start, world mm (the eye, or for an orthographic camera a point of its image plane).
+    pub origin: DVec3,
+    /// Unit direction, world.
+    pub dir: DVec3,
 }
 
-impl Projection {
-    /// Every projection, in a fixed order.
-    pub const ALL: [Projection; 4] = [
-        Self::Pinhole,
-        Self::Equidistant,
-        Self::Equisolid,
-        Self::Orthographic,
-    ];
-
-    /// The name the CLI uses: `pinhole`, `equidistant`, `equisolid`, `orthographic`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Pinhole => "pinhole",
-            Self::Equidistant => "equidistant",
-            Self::Equisolid => "equisolid",
-            Self::Orthographic => "orthographic",
-        }
-    }
-
-    /// The projection called `name` (ASCII case ignored).
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|p| p.name().eq_ignore_ascii_case(name.trim()))
+impl Ray {
+    /// The point `t_mm` along the ray.
+    pub fn at(&self, t_mm: f64) -> DVec3 {
+        self.origin + self.dir * t_mm
     }
 }
 
-/// A pinhole perspective camera.
+/// One eye of an off-axis stereo pair: its position `offset_mm` along the camera's right
+/// vector (negative for the left eye), and the distance of the zero-parallax (focus) surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EyeShift {
+    /// Signed distance of this eye from the centre along `right`, mm.
+    pub offset_mm: f64,
+    /// Distance of the focus plane (pinhole) or sphere (fisheye) from the centre eye, mm.
+    pub focus_mm: f64,
+}
+
+/// A camera: pose, projection, lens, image size and near distance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     eye_mm: DVec3,
     forward: DVec3,
     right: DVec3,
     up: DVec3,
-    /// tan(fov / 2): the half height of the image plane at distance 1.
-    tan_half_fov: f64,
+    projection: Projection,
+    /// The field: degrees for the angular projections, mm of view height for orthographic.
+    field: f64,
+    /// Pinhole: tan(fov / 2), the half height of the image plane at distance 1; fisheye: half
+    /// the field in radians; orthographic: half the view height in mm.
+    half: f64,
+    lens: Lens,
     width: usize,
     height: usize,
     near_mm: f64,
+    eye_shift: Option<EyeShift>,
+    /// Added to every image position before it becomes a ray (sub-pixel jitter).
+    pixel_offset: [f64; 2],
+}
+
+/// What the four-ray set-up of a pinhole camera with an ideal lens needs
+/// ([`Camera::fast_pinhole`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PinholeRays {
+    /// Every ray's start (the eye, or a stereo eye).
+    pub origin: DVec3,
+    pub forward: DVec3,
+    pub right: DVec3,
+    pub up: DVec3,
+    pub tan_half_fov: f64,
+    /// Subtracted from the horizontal image-plane coordinate (an off-axis stereo eye), if any.
+    pub shift: Option<f64>,
+    pub pixel_offset: [f64; 2],
 }
 
 impl Camera {
-    /// A camera at `eye_mm` looking at `look_at_mm`, `up` giving the image's upward direction
-    /// (only its part perpendicular to the view matters), with a vertical field of view of
-    /// `fov_deg` (10°–170°) and an image of `width × height` pixels. The near distance starts at
-    /// 0; see [`Camera::with_near_mm`].
+    /// A pinhole camera at `eye_mm` looking at `look_at_mm`, `up` giving the image's upward
+    /// direction (only its part perpendicular to the view matters), with a vertical field of
+    /// view of `fov_deg` (10°–170°) and an image of `width × height` pixels. The near distance
+    /// starts at 0; see [`Camera::with_near_mm`], [`Camera::with_projection`] and
+    /// [`Camera::with_lens`] for the rest.
     pub fn look_at(
         eye_mm: DVec3,
         look_at_mm: DVec3,
@@ -127,15 +181,66 @@ impl Camera {
             forward,
             right,
             up: right.cross(forward),
-            tan_half_fov: (fov_deg.to_radians() / 2.0).tan(),
+            projection: Projection::Pinhole,
+            field: fov_deg,
+            half: (fov_deg.to_radians() / 2.0).tan(),
+            lens: Lens::default(),
             width,
             height,
             near_mm: 0.0,
+            eye_shift: None,
+            pixel_offset: [0.0; 2],
         })
     }
 
-    /// The same camera with rays starting on the plane `near_mm` in front of the eye (which may
-    /// lie inside tissue: nothing nearer is rendered).
+    /// The same camera with another projection and field: degrees across the image height for
+    /// pinhole (10°–170°) and fisheye (10°–360°), mm of view height for orthographic.
+    pub fn with_projection(self, projection: Projection, field: f64) -> Result<Self, CameraError> {
+        let (min, max) = projection.field_range();
+        if !(min..=max).contains(&field) {
+            return Err(CameraError::BadField {
+                projection: projection.name(),
+                field,
+                min,
+                max,
+                unit: projection.field_unit(),
+            });
+        }
+        if projection == Projection::Orthographic && self.eye_shift.is_some() {
+            return Err(CameraError::BadStereo(
+                "an orthographic camera has no stereo eyes".into(),
+            ));
+        }
+        let half = match projection {
+            Projection::Pinhole => (field.to_radians() / 2.0).tan(),
+            Projection::Equidistant | Projection::Equisolid => field.to_radians() / 2.0,
+            Projection::Orthographic => field / 2.0,
+        };
+        Ok(Self {
+            projection,
+            field,
+            half,
+            ..self
+        })
+    }
+
+    /// The same camera seen through `lens` (distortion coefficients within ±2, vignetting
+    /// 0–1).
+    pub fn with_lens(self, lens: Lens) -> Result<Self, CameraError> {
+        for (name, k) in [("k1", lens.distortion[0]), ("k2", lens.distortion[1])] {
+            if !k.is_finite() || k.abs() > lens::MAX_DISTORTION {
+                return Err(CameraError::BadLens(name, k, "−2…2"));
+            }
+        }
+        if !(0.0..=1.0).contains(&lens.vignetting) {
+            return Err(CameraError::BadLens("vignetting", lens.vignetting, "0…1"));
+        }
+        Ok(Self { lens, ..self })
+    }
+
+    /// The same camera with rays starting `near_mm` in front of the eye — on a plane for pinhole
+    /// and orthographic cameras, on a sphere for a fisheye — which may lie inside tissue:
+    /// nothing nearer is rendered.
     pub fn with_near_mm(self, near_mm: f64) -> Result<Self, CameraError> {
         if !near_mm.is_finite() || near_mm < 0.0 {
             return Err(CameraError::BadNear(near_mm));
@@ -143,7 +248,53 @@ impl Camera {
         Ok(Self { near_mm, ..self })
     }
 
-    /// Eye position, world mm.
+    /// This camera as one eye of an off-axis stereo pair (see [`StereoRig`], which is the usual
+    /// way to make one): the eye moves along `right` and every ray passes through the point
+    /// where the centre camera's ray of the same pixel meets the focus surface, so that surface
+    /// has zero parallax (an asymmetric frustum for a pinhole; never toe-in).
+    pub fn with_eye_shift(self, shift: EyeShift) -> Result<Self, CameraError> {
+        let EyeShift {
+            offset_mm,
+            focus_mm,
+        } = shift;
+        if self.projection == Projection::Orthographic {
+            return Err(CameraError::BadStereo(
+                "an orthographic camera has no stereo eyes".into(),
+            ));
+        }
+        if !offset_mm.is_finite() || !focus_mm.is_finite() || focus_mm <= offset_mm.abs() {
+            return Err(CameraError::BadStereo(format!(
+                "the focus distance {focus_mm} mm must be finite and larger than the eye offset {offset_mm} mm"
+            )));
+        }
+        Ok(Self {
+            eye_shift: Some(shift),
+            ..self
+        })
+    }
+
+    /// The same camera sampling each pixel `(dx, dy)` pixels away from its centre (sub-pixel
+    /// jitter for accumulated still frames).
+    pub fn with_pixel_offset(self, dx: f64, dy: f64) -> Self {
+        Self {
+            pixel_offset: [dx, dy],
+            ..self
+        }
+    }
+
+    /// The same camera with another image size (the field of view is kept).
+    pub fn with_size(self, [width, height]: [usize; 2]) -> Result<Self, CameraError> {
+        if !(1..=MAX_IMAGE_EDGE).contains(&width) || !(1..=MAX_IMAGE_EDGE).contains(&height) {
+            return Err(CameraError::BadSize(width, height));
+        }
+        Ok(Self {
+            width,
+            height,
+            ..self
+        })
+    }
+
+    /// Eye position (the centre of a stereo pair), world mm.
     pub fn eye_mm(&self) -> DVec3 {
         self.eye_mm
     }
@@ -163,14 +314,32 @@ impl Camera {
         self.up
     }
 
-    /// Tangent of half the vertical field of view.
-    pub(crate) fn tan_half_fov(&self) -> f64 {
-        self.tan_half_fov
+    /// The projection.
+    pub fn projection(&self) -> Projection {
+        self.projection
     }
 
-    /// Vertical field of view, degrees.
+    /// The field: degrees across the image height, or mm of view height (orthographic).
+    pub fn field(&self) -> f64 {
+        self.field
+    }
+
+    /// The lens.
+    pub fn lens(&self) -> Lens {
+        self.lens
+    }
+
+    /// The stereo eye this camera is, if it is one.
+    pub fn eye_shift(&self) -> Option<EyeShift> {
+        self.eye_shift
+    }
+
+    /// Vertical field of view, degrees (0 for an orthographic camera).
     pub fn fov_deg(&self) -> f64 {
-        2.0 * self.tan_half_fov.atan().to_degrees()
+        match self.projection {
+            Projection::Orthographic => 0.0,
+            _ => self.field,
+        }
     }
 
     /// Image width and height, pixels.
@@ -178,96 +347,209 @@ impl Camera {
         [self.width, self.height]
     }
 
-    /// Distance of the near plane from the eye along `forward`, mm.
+    /// Distance of the near plane (or sphere) from the eye, mm.
     pub fn near_mm(&self) -> f64 {
         self.near_mm
     }
 
-    /// Unit world direction of the ray through image point `(x, y)` in pixels (pixel centres at
-    /// half-integers, row 0 at the top).
-    pub fn direction(&self, x: f64, y: f64) -> DVec3 {
+    /// Where every ray starts, where they share a start (all but orthographic cameras).
+    pub fn shared_origin(&self) -> Option<DVec3> {
+        match self.projection {
+            Projection::Orthographic => None,
+            _ => Some(self.eye_origin()),
+        }
+    }
+
+    /// The eye this camera's rays start from (shifted for a stereo eye).
+    fn eye_origin(&self) -> DVec3 {
+        match self.eye_shift {
+            Some(e) => self.eye_mm + self.right * e.offset_mm,
+            None => self.eye_mm,
+        }
+    }
+
+    /// The numbers the four-ray set-up needs, for a pinhole camera with an ideal lens.
+    pub(crate) fn fast_pinhole(&self) -> Option<PinholeRays> {
+        (self.projection == Projection::Pinhole && self.lens.is_ideal()).then(|| PinholeRays {
+            origin: self.eye_origin(),
+            forward: self.forward,
+            right: self.right,
+            up: self.up,
+            tan_half_fov: self.half,
+            shift: self.eye_shift.map(|e| e.offset_mm / e.focus_mm),
+            pixel_offset: self.pixel_offset,
+        })
+    }
+
+    /// The ray through image point `(x, y)` in pixels (pixel centres at half-integers, row 0 at
+    /// the top), or `None` where the lens forms no image (outside a fisheye's circle, or beyond
+    /// the fold of a strong barrel distortion). The one definition of pixel → ray.
+    pub fn ray(&self, x: f64, y: f64) -> Option<Ray> {
         let (w, h) = (self.width as f64, self.height as f64);
-        let sy = (1.0 - 2.0 * y / h) * self.tan_half_fov;
-        let sx = (2.0 * x / w - 1.0) * self.tan_half_fov * w / h;
-        (self.forward + self.right * sx + self.up * sy).normalize()
+        let (x, y) = (x + self.pixel_offset[0], y + self.pixel_offset[1]);
+        let a = 2.0 * x / w - 1.0;
+        let b = 1.0 - 2.0 * y / h;
+        let s = self.lens.undistort_scale((a * w / h).hypot(b))?;
+        let eye = self.eye_origin();
+        match self.projection {
+            Projection::Pinhole => {
+                // Operation for operation as the four-ray set-up (render/rays4.rs).
+                let mut sx = a * self.half * w / h;
+                let mut sy = b * self.half;
+                if s != 1.0 {
+                    (sx, sy) = (sx * s, sy * s);
+                }
+                if let Some(e) = self.eye_shift {
+                    sx -= e.offset_mm / e.focus_mm;
+                }
+                let dir = (self.forward + self.right * sx + self.up * sy).normalize();
+                Some(Ray { origin: eye, dir })
+            }
+            Projection::Equidistant | Projection::Equisolid => {
+                let (u, v) = (a * w / h * s, b * s);
+                let dir = self.fisheye_direction(u, v)?;
+                Some(match self.eye_shift {
+                    Some(e) => {
+                        let focus = self.eye_mm + dir * e.focus_mm;
+                        Ray {
+                            origin: eye,
+                            dir: (focus - eye).normalize(),
+                        }
+                    }
+                    None => Ray { origin: eye, dir },
+                })
+            }
+            Projection::Orthographic => {
+                let (u, v) = (a * w / h * s, b * s);
+                let origin = eye + self.right * (u * self.half) + self.up * (v * self.half);
+                Some(Ray {
+                    origin,
+                    dir: self.forward,
+                })
+            }
+        }
     }
 
-    /// Unit world direction of the ray through the centre of pixel `(column, row)`.
-    pub fn pixel_direction(&self, column: usize, row: usize) -> DVec3 {
-        self.direction(column as f64 + 0.5, row as f64 + 0.5)
+    /// The unit direction at normalised position `(u, v)` of a fisheye (see the module doc).
+    fn fisheye_direction(&self, u: f64, v: f64) -> Option<DVec3> {
+        let r = u.hypot(v);
+        if r > 1.0 {
+            return None;
+        }
+        let theta = match self.projection {
+            Projection::Equisolid => 2.0 * (r * (self.half / 2.0).sin()).asin(),
+            _ => r * self.half,
+        };
+        if r == 0.0 {
+            return Some(self.forward);
+        }
+        let across = (self.right * u + self.up * v) / r;
+        Some((self.forward * theta.cos() + across * theta.sin()).normalize())
     }
 
-    /// Distance along a unit ray `direction` from the eye to the near plane, mm.
+    /// The ray through the centre of pixel `(column, row)`.
+    pub fn pixel_ray(&self, column: usize, row: usize) -> Option<Ray> {
+        self.ray(column as f64 + 0.5, row as f64 + 0.5)
+    }
+
+    /// The world point `depth_mm` along the ray of pixel `(column, row)` (a depth image's hit).
+    pub fn point_at(&self, column: usize, row: usize, depth_mm: f64) -> Option<DVec3> {
+        self.pixel_ray(column, row).map(|ray| ray.at(depth_mm))
+    }
+
+    /// Distance along a unit ray `direction` from its start to the near plane (pinhole,
+    /// orthographic) or sphere (fisheye), mm.
     pub fn near_distance_along(&self, direction: DVec3) -> f64 {
         if self.near_mm == 0.0 {
             0.0
+        } else if self.projection.is_fisheye() {
+            self.near_mm
         } else {
             self.near_mm / direction.dot(self.forward).max(1e-9)
         }
     }
 
-    /// The image position `(x, y)` in pixels where world point `p_mm` projects, or `None`
-    /// behind the eye. The inverse of [`Camera::direction`].
+    /// The brightness (0–1) the lens's vignetting leaves at image point `(x, y)`.
+    pub fn vignetting(&self, x: f64, y: f64) -> f64 {
+        if self.lens.vignetting == 0.0 {
+            return 1.0;
+        }
+        let (w, h) = (self.width as f64, self.height as f64);
+        let (u, v) = ((2.0 * x / w - 1.0) * w / h, 1.0 - 2.0 * y / h);
+        let edge2 = if self.projection.is_fisheye() {
+            1.0
+        } else {
+            (w / h).powi(2) + 1.0
+        };
+        self.lens.brightness((u * u + v * v) / edge2)
+    }
+
+    /// The image position `(x, y)` in pixels where world point `p_mm` projects, or `None` where
+    /// it is not seen (behind a pinhole or orthographic camera, outside a fisheye's field). The
+    /// inverse of [`Camera::ray`].
     pub fn project(&self, p_mm: DVec3) -> Option<(f64, f64)> {
-        let d = p_mm - self.eye_mm;
+        let (u, v) = match self.projection {
+            Projection::Pinhole => self.pinhole_uv(p_mm)?,
+            Projection::Equidistant | Projection::Equisolid => self.fisheye_uv(p_mm)?,
+            Projection::Orthographic => {
+                let d = p_mm - self.eye_mm;
+                if d.dot(self.forward) < 0.0 {
+                    return None;
+                }
+                (d.dot(self.right) / self.half, d.dot(self.up) / self.half)
+            }
+        };
+        let (u, v) = self.lens.distort((u, v));
+        let (w, h) = (self.width as f64, self.height as f64);
+        let x = (u * h / w + 1.0) / 2.0 * w;
+        let y = (1.0 - v) / 2.0 * h;
+        Some((x - self.pixel_offset[0], y - self.pixel_offset[1]))
+    }
+
+    /// Normalised position of `p_mm` seen through a pinhole.
+    fn pinhole_uv(&self, p_mm: DVec3) -> Option<(f64, f64)> {
+        let d = p_mm - self.eye_origin();
         let z = d.dot(self.forward);
         if z <= 0.0 {
             return None;
         }
-        let (w, h) = (self.width as f64, self.height as f64);
-        let sx = d.dot(self.right) / z / self.tan_half_fov * h / w;
-        let sy = d.dot(self.up) / z / self.tan_half_fov;
-        Some(((sx + 1.0) / 2.0 * w, (1.0 - sy) / 2.0 * h))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn follows_the_peer_convention() {
-        // The peers' default: eye (128,128,10) looking along +z with up +y, 90° vertical fov.
-        let cam = Camera::look_at(
-            DVec3::new(128.0, 128.0, 10.0),
-            DVec3::new(128.0, 128.0, 11.0),
-            DVec3::Y,
-            90.0,
-            [512, 256],
-        )
-        .unwrap();
-        assert_eq!(cam.right(), DVec3::Z.cross(DVec3::Y)); // −x
-                                                           // A point 45° up from the axis lands on the top edge; 45° right (of a 2:1 image whose
-                                                           // horizontal half-tangent is 2) lands a quarter of the width from the centre.
-        let (x, y) = cam.project(DVec3::new(128.0, 138.0, 20.0)).unwrap();
-        assert!((x - 256.0).abs() < 1e-9 && y.abs() < 1e-9);
-        let (x, y) = cam.project(DVec3::new(118.0, 128.0, 20.0)).unwrap();
-        assert!((x - 384.0).abs() < 1e-9 && (y - 128.0).abs() < 1e-9);
-        let d = cam.direction(100.0, 30.0);
-        let (x, y) = cam.project(cam.eye_mm() + d * 7.0).unwrap();
-        assert!((x - 100.0).abs() < 1e-9 && (y - 30.0).abs() < 1e-9);
-        assert!(cam.project(DVec3::new(128.0, 128.0, 0.0)).is_none());
-        assert!((cam.fov_deg() - 90.0).abs() < 1e-9);
+        let shift = self.eye_shift.map_or(0.0, |e| e.offset_mm / e.focus_mm);
+        Some((
+            (d.dot(self.right) / z + shift) / self.half,
+            d.dot(self.up) / z / self.half,
+        ))
     }
 
-    #[test]
-    fn rejects_bad_cameras() {
-        let ok = |eye, at, up, fov, size| Camera::look_at(eye, at, up, fov, size);
-        let (e, a) = (DVec3::ZERO, DVec3::Z);
-        assert!(ok(e, a, DVec3::Y, 90.0, [4, 4]).is_ok());
-        assert!(ok(DVec3::NAN, a, DVec3::Y, 90.0, [4, 4]).is_err());
-        assert!(ok(e, e, DVec3::Y, 90.0, [4, 4]).is_err());
-        assert!(ok(e, a, DVec3::Z, 90.0, [4, 4]).is_err());
-        assert!(ok(e, a, -DVec3::Z * 3.0, 90.0, [4, 4]).is_err());
-        assert!(ok(e, a, DVec3::ZERO, 90.0, [4, 4]).is_err());
-        assert!(ok(e, a, DVec3::Y, 9.0, [4, 4]).is_err());
-        assert!(ok(e, a, DVec3::Y, 171.0, [4, 4]).is_err());
-        assert!(ok(e, a, DVec3::Y, f64::NAN, [4, 4]).is_err());
-        assert!(ok(e, a, DVec3::Y, 90.0, [0, 4]).is_err());
-        let cam = ok(e, a, DVec3::Y, 170.0, [4, 4]).unwrap();
-        assert!(cam.with_near_mm(-1.0).is_err());
-        assert!(cam.with_near_mm(f64::INFINITY).is_err());
-        let near = cam.with_near_mm(2.0).unwrap();
-        assert!((near.near_distance_along(DVec3::Z) - 2.0).abs() < 1e-12);
+    /// Normalised position of `p_mm` seen through a fisheye.
+    fn fisheye_uv(&self, p_mm: DVec3) -> Option<(f64, f64)> {
+        // The direction from the centre eye to where this eye's ray meets the focus sphere.
+        let d = match self.eye_shift {
+            None => p_mm - self.eye_mm,
+            Some(e) => {
+                let o = self.right * e.offset_mm;
+                let q = p_mm - (self.eye_mm + o);
+                let (qq, oq) = (q.length_squared(), o.dot(q));
+                if qq == 0.0 {
+                    return None;
+                }
+                let disc = oq * oq - qq * (o.length_squared() - e.focus_mm * e.focus_mm);
+                let lambda = (-oq + disc.max(0.0).sqrt()) / qq;
+                o + q * lambda
+            }
+        };
+        let (along, x, y) = (d.dot(self.forward), d.dot(self.right), d.dot(self.up));
+        let across = x.hypot(y);
+        let theta = across.atan2(along);
+        if theta > self.half * (1.0 + 1e-12) {
+            return None;
+        }
+        let r = match self.projection {
+            Projection::Equisolid => (theta / 2.0).sin() / (self.half / 2.0).sin(),
+            _ => theta / self.half,
+        };
+        if across == 0.0 {
+            return Some((0.0, 0.0));
+        }
+        Some((r * x / across, r * y / across))
     }
 }

@@ -160,7 +160,7 @@ fn unseen_wall_is_tinted_in_an_overview() {
         .filter(|(_, d)| d.is_finite())
     {
         let (x, y) = (n % 64, n / 64);
-        let hit = view.eye_mm() + view.pixel_direction(x, y) * f64::from(*depth);
+        let hit = view.point_at(x, y, f64::from(*depth)).unwrap();
         let k = g.voxel_from_world().transform_point3(hit).z;
         let is_red = image.pixel(x, y) == Some(red);
         if k < 21.0 {

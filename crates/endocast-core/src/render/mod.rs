@@ -53,6 +53,8 @@ pub mod traverse;
 mod tests;
 
 pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
+
+use crate::camera::Ray;
 pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
 pub use frame::{Frame, RenderStats};
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
@@ -221,8 +223,8 @@ pub struct TraceSample {
 /// Everything about one pixel's ray: set-up, every sample, and the result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PixelTrace {
-    /// The ray in voxel space (mm parametrisation).
-    pub ray: VoxelRay,
+    /// The ray in voxel space (mm parametrisation); `None` where the camera forms no ray.
+    pub ray: Option<VoxelRay>,
     /// The ray's part inside the volume, mm from the eye; `None` when it misses.
     pub range_mm: Option<(f64, f64)>,
     /// Distance between samples, mm.
@@ -283,12 +285,10 @@ impl Prepared<'_> {
         };
         // Every ray starting at the eye (t = 0) shares its crossing side: decided once.
         // (The origin every ray's `VoxelRay::new` computes, in the sample grid's f32.)
-        let eye = self
-            .voxel_from_world
-            .transform_point3(camera.eye_mm())
-            .as_vec3();
-        let rising = integrator.rising_at(eye, self.params.lower.iso);
-        integrator.eye_side = Some((eye, rising));
+        integrator.eye_side = camera.shared_origin().map(|origin| {
+            let eye = self.voxel_from_world.transform_point3(origin).as_vec3();
+            (eye, integrator.rising_at(eye, self.params.lower.iso))
+        });
         integrator
     }
 
@@ -324,7 +324,8 @@ impl Prepared<'_> {
             integrator.run_group(&mut tasks);
             let row = tile.pixels.len();
             tile.pixels.resize(row + rect.x1 - rect.x0, missed);
-            for (&x, task) in columns.iter().zip(&tasks) {
+            for (&x, task) in columns.iter().zip(&mut tasks) {
+                vignette(camera, x, y, &mut task.out);
                 tile.pixels[row + x - rect.x0] = self.pixel_of(&task.out);
                 count_ray(&mut tile.stats, task);
             }
@@ -337,8 +338,12 @@ impl Prepared<'_> {
         let integrator = self.integrator(camera);
         let mut samples = Vec::new();
         let mut stats = RenderStats::default();
-        let out = self.pixel(&integrator, camera, x, y, &mut stats, &mut samples);
-        let (ray, range_mm) = self.ray(camera, x, y);
+        let mut out = self.pixel(&integrator, camera, x, y, &mut stats, &mut samples);
+        vignette(camera, x, y, &mut out);
+        let (ray, range_mm) = match self.ray(camera, x, y) {
+            Some((_, voxel, range)) => (Some(voxel), range),
+            None => (None, None),
+        };
         let map = self.renderer.volume.value_map();
         for s in &mut samples {
             s.value = s.value * map.scale() + map.offset();
@@ -355,18 +360,20 @@ impl Prepared<'_> {
         }
     }
 
-    /// The voxel-space ray of pixel `(x, y)` and its part inside the volume.
-    fn ray(&self, camera: &Camera, x: usize, y: usize) -> (VoxelRay, Option<(f64, f64)>) {
-        self.ray_along(camera, camera.pixel_direction(x, y))
-    }
-
-    /// The voxel-space ray from the eye along the unit world direction `dir`, and its part
-    /// inside the volume.
-    fn ray_along(&self, camera: &Camera, dir: DVec3) -> (VoxelRay, Option<(f64, f64)>) {
-        let ray = VoxelRay::new(&self.voxel_from_world, camera.eye_mm(), dir);
+    /// The ray of pixel `(x, y)`, in the world and in voxel space, and its part inside the
+    /// volume; `None` where the camera forms no ray.
+    fn ray(
+        &self,
+        camera: &Camera,
+        x: usize,
+        y: usize,
+    ) -> Option<(Ray, VoxelRay, Option<(f64, f64)>)> {
+        let ray = camera.pixel_ray(x, y)?;
+        let voxel = VoxelRay::new(&self.voxel_from_world, ray.origin, ray.dir);
         let dims = self.renderer.volume.dims();
         let extent = DVec3::from(dims.map(|n| (n - 1) as f64));
-        (ray, ray.clip(extent, camera.near_distance_along(dir)))
+        let range = voxel.clip(extent, camera.near_distance_along(ray.dir));
+        Some((ray, voxel, range))
     }
 
     /// The sample grid's offset for pixel `(x, y)`: mid-step, or a per-pixel hash with jitter.
@@ -397,11 +404,10 @@ impl Prepared<'_> {
 
     /// The ray of pixel `(x, y)` ready to render, or `None` where it misses the volume.
     fn task(&self, camera: &Camera, x: usize, y: usize) -> Option<RayTask> {
-        let dir = camera.pixel_direction(x, y);
-        let (ray, range) = self.ray_along(camera, dir);
+        let (ray, voxel, range) = self.ray(camera, x, y)?;
         let bricks = self.renderer.grid.bricks();
-        let march = RayMarch::new(&ray, range?, bricks, self.step_mm as f32, self.offset(x, y));
-        Some(RayTask::new(march, dir.as_vec3()))
+        let march = RayMarch::new(&voxel, range?, bricks, self.step_mm as f32, self.offset(x, y));
+        Some(RayTask::new(march, ray.dir.as_vec3()))
     }
 
     /// The rays of pixels `xs` of row `y` that meet the volume, and their columns: four at a
@@ -457,6 +463,14 @@ impl Prepared<'_> {
             depth_mm: out.depth_mm,
             value: (f64::from(out.value) * map.scale() + map.offset()) as f32,
         }
+    }
+}
+
+/// Darkens a ray's colour by the camera lens's vignetting at pixel `(x, y)`.
+fn vignette(camera: &Camera, x: usize, y: usize, out: &mut PixelOut) {
+    if camera.lens().vignetting > 0.0 {
+        let f = camera.vignetting(x as f64 + 0.5, y as f64 + 0.5) as f32;
+        out.accum.rgb *= f;
     }
 }
 

@@ -1,32 +1,34 @@
 //! Ray set-up for four pixels of a row at once (AVX2, `f64`): the camera ray, its voxel-space
 //! direction, its part inside the volume past the near plane and the start of its brick walk.
-//! Every lane repeats the one-ray set-up ([`Camera::direction`], [`VoxelRay::new`],
+//! A pinhole camera with an ideal lens (the common case) has its rays made here too; any other
+//! camera's come from [`Camera::ray`] one by one and only their clipping and walks run four at
+//! a time. Every lane repeats the one-ray set-up ([`Camera::ray`], [`VoxelRay::new`],
 //! [`VoxelRay::clip`], [`BrickDda::new`]) operation for operation, in the same order and with
 //! the same comparisons, so it gives the same bits; only the per-ray bookkeeping is shared.
 
 use super::traverse::{BrickDda, VoxelRay};
 use super::BRICK_VOX;
-use crate::camera::Camera;
+use crate::camera::{Camera, PinholeRays, Ray};
 use glam::{DAffine3, DVec3};
 use std::arch::x86_64::{
     __m256d, _mm256_add_pd, _mm256_and_pd, _mm256_andnot_pd, _mm256_blendv_pd, _mm256_cmp_pd,
     _mm256_cvttpd_epi32, _mm256_div_pd, _mm256_max_pd, _mm256_min_pd, _mm256_mul_pd,
-    _mm256_set1_pd, _mm256_setr_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
-    _mm_storeu_si128, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_LE_OQ, _CMP_NEQ_OQ,
+    _mm256_or_pd, _mm256_set1_pd, _mm256_setr_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
+    _mm_storeu_si128, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_OQ,
 };
 
-/// What a frame's rays share: the camera's frame and the volume's.
+/// What a frame's rays share: the camera, and the volume's frame.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct RaySetup {
-    forward: DVec3,
-    right: DVec3,
-    up: DVec3,
-    tan_half_fov: f64,
+    camera: Camera,
+    /// The pinhole fast path's numbers, where the camera is a pinhole with an ideal lens.
+    pinhole: Option<PinholeRays>,
     size: (f64, f64),
     near_mm: f64,
+    voxel_from_world: DAffine3,
     /// The world-to-voxel matrix's columns.
     axes: [DVec3; 3],
-    /// The eye in voxel space (every ray's origin).
+    /// The pinhole's eye in voxel space (every ray's origin).
     origin: DVec3,
     /// The voxel positions' box, `[0, extent]`.
     extent: DVec3,
@@ -43,6 +45,16 @@ pub(crate) struct LaneRay {
     pub dda: BrickDda,
 }
 
+/// Four lanes' rays before clipping: voxel-space origins and directions, unit world directions,
+/// near distances, and which lanes have a ray at all.
+struct Lanes4 {
+    origin: [__m256d; 3],
+    dir_world: [__m256d; 3],
+    dir_vox: [__m256d; 3],
+    t_min: __m256d,
+    valid: [bool; 4],
+}
+
 impl RaySetup {
     /// The set-up of `camera`'s rays through a volume of `dims` voxels in `bricks` bricks.
     pub fn new(
@@ -53,58 +65,71 @@ impl RaySetup {
     ) -> Self {
         let [w, h] = camera.size();
         let m = voxel_from_world.matrix3;
+        let pinhole = camera.fast_pinhole();
+        let eye = pinhole.map_or(camera.eye_mm(), |p| p.origin);
         Self {
-            forward: camera.forward(),
-            right: camera.right(),
-            up: camera.up(),
-            tan_half_fov: camera.tan_half_fov(),
+            camera: *camera,
+            pinhole,
             size: (w as f64, h as f64),
             near_mm: camera.near_mm(),
+            voxel_from_world: *voxel_from_world,
             axes: [m.x_axis, m.y_axis, m.z_axis],
-            origin: voxel_from_world.transform_point3(camera.eye_mm()),
+            origin: voxel_from_world.transform_point3(eye),
             extent: DVec3::from(dims.map(|n| (n - 1) as f64)),
             bricks: bricks.map(|b| i32::try_from(b).unwrap_or(i32::MAX)),
         }
     }
 
-    /// The rays of pixels `x0 .. x0 + 4` of row `y` (`None` where a ray misses the volume; lanes
-    /// past the image's right edge are computed all the same).
+    /// The rays of pixels `x0 .. x0 + 4` of row `y` (`None` where a ray misses the volume or
+    /// the camera forms none; lanes past the image's right edge are computed all the same).
     #[target_feature(enable = "avx2")]
     pub fn rays4(&self, x0: usize, y: usize) -> [Option<LaneRay>; 4] {
+        let lanes = match &self.pinhole {
+            Some(pinhole) => self.pinhole4(pinhole, x0, y),
+            None => self.camera4(x0, y),
+        };
+        self.finish(&lanes)
+    }
+
+    /// A pinhole's four rays, operation for operation as `Camera::ray` and `VoxelRay::new`.
+    #[target_feature(enable = "avx2")]
+    fn pinhole4(&self, p: &PinholeRays, x0: usize, y: usize) -> Lanes4 {
         let splat = _mm256_set1_pd;
         let (w, h) = self.size;
-        // As `Camera::pixel_direction` and `Camera::direction`.
         let column = |k: usize| (x0 + k) as f64;
         let x = _mm256_add_pd(
-            _mm256_setr_pd(column(0), column(1), column(2), column(3)),
-            splat(0.5),
+            _mm256_add_pd(
+                _mm256_setr_pd(column(0), column(1), column(2), column(3)),
+                splat(0.5),
+            ),
+            splat(p.pixel_offset[0]),
         );
-        let y = y as f64 + 0.5;
-        let sy = (1.0 - 2.0 * y / h) * self.tan_half_fov;
-        let sx = _mm256_div_pd(
+        let y = (y as f64 + 0.5) + p.pixel_offset[1];
+        let sy = (1.0 - 2.0 * y / h) * p.tan_half_fov;
+        let mut sx = _mm256_div_pd(
             _mm256_mul_pd(
                 _mm256_mul_pd(
                     _mm256_sub_pd(
                         _mm256_div_pd(_mm256_mul_pd(splat(2.0), x), splat(w)),
                         splat(1.0),
                     ),
-                    splat(self.tan_half_fov),
+                    splat(p.tan_half_fov),
                 ),
                 splat(w),
             ),
             splat(h),
         );
+        if let Some(shift) = p.shift {
+            sx = _mm256_sub_pd(sx, splat(shift));
+        }
         let v: [__m256d; 3] = std::array::from_fn(|c| {
-            let along_right = _mm256_add_pd(
-                splat(self.forward[c]),
-                _mm256_mul_pd(splat(self.right[c]), sx),
-            );
-            _mm256_add_pd(along_right, splat(self.up[c] * sy))
+            let along_right = _mm256_add_pd(splat(p.forward[c]), _mm256_mul_pd(splat(p.right[c]), sx));
+            _mm256_add_pd(along_right, splat(p.up[c] * sy))
         });
         let length = _mm256_sqrt_pd(dot(v, v));
         let recip = _mm256_div_pd(splat(1.0), length);
         let dir = v.map(|vc| _mm256_mul_pd(vc, recip));
-        // As `VoxelRay::new` (`DAffine3::transform_vector3`).
+        // As `DAffine3::transform_vector3`.
         let dir_vox: [__m256d; 3] = std::array::from_fn(|c| {
             let [ax, ay, az] = self.axes;
             _mm256_add_pd(
@@ -115,39 +140,79 @@ impl RaySetup {
                 _mm256_mul_pd(splat(az[c]), dir[2]),
             )
         });
-        let t_min = self.near_distance(dir);
-        let (t0, t1, inside) = self.clip(dir_vox, t_min);
-        let walk = self.walk_start(dir_vox, t0);
-        let (dir, dir_vox, t0, t1, inside) = (
-            dir.map(|v| doubles(v)),
-            dir_vox.map(|v| doubles(v)),
+        Lanes4 {
+            origin: self.origin.to_array().map(|c| _mm256_set1_pd(c)),
+            t_min: self.near_distance(p.forward, dir),
+            dir_world: dir,
+            dir_vox,
+            valid: [true; 4],
+        }
+    }
+
+    /// Any other camera's four rays: each from `Camera::ray` and `VoxelRay::new`.
+    #[target_feature(enable = "avx2")]
+    fn camera4(&self, x0: usize, y: usize) -> Lanes4 {
+        let rays: [Option<Ray>; 4] = std::array::from_fn(|k| self.camera.pixel_ray(x0 + k, y));
+        let voxel: [(VoxelRay, DVec3, f64); 4] = std::array::from_fn(|k| match rays[k] {
+            Some(r) => (
+                VoxelRay::new(&self.voxel_from_world, r.origin, r.dir),
+                r.dir,
+                self.camera.near_distance_along(r.dir),
+            ),
+            // A placeholder the mask drops.
+            None => (
+                VoxelRay {
+                    origin: DVec3::ZERO,
+                    direction: DVec3::ONE,
+                },
+                DVec3::ONE,
+                0.0,
+            ),
+        });
+        let lanes = |f: &dyn Fn(&(VoxelRay, DVec3, f64)) -> f64| {
+            _mm256_setr_pd(f(&voxel[0]), f(&voxel[1]), f(&voxel[2]), f(&voxel[3]))
+        };
+        Lanes4 {
+            origin: std::array::from_fn(|c| lanes(&|v| v.0.origin[c])),
+            dir_world: std::array::from_fn(|c| lanes(&|v| v.1[c])),
+            dir_vox: std::array::from_fn(|c| lanes(&|v| v.0.direction[c])),
+            t_min: lanes(&|v| v.2),
+            valid: rays.map(|r| r.is_some()),
+        }
+    }
+
+    /// Clips the lanes' rays to the volume and starts their brick walks.
+    #[target_feature(enable = "avx2")]
+    fn finish(&self, lanes: &Lanes4) -> [Option<LaneRay>; 4] {
+        let (t0, t1, inside) = self.clip(lanes.origin, lanes.dir_vox, lanes.t_min);
+        let walk = self.walk_start(lanes.origin, lanes.dir_vox, t0);
+        let (origin, dir, dir_vox, t0, t1, inside) = (
+            lanes.origin.map(|v| doubles(v)),
+            lanes.dir_world.map(|v| doubles(v)),
+            lanes.dir_vox.map(|v| doubles(v)),
             doubles(t0),
             doubles(t1),
             doubles(inside),
         );
         std::array::from_fn(|k| {
-            (inside[k] != 0.0).then(|| {
-                let direction = DVec3::new(dir_vox[0][k], dir_vox[1][k], dir_vox[2][k]);
-                LaneRay {
-                    ray: VoxelRay {
-                        origin: self.origin,
-                        direction,
-                    },
-                    dir_world: DVec3::new(dir[0][k], dir[1][k], dir[2][k]),
-                    range: (t0[k], t1[k]),
-                    dda: walk.lane(k, (t0[k], t1[k]), self.bricks),
-                }
+            (lanes.valid[k] && inside[k] != 0.0).then(|| LaneRay {
+                ray: VoxelRay {
+                    origin: DVec3::new(origin[0][k], origin[1][k], origin[2][k]),
+                    direction: DVec3::new(dir_vox[0][k], dir_vox[1][k], dir_vox[2][k]),
+                },
+                dir_world: DVec3::new(dir[0][k], dir[1][k], dir[2][k]),
+                range: (t0[k], t1[k]),
+                dda: walk.lane(k, (t0[k], t1[k]), self.bricks),
             })
         })
     }
 
     /// As `Camera::near_distance_along`.
     #[target_feature(enable = "avx2")]
-    fn near_distance(&self, dir: [__m256d; 3]) -> __m256d {
+    fn near_distance(&self, f: DVec3, dir: [__m256d; 3]) -> __m256d {
         if self.near_mm == 0.0 {
             return _mm256_set1_pd(0.0);
         }
-        let f = self.forward;
         let forward = [
             _mm256_set1_pd(f.x),
             _mm256_set1_pd(f.y),
@@ -164,17 +229,25 @@ impl RaySetup {
     /// As `VoxelRay::clip(extent, t_min)`: the lanes' `t0`, `t1` and a mask of the lanes whose
     /// interval is not empty.
     #[target_feature(enable = "avx2")]
-    fn clip(&self, dir: [__m256d; 3], t_min: __m256d) -> (__m256d, __m256d, __m256d) {
+    fn clip(
+        &self,
+        origin: [__m256d; 3],
+        dir: [__m256d; 3],
+        t_min: __m256d,
+    ) -> (__m256d, __m256d, __m256d) {
         let (mut t0, mut t1) = (t_min, _mm256_set1_pd(f64::INFINITY));
         let mut missed = _mm256_set1_pd(0.0);
         for (axis, &d) in dir.iter().enumerate() {
-            let (o, hi) = (self.origin[axis], self.extent[axis]);
+            let (o, hi) = (origin[axis], _mm256_set1_pd(self.extent[axis]));
             let parallel = _mm256_cmp_pd::<_CMP_EQ_OQ>(d, _mm256_set1_pd(0.0));
-            if o < 0.0 || o > hi {
-                missed = _mm256_blendv_pd(missed, parallel, parallel);
-            }
-            let a = _mm256_div_pd(_mm256_set1_pd(0.0 - o), d);
-            let b = _mm256_div_pd(_mm256_set1_pd(hi - o), d);
+            // `o < 0.0 || o > hi` per lane.
+            let outside = _mm256_or_pd(
+                _mm256_cmp_pd::<_CMP_LT_OQ>(o, _mm256_set1_pd(0.0)),
+                _mm256_cmp_pd::<_CMP_GT_OQ>(o, hi),
+            );
+            missed = _mm256_or_pd(missed, _mm256_and_pd(parallel, outside));
+            let a = _mm256_div_pd(_mm256_sub_pd(_mm256_set1_pd(0.0), o), d);
+            let b = _mm256_div_pd(_mm256_sub_pd(hi, o), d);
             // `t0.max(a.min(b))` and `t1.min(a.max(b))`; a NaN operand yields the other, as
             // `f64::max` and `f64::min` do.
             let entered = _mm256_max_pd(_mm256_min_pd(a, b), t0);
@@ -193,7 +266,7 @@ impl RaySetup {
 
     /// As `BrickDda::new`: each lane's first brick, step directions and face distances.
     #[target_feature(enable = "avx2")]
-    fn walk_start(&self, dir: [__m256d; 3], t_start: __m256d) -> WalkStart {
+    fn walk_start(&self, origin: [__m256d; 3], dir: [__m256d; 3], t_start: __m256d) -> WalkStart {
         let brick = BRICK_VOX as f64;
         let splat = _mm256_set1_pd;
         let mut start = WalkStart {
@@ -203,9 +276,9 @@ impl RaySetup {
             step: [[0; 4]; 3],
         };
         for (axis, &d) in dir.iter().enumerate() {
-            let o = self.origin[axis];
+            let o = origin[axis];
             let at = _mm256_div_pd(
-                _mm256_add_pd(splat(o), _mm256_mul_pd(d, t_start)),
+                _mm256_add_pd(o, _mm256_mul_pd(d, t_start)),
                 splat(brick),
             );
             let cell = truncate(at).map(|c| c.clamp(0, self.bricks[axis] - 1));
@@ -218,7 +291,7 @@ impl RaySetup {
                 face_of(cell[3], up[3]),
             );
             let t_next = doubles(_mm256_div_pd(
-                _mm256_sub_pd(_mm256_mul_pd(face, splat(brick)), splat(o)),
+                _mm256_sub_pd(_mm256_mul_pd(face, splat(brick)), o),
                 d,
             ));
             let forward = doubles(_mm256_div_pd(splat(brick), d));

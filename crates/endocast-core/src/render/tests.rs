@@ -62,7 +62,7 @@ fn sphere_depth_error(eye_offset: DVec3, refine_steps: u32) -> f64 {
         let frame = prepared.render(&camera);
         for y in 0..24 {
             for x in 0..24 {
-                let dir = camera.pixel_direction(x, y);
+                let dir = camera.pixel_ray(x, y).unwrap().dir;
                 let expected =
                     sphere_distance(eye_vox, dir, shell.centre_vox, shell.inner_radius_vox);
                 let depth = f64::from(frame.depth_mm[x + 24 * y]);
@@ -105,7 +105,7 @@ fn tube_depth_from_inside_matches_the_cylinder() {
     let mut checked = 0;
     for y in 0..32 {
         for x in 0..32 {
-            let d = camera.pixel_direction(x, y);
+            let d = camera.pixel_ray(x, y).unwrap().dir;
             // |(e + t d − a)⊥| = R in the i–j plane.
             let (e, dp) = ((eye_vox - axis).truncate(), d.truncate());
             let (a, b, c) = (
@@ -459,7 +459,7 @@ fn two_iso_shows_the_stent_in_front_of_the_wall() {
         for x in 0..32 {
             let depth = f64::from(frame.depth_mm[x + 32 * y]);
             assert!(depth.is_finite(), "({x}, {y}) sees nothing");
-            let dir = camera.pixel_direction(x, y);
+            let dir = camera.pixel_ray(x, y).unwrap().dir;
             // Metal within a voxel behind the hit (a strut is thin; rays may graze it).
             let metal = (0..10).any(|n| {
                 let p = middle + dir * (depth + 0.1 * f64::from(n));
@@ -532,7 +532,7 @@ fn mip_and_minip_match_a_brute_force_reference() {
                     if t >= t1 {
                         break;
                     }
-                    let p = trace.ray.at(t).clamp(DVec3::ZERO, extent);
+                    let p = trace.ray.unwrap().at(t).clamp(DVec3::ZERO, extent);
                     let v = volume.sample_physical(p).unwrap();
                     best = Some(match (best, mode) {
                         (None, _) => v,

@@ -1,0 +1,70 @@
+//! The projections a camera can have, and their field-of-view ranges.
+
+/// How a camera maps view directions to image positions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Projection {
+    /// Perspective (a rectilinear lens): straight lines stay straight; field of view < 180°.
+    #[default]
+    Pinhole,
+    /// Fisheye, equidistant: the image radius grows with the angle from the axis (r = f·θ).
+    Equidistant,
+    /// Fisheye, equisolid-angle: r = 2f·sin(θ/2), equal solid angles get equal areas.
+    Equisolid,
+    /// Parallel rays along the view direction (overviews and checks); the field of view is a
+    /// height in mm.
+    Orthographic,
+}
+
+impl Projection {
+    /// Every projection, in a fixed order.
+    pub const ALL: [Projection; 4] = [
+        Self::Pinhole,
+        Self::Equidistant,
+        Self::Equisolid,
+        Self::Orthographic,
+    ];
+
+    /// The name the CLI uses: `pinhole`, `equidistant`, `equisolid`, `orthographic`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Pinhole => "pinhole",
+            Self::Equidistant => "equidistant",
+            Self::Equisolid => "equisolid",
+            Self::Orthographic => "orthographic",
+        }
+    }
+
+    /// The projection called `name` (ASCII case ignored).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name().eq_ignore_ascii_case(name.trim()))
+    }
+}
+
+impl Projection {
+    /// Whether this is one of the fisheye projections (the field is an angle across the image
+    /// circle, and rays at more than 90° from the axis exist).
+    pub fn is_fisheye(self) -> bool {
+        matches!(self, Self::Equidistant | Self::Equisolid)
+    }
+
+    /// The accepted range of the field: degrees for the angular projections (pinhole
+    /// [`FOV_RANGE_DEG`](super::FOV_RANGE_DEG), fisheye 10°–360°), mm of view height for the
+    /// orthographic one.
+    pub fn field_range(self) -> (f64, f64) {
+        match self {
+            Self::Pinhole => super::FOV_RANGE_DEG,
+            Self::Equidistant | Self::Equisolid => (10.0, 360.0),
+            Self::Orthographic => (1e-3, 1e6),
+        }
+    }
+
+    /// The unit of the field, in words.
+    pub fn field_unit(self) -> &'static str {
+        match self {
+            Self::Orthographic => "mm of view height",
+            _ => "degrees of field of view",
+        }
+    }
+}
