@@ -94,7 +94,9 @@ mod tests {
             };
             for &(u, v) in &[(0.3, 0.1), (-0.7, 0.5), (0.0, -0.9), (1.1, 0.4)] {
                 let (du, dv) = lens.distort((u, v));
-                let s = lens.undistort_scale(du.hypot(dv)).expect("inside the image");
+                let s = lens
+                    .undistort_scale(du.hypot(dv))
+                    .expect("inside the image");
                 assert!((du * s - u).abs() < 1e-12 && (dv * s - v).abs() < 1e-12);
             }
         }

@@ -51,6 +51,9 @@ pub use sphere_shell::{sphere_shell, SphereShell};
 pub use straight_tube::{straight_tube, Tube};
 pub use vessel::{vessel, Stent, Vessel};
 
+#[cfg(test)]
+pub(crate) use raster::rasterize;
+
 use crate::Volume;
 
 /// The phantoms, by name.

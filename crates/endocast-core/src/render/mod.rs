@@ -50,6 +50,8 @@ mod transfer;
 pub mod traverse;
 
 #[cfg(test)]
+mod camera_tests;
+#[cfg(test)]
 mod tests;
 
 pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
@@ -209,6 +211,14 @@ pub struct Prepared<'a> {
     voxel_from_world: DAffine3,
 }
 
+/// A pixel's ray in the world and in voxel space, and its part inside the volume (mm).
+#[derive(Debug, Clone, Copy)]
+struct PixelRay {
+    world: Ray,
+    voxel: VoxelRay,
+    range: Option<(f64, f64)>,
+}
+
 /// One sample of a traced pixel (see [`Prepared::trace_pixel`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TraceSample {
@@ -340,16 +350,14 @@ impl Prepared<'_> {
         let mut stats = RenderStats::default();
         let mut out = self.pixel(&integrator, camera, x, y, &mut stats, &mut samples);
         vignette(camera, x, y, &mut out);
-        let (ray, range_mm) = match self.ray(camera, x, y) {
-            Some((_, voxel, range)) => (Some(voxel), range),
-            None => (None, None),
-        };
+        let ray = self.ray(camera, x, y);
+        let range_mm = ray.and_then(|r| r.range);
         let map = self.renderer.volume.value_map();
         for s in &mut samples {
             s.value = s.value * map.scale() + map.offset();
         }
         PixelTrace {
-            ray,
+            ray: ray.map(|r| r.voxel),
             range_mm,
             step_mm: self.step_mm,
             offset: self.offset(x, y),
@@ -362,18 +370,17 @@ impl Prepared<'_> {
 
     /// The ray of pixel `(x, y)`, in the world and in voxel space, and its part inside the
     /// volume; `None` where the camera forms no ray.
-    fn ray(
-        &self,
-        camera: &Camera,
-        x: usize,
-        y: usize,
-    ) -> Option<(Ray, VoxelRay, Option<(f64, f64)>)> {
-        let ray = camera.pixel_ray(x, y)?;
-        let voxel = VoxelRay::new(&self.voxel_from_world, ray.origin, ray.dir);
+    fn ray(&self, camera: &Camera, x: usize, y: usize) -> Option<PixelRay> {
+        let world = camera.pixel_ray(x, y)?;
+        let voxel = VoxelRay::new(&self.voxel_from_world, world.origin, world.dir);
         let dims = self.renderer.volume.dims();
         let extent = DVec3::from(dims.map(|n| (n - 1) as f64));
-        let range = voxel.clip(extent, camera.near_distance_along(ray.dir));
-        Some((ray, voxel, range))
+        let range = voxel.clip(extent, camera.near_distance_along(world.dir));
+        Some(PixelRay {
+            world,
+            voxel,
+            range,
+        })
     }
 
     /// The sample grid's offset for pixel `(x, y)`: mid-step, or a per-pixel hash with jitter.
@@ -404,10 +411,10 @@ impl Prepared<'_> {
 
     /// The ray of pixel `(x, y)` ready to render, or `None` where it misses the volume.
     fn task(&self, camera: &Camera, x: usize, y: usize) -> Option<RayTask> {
-        let (ray, voxel, range) = self.ray(camera, x, y)?;
-        let bricks = self.renderer.grid.bricks();
-        let march = RayMarch::new(&voxel, range?, bricks, self.step_mm as f32, self.offset(x, y));
-        Some(RayTask::new(march, ray.dir.as_vec3()))
+        let ray = self.ray(camera, x, y)?;
+        let (bricks, step) = (self.renderer.grid.bricks(), self.step_mm as f32);
+        let march = RayMarch::new(&ray.voxel, ray.range?, bricks, step, self.offset(x, y));
+        Some(RayTask::new(march, ray.world.dir.as_vec3()))
     }
 
     /// The rays of pixels `xs` of row `y` that meet the volume, and their columns: four at a

@@ -12,8 +12,8 @@ use crate::camera::{Camera, PinholeRays, Ray};
 use glam::{DAffine3, DVec3};
 use std::arch::x86_64::{
     __m256d, _mm256_add_pd, _mm256_and_pd, _mm256_andnot_pd, _mm256_blendv_pd, _mm256_cmp_pd,
-    _mm256_cvttpd_epi32, _mm256_div_pd, _mm256_max_pd, _mm256_min_pd, _mm256_mul_pd,
-    _mm256_or_pd, _mm256_set1_pd, _mm256_setr_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
+    _mm256_cvttpd_epi32, _mm256_div_pd, _mm256_max_pd, _mm256_min_pd, _mm256_mul_pd, _mm256_or_pd,
+    _mm256_set1_pd, _mm256_setr_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
     _mm_storeu_si128, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_OQ,
 };
 
@@ -123,7 +123,8 @@ impl RaySetup {
             sx = _mm256_sub_pd(sx, splat(shift));
         }
         let v: [__m256d; 3] = std::array::from_fn(|c| {
-            let along_right = _mm256_add_pd(splat(p.forward[c]), _mm256_mul_pd(splat(p.right[c]), sx));
+            let along_right =
+                _mm256_add_pd(splat(p.forward[c]), _mm256_mul_pd(splat(p.right[c]), sx));
             _mm256_add_pd(along_right, splat(p.up[c] * sy))
         });
         let length = _mm256_sqrt_pd(dot(v, v));
@@ -277,10 +278,7 @@ impl RaySetup {
         };
         for (axis, &d) in dir.iter().enumerate() {
             let o = origin[axis];
-            let at = _mm256_div_pd(
-                _mm256_add_pd(o, _mm256_mul_pd(d, t_start)),
-                splat(brick),
-            );
+            let at = _mm256_div_pd(_mm256_add_pd(o, _mm256_mul_pd(d, t_start)), splat(brick));
             let cell = truncate(at).map(|c| c.clamp(0, self.bricks[axis] - 1));
             // The face ahead: `cell + 1` going up, `cell` going down.
             let up = doubles(_mm256_cmp_pd::<_CMP_GE_OQ>(d, splat(0.0)));

@@ -1,6 +1,7 @@
 //! Image-space views around the endoscope: an RGB [`Image`] with small drawing primitives and a
 //! built-in bitmap [`font`], the orthogonal [`slices`] through the camera, and the
-//! [`dashboard`] that puts the endoscopic view, the slices and an overview side by side.
+//! [`dashboard`] that puts the endoscopic view, the slices and an overview side by side, and
+//! the [`stereo`] outputs that combine two eyes' views.
 //!
 //! No file formats here: the writers live in `endocast-io`.
 //!
@@ -21,6 +22,7 @@
 pub mod dashboard;
 pub mod font;
 pub mod slices;
+pub mod stereo;
 
 use crate::render::{Frame, MAX_IMAGE_EDGE};
 use glam::DVec3;
@@ -71,6 +73,9 @@ pub enum ViewError {
         /// The accepted range, in words.
         range: &'static str,
     },
+    /// Two images that must have one size do not.
+    #[error("the two images differ in size ({0:?} and {1:?} pixels)")]
+    SizesDiffer([usize; 2], [usize; 2]),
 }
 
 /// An RGB image, 8 bits per channel, row 0 at the top, `R G B` interleaved.
