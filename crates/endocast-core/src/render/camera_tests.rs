@@ -246,3 +246,51 @@ fn every_camera_gives_the_one_ray_pixels() {
         }
     }
 }
+
+/// The right eye rendered with the searches the left eye's emptiness allows is the right eye
+/// rendered alone, bit for bit, with far fewer samples; modes that composite in front of the
+/// surface, and eyes the sharing does not cover, fall back to plain renders.
+#[test]
+fn the_second_eye_starts_late_and_gives_the_same_image() {
+    use super::tests::{assert_same_image, colon_view};
+    let (renderer, camera) = colon_view(160, 0.3, 96);
+    let rig = StereoRig {
+        eye_separation_mm: 1.0,
+        focus_mm: 12.0,
+    };
+    let [left, right] = rig.eyes(&camera).unwrap();
+    for (mode, opacity, jitter) in [
+        (Mode::Iso, 1.0, false),
+        (Mode::Hybrid, 0.6, true),
+        (Mode::Hybrid, 0.3, false),
+        (Mode::Dvr, 1.0, false),
+    ] {
+        let settings = RenderSettings {
+            mode,
+            iso_opacity: opacity,
+            jitter,
+            tf: TransferFunction::preset("complex").unwrap(),
+            ..iso()
+        };
+        let prepared = renderer.prepare(&settings).unwrap();
+        let [l, r] = prepared.render_stereo(&camera, &rig).unwrap();
+        let (alone_l, alone_r) = (prepared.render(&left), prepared.render(&right));
+        assert_same_image(&l, &alone_l, &format!("{mode:?} left"));
+        assert_same_image(&r, &alone_r, &format!("{mode:?} right"));
+        if mode == Mode::Iso {
+            let (shared, own) = (r.stats.samples, alone_r.stats.samples);
+            assert!(2 * shared < own, "{shared} samples against {own}");
+        }
+    }
+    // A fisheye pair and a pair with a near plane render as two plain eyes.
+    let prepared = renderer.prepare(&iso()).unwrap();
+    for camera in [
+        camera.with_projection(Projection::Equidistant, 170.0).unwrap(),
+        camera.with_near_mm(2.0).unwrap(),
+    ] {
+        let [l, r] = prepared.render_stereo(&camera, &rig).unwrap();
+        let [left, right] = rig.eyes(&camera).unwrap();
+        assert_same_image(&l, &prepared.render(&left), "left");
+        assert_same_image(&r, &prepared.render(&right), "right");
+    }
+}

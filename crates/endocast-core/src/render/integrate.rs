@@ -249,7 +249,7 @@ impl Integrator<'_> {
     /// Whether the value rises through `iso` at the surface, for a ray starting at `march`. In
     /// auto mode the value at the start decides; a brick that cannot hold `iso` tells which side
     /// it lies on without a sample.
-    fn rising(&self, march: &RayMarch, iso: f32) -> bool {
+    pub fn rising(&self, march: &RayMarch, iso: f32) -> bool {
         let grid = march.grid();
         match self.eye_side {
             Some((eye, rising))

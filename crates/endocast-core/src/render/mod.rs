@@ -47,6 +47,7 @@ mod sample;
 mod settings;
 mod tiles;
 mod transfer;
+mod stereo;
 pub mod traverse;
 
 #[cfg(test)]
@@ -71,7 +72,8 @@ use march::RayMarch;
 use rays4::RaySetup;
 use std::time::Instant;
 use tiles::{Pixel, Tile, TileRect, Tiling, TILE};
-use traverse::VoxelRay;
+use stereo::SearchStarts;
+use traverse::{BrickDda, VoxelRay};
 
 use crate::Volume;
 
@@ -312,15 +314,32 @@ impl Prepared<'_> {
     /// [`Self::render`] into `frame`, reusing its buffers (a loop over many frames of one size
     /// then allocates none: fresh buffers cost about 2 ms a frame in page faults).
     pub fn render_into(&self, camera: &Camera, frame: &mut Frame) {
+        self.render_with_starts(camera, frame, None);
+    }
+
+    /// [`Self::render_into`], the isosurface searches starting at `starts` where given (the
+    /// second eye of a stereo pair, [`stereo`]).
+    fn render_with_starts(
+        &self,
+        camera: &Camera,
+        frame: &mut Frame,
+        starts: Option<&SearchStarts>,
+    ) {
         let start = Instant::now();
         let integrator = self.integrator(camera);
-        let tile = |rect| self.tile(&integrator, camera, rect);
+        let tile = |rect| self.tile(&integrator, camera, rect, starts);
         Tiling::new(camera.size()).render_into(tile, frame);
         frame.stats.time = start.elapsed();
     }
 
     /// Renders the pixels of `rect`, each row's rays as one group.
-    fn tile(&self, integrator: &Integrator<'_>, camera: &Camera, rect: TileRect) -> Tile {
+    fn tile(
+        &self,
+        integrator: &Integrator<'_>,
+        camera: &Camera,
+        rect: TileRect,
+        starts: Option<&SearchStarts>,
+    ) -> Tile {
         let mut tile = Tile {
             pixels: Vec::with_capacity((rect.x1 - rect.x0) * (rect.y1 - rect.y0)),
             stats: RenderStats::default(),
@@ -330,7 +349,11 @@ impl Prepared<'_> {
         for y in rect.y0..rect.y1 {
             columns.clear();
             tasks.clear();
-            self.row_tasks(camera, y, rect.x0..rect.x1, &mut columns, &mut tasks);
+            let xs = rect.x0..rect.x1;
+            self.row_tasks(camera, y, xs, &mut columns, &mut tasks);
+            if let Some(starts) = starts {
+                self.start_late(integrator, camera, y, starts, &columns, &mut tasks);
+            }
             integrator.run_group(&mut tasks);
             let row = tile.pixels.len();
             tile.pixels.resize(row + rect.x1 - rect.x0, missed);
@@ -450,6 +473,45 @@ impl Prepared<'_> {
             if let Some(task) = self.task(camera, x, y) {
                 columns.push(x);
                 tasks.push(task);
+            }
+        }
+    }
+
+    /// Moves the searches of row `y`'s rays to their `starts` where the samples before the
+    /// region known to be empty (up to the check distance) all lie on the eye's side of the
+    /// isovalue; the sample grid stays the ray's own.
+    fn start_late(
+        &self,
+        integrator: &Integrator<'_>,
+        camera: &Camera,
+        y: usize,
+        starts: &SearchStarts,
+        columns: &[usize],
+        tasks: &mut [RayTask],
+    ) {
+        let iso = self.params.lower.iso;
+        for (&x, task) in columns.iter().zip(tasks) {
+            let Some((check, start)) = starts.at(x, y) else {
+                continue;
+            };
+            let (grid, end) = (task.march.grid(), task.march.parts().2);
+            if start <= grid.t_start {
+                continue;
+            }
+            let rising = integrator.rising(&task.march, iso);
+            let prefix = (0..end).take_while(|&n| n == 0 || grid.t_of(n - 1) <= check);
+            let empty = prefix
+                .map(|n| integrator.sampler.value(grid.at(grid.t_of(n))))
+                .all(|v| (v < iso) == rising);
+            if empty {
+                let Some(ray) = self.ray(camera, x, y) else {
+                    continue;
+                };
+                let Some((t0, t1)) = ray.range else { continue };
+                let t_start = f64::from(start).min(t1);
+                let dda = BrickDda::new(&ray.voxel, (t_start, t1), self.renderer.grid.bricks());
+                let (step, offset) = (self.step_mm as f32, self.offset(x, y));
+                task.march = RayMarch::with_walk(dda, &ray.voxel, (t0, t1), step, offset);
             }
         }
     }

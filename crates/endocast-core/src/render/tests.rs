@@ -188,7 +188,7 @@ fn dvr_of_a_homogeneous_slab_follows_beer_lambert_at_any_step() {
 
 /// The colon phantom and a camera on its centreline at arc-length fraction `at`, looking along
 /// it.
-fn colon_view(size: usize, at: f64, image: usize) -> (Renderer, Camera) {
+pub(super) fn colon_view(size: usize, at: f64, image: usize) -> (Renderer, Camera) {
     let (volume, colon) = phantom::colon(&options(size));
     let s = colon.centreline.length_vox() * at;
     let eye = colon.centreline.point_at(s);
@@ -213,7 +213,7 @@ fn assert_same<T: PartialEq + std::fmt::Debug>(a: &[T], b: &[T], what: &str) {
     }
 }
 
-fn assert_same_image(a: &Frame, b: &Frame, what: &str) {
+pub(super) fn assert_same_image(a: &Frame, b: &Frame, what: &str) {
     assert_same(&a.rgb, &b.rgb, &format!("{what}: colours"));
     assert_same(&a.alpha, &b.alpha, &format!("{what}: opacities"));
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
