@@ -108,6 +108,48 @@ pub struct EyeShift {
     pub focus_mm: f64,
 }
 
+/// Everything about a camera but its pose and image size: projection, field, lens and near
+/// distance (what a command's options or a preset say once for every frame of a flight).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Optics {
+    /// The projection.
+    pub projection: Projection,
+    /// Degrees across the image height, or mm of view height (orthographic).
+    pub field: f64,
+    /// Distortion and vignetting.
+    pub lens: Lens,
+    /// Near distance, mm.
+    pub near_mm: f64,
+}
+
+impl Default for Optics {
+    /// A pinhole with a 90° vertical field of view and a perfect lens.
+    fn default() -> Self {
+        Self {
+            projection: Projection::Pinhole,
+            field: 90.0,
+            lens: Lens::default(),
+            near_mm: 0.0,
+        }
+    }
+}
+
+impl Optics {
+    /// The camera at `eye_mm` looking at `look_at_mm` with `up`, of `size` pixels.
+    pub fn camera(
+        &self,
+        eye_mm: DVec3,
+        look_at_mm: DVec3,
+        up: DVec3,
+        size: [usize; 2],
+    ) -> Result<Camera, CameraError> {
+        Camera::look_at(eye_mm, look_at_mm, up, 90.0, size)?
+            .with_projection(self.projection, self.field)?
+            .with_lens(self.lens)?
+            .with_near_mm(self.near_mm)
+    }
+}
+
 /// A camera: pose, projection, lens, image size and near distance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {

@@ -207,3 +207,22 @@ fn vignetting_darkens_the_corners_only_as_asked() {
     assert_eq!(dark.vignetting(20.0, 20.0), 1.0);
     assert!((dark.vignetting(0.0, 0.0) - 0.5).abs() < 1e-12);
 }
+
+#[test]
+fn optics_make_the_camera_look_at_makes() {
+    let (eye, at) = (DVec3::new(1.0, 2.0, 3.0), DVec3::new(4.0, -1.0, 9.0));
+    let plain = Camera::look_at(eye, at, DVec3::Z, 70.0, [33, 21]).unwrap();
+    let optics = Optics {
+        field: 70.0,
+        ..Optics::default()
+    };
+    assert_eq!(optics.camera(eye, at, DVec3::Z, [33, 21]).unwrap(), plain);
+    let fisheye = Optics {
+        projection: Projection::Equisolid,
+        field: 220.0,
+        near_mm: 1.0,
+        ..Optics::default()
+    };
+    let camera = fisheye.camera(eye, at, DVec3::Z, [33, 21]).unwrap();
+    assert_eq!((camera.field(), camera.near_mm()), (220.0, 1.0));
+}

@@ -285,7 +285,9 @@ fn the_second_eye_starts_late_and_gives_the_same_image() {
     // A fisheye pair and a pair with a near plane render as two plain eyes.
     let prepared = renderer.prepare(&iso()).unwrap();
     for camera in [
-        camera.with_projection(Projection::Equidistant, 170.0).unwrap(),
+        camera
+            .with_projection(Projection::Equidistant, 170.0)
+            .unwrap(),
         camera.with_near_mm(2.0).unwrap(),
     ] {
         let [l, r] = prepared.render_stereo(&camera, &rig).unwrap();

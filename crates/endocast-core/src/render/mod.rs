@@ -45,9 +45,9 @@ mod packet;
 mod rays4;
 mod sample;
 mod settings;
+mod stereo;
 mod tiles;
 mod transfer;
-mod stereo;
 pub mod traverse;
 
 #[cfg(test)]
@@ -71,8 +71,8 @@ use march::RayMarch;
 #[cfg(target_arch = "x86_64")]
 use rays4::RaySetup;
 use std::time::Instant;
-use tiles::{Pixel, Tile, TileRect, Tiling, TILE};
 use stereo::SearchStarts;
+use tiles::{Pixel, Tile, TileRect, Tiling, TILE};
 use traverse::{BrickDda, VoxelRay};
 
 use crate::Volume;

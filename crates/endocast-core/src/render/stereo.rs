@@ -72,7 +72,11 @@ impl Prepared<'_> {
     }
 
     /// [`Self::render_stereo_into`] into new frames.
-    pub fn render_stereo(&self, camera: &Camera, rig: &StereoRig) -> Result<[Frame; 2], CameraError> {
+    pub fn render_stereo(
+        &self,
+        camera: &Camera,
+        rig: &StereoRig,
+    ) -> Result<[Frame; 2], CameraError> {
         let mut frames = [Frame::default(), Frame::default()];
         self.render_stereo_into(camera, rig, &mut frames)?;
         Ok(frames)
@@ -118,26 +122,23 @@ impl Prepared<'_> {
         let margin = 0.5 * spacing + 2.0 * self.step_mm;
         let forward_depth = forward_depths(left, left_frame);
         let mut starts = vec![[f32::NAN; 2]; w * h];
-        starts
-            .par_chunks_mut(w)
-            .enumerate()
-            .for_each(|(y, row)| {
-                let columns = RowBounds::new(&forward_depth, [w, h], y, k, margin);
-                for (x, start) in row.iter_mut().enumerate() {
-                    let q = x as f64 + 0.5 - k / rig.focus_mm;
-                    let Some((z_enter, z_safe)) = columns.empty_span(q, k) else {
-                        continue;
-                    };
-                    let Some(ray) = right.pixel_ray(x, y) else {
-                        continue;
-                    };
-                    let cos = ray.dir.dot(right.forward());
-                    let (check, skip) = (z_enter / cos, z_safe / cos);
-                    if skip > check + 2.0 * self.step_mm {
-                        *start = [check as f32, skip as f32];
-                    }
+        starts.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            let columns = RowBounds::new(&forward_depth, [w, h], y, k, margin);
+            for (x, start) in row.iter_mut().enumerate() {
+                let q = x as f64 + 0.5 - k / rig.focus_mm;
+                let Some((z_enter, z_safe)) = columns.empty_span(q, k) else {
+                    continue;
+                };
+                let Some(ray) = right.pixel_ray(x, y) else {
+                    continue;
+                };
+                let cos = ray.dir.dot(right.forward());
+                let (check, skip) = (z_enter / cos, z_safe / cos);
+                if skip > check + 2.0 * self.step_mm {
+                    *start = [check as f32, skip as f32];
                 }
-            });
+            }
+        });
         SearchStarts { width: w, starts }
     }
 }
