@@ -19,6 +19,7 @@ pub mod navigate;
 pub mod path;
 pub mod phantom;
 pub mod pose;
+pub mod presets;
 pub mod render;
 pub mod views;
 pub mod volume;

@@ -4,6 +4,9 @@
 //! `right = forward × up`, the field of view is the *vertical* one, row 0 is the top of the
 //! image, and pixel `(x, y)` is sampled through its centre `(x + ½, y + ½)`.
 
+mod framing;
+pub use framing::{default_up, framing_eye, framing_pose};
+
 use glam::DVec3;
 use thiserror::Error;
 
