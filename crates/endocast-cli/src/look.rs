@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, RenderSettings, TransferFunction};
 use std::path::Path;
 
@@ -10,7 +11,8 @@ use std::path::Path;
 #[derive(Args, Debug, Clone)]
 pub struct LookArgs {
     /// Clinical defaults: colonoscopy, bronchoscopy, angioscopy, sinus, ventricles (also the
-    /// benchmark TFs ramp, complex). Options given explicitly override the preset.
+    /// benchmark TFs ramp, complex; `endocast presets` lists them). Options given explicitly
+    /// override the preset.
     #[arg(long)]
     preset: Option<String>,
     /// iso, dvr, hybrid, two-iso, mip or minip (default: the preset's, else hybrid).
@@ -44,20 +46,15 @@ pub struct LookArgs {
 }
 
 impl LookArgs {
-    /// The preset named with `--preset`, if any.
-    pub fn preset(&self) -> Option<&str> {
-        self.preset.as_deref()
+    /// The preset named with `--preset`, if any; an error for an unknown name.
+    pub fn preset(&self) -> Result<Option<&'static Preset>> {
+        self.preset.as_deref().map(find_preset).transpose()
     }
 
     /// The preset (or defaults), overridden by every option given.
     pub fn settings(&self) -> Result<RenderSettings> {
-        let mut s = match &self.preset {
-            Some(name) => RenderSettings::preset(name).with_context(|| {
-                format!(
-                    "unknown preset {name:?}; choose one of {}",
-                    TransferFunction::PRESETS.join(", ")
-                )
-            })?,
+        let mut s = match self.preset()? {
+            Some(preset) => preset.settings(),
             None => RenderSettings::default(),
         };
         if let Some(mode) = &self.mode {
@@ -87,6 +84,16 @@ impl LookArgs {
         s.skip_empty = self.skip_empty;
         Ok(s)
     }
+}
+
+/// The preset called `name`, or an error listing the known ones.
+pub fn find_preset(name: &str) -> Result<&'static Preset> {
+    Preset::find(name).with_context(|| {
+        format!(
+            "unknown preset {name:?}; choose one of {}",
+            presets::all_names()
+        )
+    })
 }
 
 fn finite(name: &str, value: f64) -> Result<f64> {

@@ -34,6 +34,8 @@ enum Command {
     /// Fly along a path (or key frames) to a GIF, an MP4 or PNG frames, optionally as a
     /// dashboard with slices and an overview, optionally measuring the wall seen.
     Fly(Box<commands::fly::FlyArgs>),
+    /// List the procedure presets: mode, transfer function, isovalues, lumen, slice window, lens.
+    Presets(commands::presets::PresetsArgs),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
 }
@@ -46,8 +48,9 @@ fn main() -> ExitCode {
         Command::Convert(args) => commands::convert::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
+        Command::Presets(args) => commands::presets::run(&args),
         Command::Path(args) => commands::path::run(&args),
-        Command::Fly(args) => commands::fly::run(&args),
+        Command::Fly(mut args) => commands::fly::run(&mut args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

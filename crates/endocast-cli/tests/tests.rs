@@ -7,5 +7,6 @@ mod common;
 mod info_shared_data;
 mod navigation;
 mod phantom_convert;
+mod presets;
 mod real_scans;
 mod render;

@@ -1,5 +1,7 @@
 //! The heart of endocast, free of file formats and GUI: the [`Volume`] every reader produces,
 //! its [`Geometry`] in the patient frame, and analytic [`phantom`]s whose right answers are known.
+//! The procedures' defaults (mode, transfer function, isovalues, lumen, slice window, lens) live
+//! in one table, [`presets`], which every front end reads.
 //!
 //! ```
 //! use endocast_core::phantom::{Phantom, PhantomOptions};
@@ -19,6 +21,7 @@ pub mod navigate;
 pub mod path;
 pub mod phantom;
 pub mod pose;
+pub mod presets;
 pub mod render;
 pub mod views;
 pub mod volume;

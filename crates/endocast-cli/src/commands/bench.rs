@@ -3,14 +3,15 @@
 //! size): iso-only, then the hybrid mode at isosurface opacity 100 / 80 / 50 / 0 % with a simple
 //! ramp and a complex transfer function; with a scan and `--path` it measures one setting.
 
-use crate::look::{in_pool, LookArgs};
+use crate::look::{find_preset, in_pool, LookArgs};
 use crate::parse::parse_size;
 use crate::route::read_route;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
-use endocast_core::render::{Camera, Frame, Mode, RenderSettings, Renderer, TransferFunction};
+use endocast_core::presets::DEFAULT_FOV_DEG;
+use endocast_core::render::{Camera, Frame, Mode, RenderSettings, Renderer};
 use endocast_io::OpenOptions;
 use glam::DVec3;
 use serde_json::json;
@@ -38,9 +39,9 @@ pub struct BenchArgs {
     /// Image size in pixels.
     #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
     image: [usize; 2],
-    /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 90.0)]
-    fov: f64,
+    /// Vertical field of view in degrees (default: the preset's, else 90).
+    #[arg(long, value_name = "DEG")]
+    fov: Option<f64>,
     #[command(flatten)]
     look: LookArgs,
     /// Also append one JSON line per measured setting to this file.
@@ -62,13 +63,17 @@ struct Measured {
 
 /// Runs `endocast bench`.
 pub fn run(args: &BenchArgs) -> Result<()> {
+    let preset = args.look.preset()?;
+    let fov_deg = args
+        .fov
+        .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
     let (renderer, poses, cells) = match &args.volume {
         None => paper_protocol(args)?,
         Some(volume) => one_setting(args, volume)?,
     };
     let cameras: Vec<Camera> = poses
         .iter()
-        .map(|p| Camera::look_at(p.eye_mm, p.look_at_mm, p.up, args.fov, args.image))
+        .map(|p| Camera::look_at(p.eye_mm, p.look_at_mm, p.up, fov_deg, args.image))
         .collect::<Result<_, _>>()
         .context("invalid camera on the path")?;
     println!(
@@ -76,7 +81,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         cameras.len(),
         args.image[0],
         args.image[1],
-        args.fov,
+        fov_deg,
         args.look.threads.unwrap_or_else(rayon::current_num_threads)
     );
     println!("| setting | min fps | avg fps | max fps | median ms | Msamples/s |");
@@ -98,7 +103,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             }
             m
         })?;
-        report(args, cell, &measured)?;
+        report(args, fov_deg, cell, &measured)?;
     }
     Ok(())
 }
@@ -132,7 +137,7 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
         settings: with(&|s| s.mode = Mode::Iso),
     }];
     for tf in ["ramp", "complex"] {
-        let tf_fn = TransferFunction::preset(tf).context("benchmark transfer function")?;
+        let tf_fn = find_preset(tf)?.transfer_function();
         for opacity in [1.0, 0.8, 0.5, 0.0] {
             cells.push(Cell {
                 name: format!("hybrid {:.0} %, {tf} TF", opacity * 100.0),
@@ -215,7 +220,7 @@ fn route_poses(path: &Path, frames: usize) -> Result<Vec<Pose>> {
 }
 
 /// Prints one table row (and appends a JSON line when asked).
-fn report(args: &BenchArgs, cell: &Cell, m: &Measured) -> Result<()> {
+fn report(args: &BenchArgs, fov_deg: f64, cell: &Cell, m: &Measured) -> Result<()> {
     let total_s: f64 = m.ms.iter().sum::<f64>() / 1e3;
     let fps: Vec<f64> = m.ms.iter().map(|ms| 1e3 / ms).collect();
     let min = fps.iter().copied().fold(f64::INFINITY, f64::min);
@@ -234,7 +239,7 @@ fn report(args: &BenchArgs, cell: &Cell, m: &Measured) -> Result<()> {
             "setting": cell.name,
             "frames": m.ms.len(),
             "image": args.image,
-            "fov_deg": args.fov,
+            "fov_deg": fov_deg,
             "fps_min": min, "fps_avg": avg, "fps_max": max,
             "ms_median": median,
             "ms": m.ms,

@@ -13,6 +13,7 @@ use clap::{Args, ValueEnum};
 use endocast_core::coverage::Coverage;
 use endocast_core::flight::{lumen_overview, Flight, FlightOptions, Layout, Shot};
 use endocast_core::navigate::{seed_voxel, Lumen};
+use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{RenderSettings, Renderer};
 use endocast_core::views::slices::Window;
 use endocast_io::video::{open_sink, VideoOptions};
@@ -43,8 +44,12 @@ pub struct FlyArgs {
     /// How far ahead on the path the camera looks, mm.
     #[arg(long, value_name = "MM", default_value_t = 10.0)]
     pub(crate) look_ahead: f64,
-    /// Vertical field of view, degrees (key frames carry their own).
-    #[arg(long, default_value_t = 90.0)]
+    /// Vertical field of view, degrees (default: the preset's, else 90; key frames carry their
+    /// own).
+    #[arg(long = "fov", value_name = "DEG")]
+    fov_deg: Option<f64>,
+    /// The field of view flown with: `--fov`, else the preset's; set by [`run`].
+    #[arg(skip = DEFAULT_FOV_DEG)]
     pub(crate) fov: f64,
     /// Endoscope image size, pixels.
     #[arg(long, value_name = "WxH", default_value = "384x384", value_parser = parse_size)]
@@ -52,14 +57,10 @@ pub struct FlyArgs {
     /// Frames per second of the video.
     #[arg(long, default_value_t = 25.0)]
     fps: f64,
-    /// Slice window centre and width, physical units (HU), for the dashboard.
-    #[arg(
-        long,
-        value_name = "LEVEL,WIDTH",
-        default_value = "-300,1400",
-        allow_hyphen_values = true
-    )]
-    window: String,
+    /// Slice window centre and width, physical units (HU), for the dashboard (default: the
+    /// preset's, e.g. -600,1500 for bronchoscopy; else -300,1400).
+    #[arg(long, value_name = "LEVEL,WIDTH", allow_hyphen_values = true)]
+    window: Option<String>,
     /// Measure the wall seen (forward, then forward + backward), print it and write
     /// OUT.coverage.json, OUT.coverage.png (unseen wall in red) and OUT.coverage.nii.gz
     /// (1 seen, 2 unseen wall voxels).
@@ -76,10 +77,16 @@ enum LayoutArg {
     Dashboard,
 }
 
-/// Runs `endocast fly`.
-pub fn run(args: &FlyArgs) -> Result<()> {
+/// Runs `endocast fly`, first filling in the preset's field of view.
+pub fn run(args: &mut FlyArgs) -> Result<()> {
+    let preset = args.look.preset()?;
+    args.fov = args
+        .fov_deg
+        .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
+    let args = &*args;
     set_threads(args.look.threads)?;
     let settings = args.look.settings()?;
+    let window = slice_window(args.window.as_deref(), preset)?;
     if !(args.frame_step.is_finite() && args.frame_step > 0.0) {
         bail!(
             "--frame-step must be a positive number of mm, not {}",
@@ -98,7 +105,13 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     }
     let needs_lumen = args.coverage || args.layout == LayoutArg::Dashboard;
     let lumen = if needs_lumen {
-        Some(lumen_at_start(args, &loaded.volume, &settings, &shots)?)
+        Some(lumen_at_start(
+            args,
+            preset,
+            &loaded.volume,
+            &settings,
+            &shots,
+        )?)
     } else {
         None
     };
@@ -110,7 +123,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
             LayoutArg::Endoscope => Layout::Endoscope,
             LayoutArg::Dashboard => Layout::Dashboard,
         },
-        window: parse_window(&args.window)?,
+        window,
     };
     let mut flight = Flight::new(&renderer, options);
     if let Some(lumen) = &lumen {
@@ -162,13 +175,12 @@ fn video_options(fps: f64) -> VideoOptions {
 /// The lumen around the route's first camera position.
 fn lumen_at_start(
     args: &FlyArgs,
+    preset: Option<&Preset>,
     volume: &endocast_core::Volume,
     settings: &RenderSettings,
     shots: &[Shot],
 ) -> Result<Lumen> {
-    let (threshold, side) = args
-        .lumen
-        .resolve(args.look.preset(), Some(settings.iso_hu))?;
+    let (threshold, side) = args.lumen.resolve(preset, Some(settings.iso_hu))?;
     let start = shots
         .first()
         .context("the route has no frames")?
@@ -185,6 +197,15 @@ pub fn wall_coverage(lumen: &Lumen, geometry: &endocast_core::Geometry) -> Resul
     let dims = geometry.dims();
     let bbox = [0, 1, 2].map(|a| lo[a].saturating_sub(1)..(hi[a] + 2).min(dims[a]));
     Coverage::new(geometry, |v| lumen.is_wall(v), &bbox).context("no wall around the lumen")
+}
+
+/// The dashboard's slice window: `--window` when given, else the preset's, else the window for
+/// air-filled lumens.
+fn slice_window(text: Option<&str>, preset: Option<&Preset>) -> Result<Window> {
+    match text {
+        Some(text) => parse_window(text),
+        None => Ok(preset.map_or(Window::AIR_TISSUE, |p| p.window)),
+    }
 }
 
 fn parse_window(text: &str) -> Result<Window> {
@@ -224,5 +245,22 @@ impl TfCache {
             }
         }
         Ok(settings)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_slice_window_is_the_options_else_the_presets() {
+        let bronchoscopy = Preset::find("bronchoscopy");
+        let lung = slice_window(None, bronchoscopy).unwrap();
+        assert_eq!((lung.level_hu, lung.width_hu), (-600.0, 1500.0));
+        let given = slice_window(Some("40, 400"), bronchoscopy).unwrap();
+        assert_eq!(given, Window::SOFT_TISSUE);
+        assert_eq!(slice_window(None, None).unwrap(), Window::AIR_TISSUE);
+        assert!(slice_window(Some("40"), None).is_err());
+        assert!(slice_window(Some("40,-1"), None).is_err());
     }
 }

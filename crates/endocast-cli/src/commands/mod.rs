@@ -7,4 +7,5 @@ mod fly_coverage;
 pub mod info;
 pub mod path;
 pub mod phantom;
+pub mod presets;
 pub mod render;

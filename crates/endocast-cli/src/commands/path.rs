@@ -2,6 +2,7 @@
 //! farthest point), written as our path JSON or as 3D Slicer Markups (`.mrk.json`).
 
 use crate::input::InputArgs;
+use crate::look::find_preset;
 use crate::lumen::LumenArgs;
 use crate::parse::parse_vec3;
 use crate::route::is_markups;
@@ -63,7 +64,8 @@ pub fn run(args: &PathArgs) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     let volume = &loaded.volume;
-    let (threshold, side) = args.lumen.resolve(args.preset.as_deref(), args.iso)?;
+    let preset = args.preset.as_deref().map(find_preset).transpose()?;
+    let (threshold, side) = args.lumen.resolve(preset, args.iso)?;
     let start = point(volume, args.from, args.from_voxel, "--from")?
         .context("give the start with --from X,Y,Z (mm) or --from-voxel I,J,K")?;
     let end =

@@ -6,10 +6,12 @@ use crate::lumen::LumenArgs;
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::navigate::{default_viewpoint, preset_lumen};
+use endocast_core::camera::default_up;
+use endocast_core::navigate::{default_view, DefaultView, FramingReason};
 use endocast_core::pose::Pose;
+use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
-use endocast_core::{Geometry, Volume};
+use endocast_core::Volume;
 use glam::DVec3;
 use serde_json::json;
 use std::path::PathBuf;
@@ -37,9 +39,9 @@ pub struct RenderArgs {
     /// Up direction (default: superior, +z; posterior when looking up or down).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     up: Option<[f64; 3]>,
-    /// Vertical field of view in degrees (10–170).
-    #[arg(long, default_value_t = 90.0)]
-    fov: f64,
+    /// Vertical field of view in degrees, 10–170 (default: the preset's, else 90).
+    #[arg(long, value_name = "DEG")]
+    fov: Option<f64>,
     /// Distance from the eye to the near plane, mm (may lie inside tissue).
     #[arg(long, default_value_t = 0.0)]
     near: f64,
@@ -60,11 +62,12 @@ pub struct RenderArgs {
 /// Runs `endocast render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let settings = args.look.settings()?;
+    let preset = args.look.preset()?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
-    let camera = camera(args, &loaded.volume, &settings)?;
+    let camera = camera(args, preset, &loaded.volume, &settings)?;
     let renderer = Renderer::new(loaded.volume);
     let prepared = renderer
         .prepare(&settings)
@@ -100,16 +103,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
 /// The camera the options describe; without one, for an endoscopic preset, a view from inside
 /// the largest lumen along its axis, else one framing the whole volume from the front.
-fn camera(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Result<Camera> {
+fn camera(
+    args: &RenderArgs,
+    preset: Option<&Preset>,
+    volume: &Volume,
+    settings: &RenderSettings,
+) -> Result<Camera> {
+    let fov_deg = args
+        .fov
+        .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
     let (eye, look_at, up) = match (args.eye, args.look_at) {
         (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None),
-        (None, None) => match inside_view(args, volume, settings) {
-            Some(pose) => (pose.eye_mm, pose.look_at_mm, Some(pose.up)),
-            None => {
-                let (eye, look_at) = framing_eye(volume.geometry(), args.fov);
-                (eye, look_at, None)
-            }
-        },
+        (None, None) => {
+            let pose = default_pose(args, preset, volume, settings, fov_deg);
+            (pose.eye_mm, pose.look_at_mm, Some(pose.up))
+        }
         _ => bail!("--eye and --look-at go together"),
     };
     let up = args
@@ -117,62 +125,49 @@ fn camera(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Resu
         .map(DVec3::from)
         .or(up)
         .unwrap_or_else(|| default_up(look_at - eye));
-    Camera::look_at(eye, look_at, up, args.fov, args.size)
+    Camera::look_at(eye, look_at, up, fov_deg, args.size)
         .and_then(|c| c.with_near_mm(args.near))
         .context("invalid camera")
 }
 
-/// The default endoscopic view of `--preset` (see [`default_viewpoint`]), if it names a lumen
-/// and the scan has one.
-fn inside_view(args: &RenderArgs, volume: &Volume, settings: &RenderSettings) -> Option<Pose> {
-    let name = args
-        .look
-        .preset()
-        .filter(|name| preset_lumen(name).is_some())?;
-    let (threshold, side) = match args.lumen.resolve(Some(name), Some(settings.iso_hu)) {
-        Ok(lumen) => lumen,
-        Err(error) => {
-            eprintln!("warning: {error:#}; framing the whole volume instead");
-            return None;
-        }
-    };
-    let pose = default_viewpoint(volume, threshold, side);
-    match &pose {
-        Some(p) => eprintln!(
+/// The library's default view (see [`default_view`]) for `--preset` and the lumen options,
+/// saying on stderr where it put the camera and why it fell back to framing the volume.
+fn default_pose(
+    args: &RenderArgs,
+    preset: Option<&Preset>,
+    volume: &Volume,
+    settings: &RenderSettings,
+    fov_deg: f64,
+) -> Pose {
+    let choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
+    let view = default_view(volume, choice.as_ref(), fov_deg);
+    match &view {
+        DefaultView::InsideLumen {
+            pose,
+            threshold,
+            side,
+        } => eprintln!(
             "camera inside the largest lumen {side} {threshold}: --eye {} --look-at {} --up {}",
-            triple(p.eye_mm),
-            triple(p.look_at_mm),
-            triple(p.up)
+            triple(pose.eye_mm),
+            triple(pose.look_at_mm),
+            triple(pose.up)
         ),
-        None => eprintln!("warning: no lumen {side} {threshold}; framing the whole volume instead"),
+        DefaultView::Framing { reason, .. } => match reason {
+            FramingReason::Choice(error) => {
+                eprintln!("warning: {error}; framing the whole volume instead");
+            }
+            FramingReason::NoLumen { threshold, side } => {
+                eprintln!("warning: no lumen {side} {threshold}; framing the whole volume instead");
+            }
+            _ => {}
+        },
     }
-    pose
+    view.pose()
 }
 
 /// `x,y,z` with two decimals, as `--eye` takes it.
 fn triple(v: DVec3) -> String {
     format!("{:.2},{:.2},{:.2}", v.x, v.y, v.z)
-}
-
-/// Superior (+z in LPS), or posterior when looking (nearly) straight up or down.
-fn default_up(forward: DVec3) -> DVec3 {
-    let forward = forward.normalize_or_zero();
-    if forward.dot(DVec3::Z).abs() > 0.99 {
-        DVec3::Y
-    } else {
-        DVec3::Z
-    }
-}
-
-/// An eye in front of the patient (anterior, −y in LPS) from which the bounding sphere of the
-/// volume fills the vertical field of view, looking at the volume's centre.
-fn framing_eye(geometry: &Geometry, fov_deg: f64) -> (DVec3, DVec3) {
-    let (lo, hi) = geometry.world_bounds();
-    let centre = (lo + hi) / 2.0;
-    let radius = ((hi - lo).length() / 2.0).max(1.0);
-    let half_fov = (fov_deg.clamp(10.0, 170.0) / 2.0).to_radians();
-    let distance = radius / half_fov.sin();
-    (centre - DVec3::Y * distance, centre)
 }
 
 fn print_trace(prepared: &Prepared<'_>, camera: &Camera, x: usize, y: usize) -> Result<()> {

@@ -30,6 +30,9 @@ pub use lens::Lens;
 pub use projection::Projection;
 pub use stereo::{disparity_px, StereoRig};
 
+mod framing;
+pub use framing::{default_up, framing_eye, framing_pose};
+
 use glam::DVec3;
 use thiserror::Error;
 

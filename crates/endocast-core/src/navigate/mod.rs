@@ -35,5 +35,5 @@ pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
 pub use plan::{plan_path, seed_voxel, smooth_centreline, PlannedPath};
-pub use preset::preset_lumen;
-pub use viewpoint::default_viewpoint;
+pub use preset::{preset_lumen, LumenChoice, LumenChoiceError};
+pub use viewpoint::{default_view, default_viewpoint, DefaultView, FramingReason};

@@ -1,23 +1,85 @@
-//! Which lumen each endoscopic preset flies through: the threshold that separates it from the wall
-//! for region growing, and on which side of it the lumen lies.
+//! Which lumen a command navigates: the region-growing threshold and lumen side, from the
+//! preset's lumen (see [`crate::presets`]) and what the user changed.
 
 use super::lumen::LumenSide;
+use crate::presets::{self, Preset};
+use thiserror::Error;
 
-/// The region-growing threshold (physical units) and lumen side of an endoscopic preset, or
+/// The region-growing threshold (physical units) and lumen side of the preset called `name`, or
 /// `None` for presets that are not a flight through a lumen (`ramp`, `complex`) and unknown names.
-///
-/// The thresholds are those measured on the shared scans (`shared/data/README.md`): −500 HU
-/// separates gas from the colon and sinus walls; airways need −900 HU, because at −500 the thin
-/// bronchial wall leaks into the lung (lung −820…−950 HU, tracheal air −973 HU); the enhanced
-/// aorta lies above 130 HU; ventricular CSF is dark on T1, below the renderer's isovalue of 75.
+/// The values live in [`presets::ALL`].
 pub fn preset_lumen(name: &str) -> Option<(f64, LumenSide)> {
-    Some(match name.trim().to_ascii_lowercase().as_str() {
-        "colonoscopy" | "sinus" => (-500.0, LumenSide::Below),
-        "bronchoscopy" => (-900.0, LumenSide::Below),
-        "angioscopy" => (130.0, LumenSide::Above),
-        "ventricles" => (75.0, LumenSide::Below),
-        _ => return None,
-    })
+    let lumen = Preset::find(name)?.lumen?;
+    Some((lumen.threshold, lumen.side))
+}
+
+/// What was asked about the lumen: a preset, the wall isovalue, an explicit threshold and side.
+/// [`LumenChoice::resolve`] turns it into the threshold and side to grow the lumen with.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LumenChoice<'a> {
+    /// The procedure, whose lumen gives the threshold and side. Default none.
+    pub preset: Option<&'a Preset>,
+    /// The wall isovalue, physical units; `None` (the default) means the preset's.
+    pub iso: Option<f64>,
+    /// An explicit region-growing threshold, physical units, overriding the rest. Default none.
+    pub threshold: Option<f64>,
+    /// The lumen is brighter than the wall (contrast, CSF on T2). Default false: the preset's
+    /// side, else darker (air, CSF on T1).
+    pub bright_lumen: bool,
+}
+
+/// A lumen choice that names no threshold.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum LumenChoiceError {
+    /// The preset is not a procedure in a lumen (the benchmark presets).
+    #[error("preset {0:?} names no lumen; use {lumens}", lumens = presets::lumen_names())]
+    PresetHasNoLumen(&'static str),
+    /// Neither a preset, an isovalue nor a threshold was given.
+    #[error("no lumen threshold: give a preset, an isovalue or a threshold")]
+    Underdetermined,
+    /// The threshold works out NaN or infinite.
+    #[error("the lumen threshold must be a finite number, not {0}")]
+    NotFinite(f64),
+}
+
+impl LumenChoice<'_> {
+    /// The threshold and side of the lumen:
+    /// - an explicit `threshold` wins;
+    /// - else the preset's threshold, moved by as much as `iso` moves the wall from the preset's
+    ///   isovalue (a scan stored as HU + 1024, such as CThead, moves both by 1024; the airways'
+    ///   −900 HU stays 400 below their −500 HU wall);
+    /// - else, without a preset, the isovalue itself.
+    ///
+    /// The side is above with `bright_lumen`, else the preset's, else below.
+    pub fn resolve(&self) -> Result<(f64, LumenSide), LumenChoiceError> {
+        let lumen = match self.preset {
+            Some(preset) => Some(
+                preset
+                    .lumen
+                    .map(|lumen| (lumen, preset.iso))
+                    .ok_or(LumenChoiceError::PresetHasNoLumen(preset.name))?,
+            ),
+            None => None,
+        };
+        let side = match (self.bright_lumen, lumen) {
+            (true, _) => LumenSide::Above,
+            (false, Some((lumen, _))) => lumen.side,
+            (false, None) => LumenSide::Below,
+        };
+        let threshold = match (self.threshold, lumen, self.iso) {
+            (Some(t), _, _) => t,
+            (None, Some((lumen, preset_iso)), iso) => {
+                lumen.threshold + iso.unwrap_or(preset_iso) - preset_iso
+            }
+            (None, None, Some(iso)) => iso,
+            (None, None, None) => return Err(LumenChoiceError::Underdetermined),
+        };
+        if !threshold.is_finite() {
+            return Err(LumenChoiceError::NotFinite(threshold));
+        }
+        Ok((threshold, side))
+    }
 }
 
 #[cfg(test)]
@@ -41,5 +103,62 @@ mod tests {
         }
         assert_eq!(preset_lumen("ramp"), None);
         assert_eq!(preset_lumen(" Bronchoscopy "), preset_lumen("bronchoscopy"));
+    }
+
+    fn choice(
+        preset: Option<&str>,
+        iso: Option<f64>,
+        threshold: Option<f64>,
+        bright_lumen: bool,
+    ) -> LumenChoice<'static> {
+        LumenChoice {
+            preset: preset.map(|name| Preset::find(name).unwrap()),
+            iso,
+            threshold,
+            bright_lumen,
+        }
+    }
+
+    #[test]
+    fn the_preset_threshold_moves_with_the_isovalue() {
+        let resolve = |preset, iso| choice(preset, iso, None, false).resolve();
+        assert_eq!(
+            resolve(Some("bronchoscopy"), None),
+            Ok((-900.0, LumenSide::Below))
+        );
+        // CThead stores HU + 1024: an isovalue of 524 puts the airway threshold at 124.
+        assert_eq!(resolve(Some("bronchoscopy"), Some(524.0)).unwrap().0, 124.0);
+        assert_eq!(
+            resolve(Some("angioscopy"), None).unwrap().1,
+            LumenSide::Above
+        );
+        assert_eq!(resolve(None, Some(-400.0)), Ok((-400.0, LumenSide::Below)));
+        assert_eq!(
+            choice(None, None, Some(7.0), true).resolve(),
+            Ok((7.0, LumenSide::Above))
+        );
+        assert_eq!(resolve(None, None), Err(LumenChoiceError::Underdetermined));
+        assert_eq!(
+            resolve(Some("ramp"), None),
+            Err(LumenChoiceError::PresetHasNoLumen("ramp"))
+        );
+        assert!(matches!(
+            choice(None, None, Some(f64::NAN), false).resolve(),
+            Err(LumenChoiceError::NotFinite(_))
+        ));
+        // An explicit threshold and side win over the preset's.
+        assert_eq!(
+            choice(Some("colonoscopy"), Some(-400.0), Some(-600.0), true).resolve(),
+            Ok((-600.0, LumenSide::Above))
+        );
+    }
+
+    #[test]
+    fn errors_name_the_lumen_presets() {
+        let message = LumenChoiceError::PresetHasNoLumen("ramp").to_string();
+        assert!(
+            message.contains("\"ramp\"") && message.contains("bronchoscopy"),
+            "{message}"
+        );
     }
 }

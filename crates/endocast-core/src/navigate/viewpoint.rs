@@ -3,6 +3,8 @@
 
 use super::distance::DistanceField;
 use super::lumen::{Lumen, LumenSide};
+use super::preset::{LumenChoice, LumenChoiceError};
+use crate::camera::framing_pose;
 use crate::pose::Pose;
 use crate::Volume;
 use glam::{DMat3, DVec3};
@@ -49,6 +51,79 @@ pub fn default_viewpoint(volume: &Volume, threshold_hu: f64, side: LumenSide) ->
         look_at_mm: eye_mm + forward * field.max_mm().max(1.0),
         up,
     })
+}
+
+/// The camera a command uses when the user placed none, and why it was chosen.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DefaultView {
+    /// Inside the largest lumen on `side` of `threshold` (see [`default_viewpoint`]).
+    InsideLumen {
+        /// The camera.
+        pose: Pose,
+        /// The lumen's region-growing threshold, physical units.
+        threshold: f64,
+        /// The lumen's side of it.
+        side: LumenSide,
+    },
+    /// The whole volume framed from the front (see [`crate::camera::framing_pose`]).
+    Framing {
+        /// The camera.
+        pose: Pose,
+        /// Why not from inside a lumen.
+        reason: FramingReason,
+    },
+}
+
+impl DefaultView {
+    /// The camera, however it was chosen.
+    pub fn pose(&self) -> Pose {
+        match self {
+            Self::InsideLumen { pose, .. } | Self::Framing { pose, .. } => *pose,
+        }
+    }
+}
+
+/// Why a [`DefaultView`] frames the volume from outside.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum FramingReason {
+    /// No lumen was asked for (no preset, or one that is no procedure in a lumen).
+    NoLumenAsked,
+    /// The lumen choice gives no threshold.
+    Choice(LumenChoiceError),
+    /// No voxel of the volume lies on `side` of `threshold`.
+    NoLumen {
+        /// The region-growing threshold, physical units.
+        threshold: f64,
+        /// The lumen's side of it.
+        side: LumenSide,
+    },
+}
+
+/// The default camera for `volume`: with a `lumen` choice (an endoscopic preset), inside the
+/// largest lumen it resolves to ([`default_viewpoint`]), looking along it; without one, or when
+/// the choice gives no threshold or the scan no such lumen, the whole volume framed from the
+/// front for the vertical field of view `fov_deg` ([`framing_pose`]), with the reason.
+pub fn default_view(volume: &Volume, lumen: Option<&LumenChoice<'_>>, fov_deg: f64) -> DefaultView {
+    let framing = |reason| DefaultView::Framing {
+        pose: framing_pose(volume.geometry(), fov_deg),
+        reason,
+    };
+    let Some(choice) = lumen.filter(|c| c.preset.is_none_or(|p| p.lumen.is_some())) else {
+        return framing(FramingReason::NoLumenAsked);
+    };
+    let (threshold, side) = match choice.resolve() {
+        Ok(lumen) => lumen,
+        Err(error) => return framing(FramingReason::Choice(error)),
+    };
+    match default_viewpoint(volume, threshold, side) {
+        Some(pose) => DefaultView::InsideLumen {
+            pose,
+            threshold,
+            side,
+        },
+        None => framing(FramingReason::NoLumen { threshold, side }),
+    }
 }
 
 /// The voxel nearest the lumen's centroid among those within half a voxel of the largest
@@ -161,5 +236,55 @@ mod tests {
             "{}°",
             cos.acos().to_degrees()
         );
+    }
+
+    #[test]
+    fn default_view_is_inside_an_endoscopic_presets_lumen_else_framing() {
+        use crate::presets::Preset;
+        let (volume, _) = phantom::straight_tube(&options(32));
+        let colonoscopy = LumenChoice {
+            preset: Preset::find("colonoscopy"),
+            ..LumenChoice::default()
+        };
+        let view = default_view(&volume, Some(&colonoscopy), 90.0);
+        assert!(
+            matches!(view, DefaultView::InsideLumen { threshold, side: LumenSide::Below, .. } if threshold == -500.0),
+            "{view:?}"
+        );
+        assert_eq!(
+            view.pose(),
+            default_viewpoint(&volume, -500.0, LumenSide::Below).unwrap()
+        );
+        let framed = framing_pose(volume.geometry(), 90.0);
+        let ramp = LumenChoice {
+            preset: Preset::find("ramp"),
+            ..LumenChoice::default()
+        };
+        for (choice, reason) in [
+            (None, FramingReason::NoLumenAsked),
+            (Some(ramp), FramingReason::NoLumenAsked),
+            (
+                Some(LumenChoice::default()),
+                FramingReason::Choice(LumenChoiceError::Underdetermined),
+            ),
+            (
+                Some(LumenChoice {
+                    threshold: Some(-5000.0),
+                    ..colonoscopy
+                }),
+                FramingReason::NoLumen {
+                    threshold: -5000.0,
+                    side: LumenSide::Below,
+                },
+            ),
+        ] {
+            assert_eq!(
+                default_view(&volume, choice.as_ref(), 90.0),
+                DefaultView::Framing {
+                    pose: framed,
+                    reason
+                }
+            );
+        }
     }
 }

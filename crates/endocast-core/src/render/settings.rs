@@ -166,41 +166,10 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
-    /// Sensible settings for a clinical preset: the transfer function of the same name (see
-    /// [`TransferFunction::preset`]) plus a mode and isovalues from the measured thresholds:
-    /// `colonoscopy`, `bronchoscopy`, `sinus`: hybrid at −500 HU, the wall 60 % opaque;
-    /// `angioscopy`: two surfaces, the lumen wall at 130 HU (contrast ≈ 190–300 HU, wall
-    /// ≈ 40 HU) and metal/calcium at 700 HU; `ventricles` (T1 MRI): hybrid at 75;
-    /// `ramp`, `complex`: the paper's benchmark transfer functions, hybrid at −500 HU, 50 %.
+    /// The settings of the preset called `name` (see [`crate::presets`], which holds every
+    /// preset's mode, transfer function and surfaces), or `None` for an unknown name.
     pub fn preset(name: &str) -> Option<Self> {
-        let tf = TransferFunction::preset(name)?;
-        let base = Self {
-            tf,
-            ..Self::default()
-        };
-        Some(match name.trim().to_ascii_lowercase().as_str() {
-            "angioscopy" => Self {
-                mode: Mode::TwoIso,
-                iso_hu: 130.0,
-                iso_opacity: 0.7,
-                iso_color: [0.85, 0.35, 0.3],
-                iso2_hu: 700.0,
-                ..base
-            },
-            "ventricles" => Self {
-                iso_hu: 75.0,
-                iso_opacity: 0.6,
-                ..base
-            },
-            "ramp" | "complex" => Self {
-                iso_opacity: 0.5,
-                ..base
-            },
-            _ => Self {
-                iso_opacity: 0.6,
-                ..base
-            },
-        })
+        crate::presets::Preset::find(name).map(crate::presets::Preset::settings)
     }
 
     /// The step between samples in mm for voxels whose smallest spacing is `min_spacing_mm`.

@@ -1,0 +1,359 @@
+//! The procedures endocast knows, in one table: per preset the render mode, the named transfer
+//! function, the wall isosurface (and angioscopy's second one), the lumen a flight grows through,
+//! the slice window and the lens. Every front end (the CLI's `render`, `path`, `fly`, `bench`
+//! and `presets`) reads its defaults here, so a value lives in exactly one place.
+//!
+//! ```
+//! use endocast_core::presets::Preset;
+//! use endocast_core::render::Mode;
+//!
+//! let bronchoscopy = Preset::find("Bronchoscopy").expect("a known preset");
+//! assert_eq!(bronchoscopy.settings().mode, Mode::Hybrid);
+//! // Airways are grown below −900 HU: at the wall's −500 HU they would leak into the lung.
+//! assert_eq!(bronchoscopy.lumen.map(|l| l.threshold), Some(-900.0));
+//! assert!(endocast_core::presets::ALL.iter().any(|p| p.name == "ramp"));
+//! ```
+//!
+//! Thresholds are the ones measured on the shared scans (`shared/data/README.md`): CT in
+//! Hounsfield units, `ventricles` in the intensity units of a T1 MRI.
+
+use crate::camera::Projection;
+use crate::navigate::LumenSide;
+use crate::render::{Mode, RenderSettings, TransferFunction};
+use crate::views::slices::Window;
+
+/// Vertical field of view of a pinhole endoscope, degrees: the default of every preset and of
+/// commands run without one.
+pub const DEFAULT_FOV_DEG: f64 = 90.0;
+
+/// A second isosurface ([`Mode::TwoIso`]'s upper one: stent, calcification).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Surface {
+    /// Isovalue, physical units.
+    pub iso: f64,
+    /// Opacity, 0–1.
+    pub opacity: f32,
+    /// Colour before shading, 0–1 (sRGB); `None` keeps [`RenderSettings`]' default.
+    pub color: Option<[f32; 3]>,
+}
+
+/// The lumen a preset flies through: region growing keeps the voxels on `side` of `threshold`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PresetLumen {
+    /// Region-growing threshold, physical units. It may differ from the wall isovalue: airways
+    /// are grown below −900 HU although their wall is drawn at −500 HU.
+    pub threshold: f64,
+    /// Whether the lumen is darker (air, CSF on T1) or brighter (contrast) than the wall.
+    pub side: LumenSide,
+}
+
+/// One procedure's defaults. Built only in [`ALL`]; find one with [`Preset::find`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Preset {
+    /// Lower-case name, as `--preset` takes it.
+    pub name: &'static str,
+    /// What it is for, in one line.
+    pub description: &'static str,
+    /// Render mode.
+    pub mode: Mode,
+    /// Name of the transfer function (see [`TransferFunction::preset`]).
+    pub tf: &'static str,
+    /// Wall isovalue, physical units (HU for CT).
+    pub iso: f64,
+    /// Opacity of the wall isosurface, 0–1.
+    pub iso_opacity: f32,
+    /// Colour of the wall before shading, 0–1 (sRGB); `None` keeps [`RenderSettings`]' default
+    /// (a mucosa pink).
+    pub iso_color: Option<[f32; 3]>,
+    /// The second isosurface of [`Mode::TwoIso`], where the preset has one.
+    pub iso2: Option<Surface>,
+    /// The lumen a flight navigates; `None` for the benchmark presets, which are no procedure.
+    pub lumen: Option<PresetLumen>,
+    /// Window of the slice views, physical units.
+    pub window: Window,
+    /// The endoscope's lens.
+    pub projection: Projection,
+    /// The endoscope's field of view, degrees (vertical for a pinhole).
+    pub fov_deg: f64,
+}
+
+/// The window for CT with an air-filled lumen: air black, soft tissue light grey, bone white.
+const AIR_TISSUE: Window = Window::AIR_TISSUE;
+
+/// Every preset: the five procedures, then the benchmark's two transfer functions.
+pub const ALL: &[Preset] = &[
+    Preset {
+        name: "colonoscopy",
+        description: "CT colonography: the gas-filled colon's wall at -500 HU, 60 % opaque",
+        mode: Mode::Hybrid,
+        tf: "colonoscopy",
+        iso: -500.0,
+        iso_opacity: 0.6,
+        iso_color: None,
+        iso2: None,
+        lumen: Some(PresetLumen {
+            threshold: -500.0,
+            side: LumenSide::Below,
+        }),
+        window: AIR_TISSUE,
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+    Preset {
+        name: "bronchoscopy",
+        description: "chest CT: trachea and bronchi, wall at -500 HU, lumen grown below -900 HU",
+        mode: Mode::Hybrid,
+        tf: "bronchoscopy",
+        iso: -500.0,
+        iso_opacity: 0.6,
+        iso_color: None,
+        iso2: None,
+        // −900, not −500: at −500 the thin bronchial wall leaks into the lung (−820…−950 HU).
+        lumen: Some(PresetLumen {
+            threshold: -900.0,
+            side: LumenSide::Below,
+        }),
+        // The lung window.
+        window: Window {
+            level_hu: -600.0,
+            width_hu: 1500.0,
+        },
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+    Preset {
+        name: "angioscopy",
+        description: "CT angiography: vessel wall at 130 HU and calcium or stent at 700 HU",
+        mode: Mode::TwoIso,
+        tf: "angioscopy",
+        // Contrast ≈ 190–300 HU, wall ≈ 40 HU.
+        iso: 130.0,
+        iso_opacity: 0.7,
+        iso_color: Some([0.85, 0.35, 0.3]),
+        iso2: Some(Surface {
+            iso: 700.0,
+            opacity: 1.0,
+            color: None,
+        }),
+        lumen: Some(PresetLumen {
+            threshold: 130.0,
+            side: LumenSide::Above,
+        }),
+        // A vessel window: contrast light grey, calcium and metal white, fat dark.
+        window: Window {
+            level_hu: 100.0,
+            width_hu: 700.0,
+        },
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+    Preset {
+        name: "sinus",
+        description: "head CT: nasal cavity and sinuses, wall at -500 HU, bone seen through it",
+        mode: Mode::Hybrid,
+        tf: "sinus",
+        iso: -500.0,
+        iso_opacity: 0.6,
+        iso_color: None,
+        iso2: None,
+        lumen: Some(PresetLumen {
+            threshold: -500.0,
+            side: LumenSide::Below,
+        }),
+        // The bone window: air black, thin sinus walls distinct from soft tissue.
+        window: Window {
+            level_hu: 400.0,
+            width_hu: 2000.0,
+        },
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+    Preset {
+        name: "ventricles",
+        description: "T1 MRI: the lateral ventricles, CSF (25-40) darker than white matter at 75",
+        mode: Mode::Hybrid,
+        tf: "ventricles",
+        iso: 75.0,
+        iso_opacity: 0.6,
+        iso_color: None,
+        iso2: None,
+        lumen: Some(PresetLumen {
+            threshold: 75.0,
+            side: LumenSide::Below,
+        }),
+        // T1 intensity units (chris_t1: CSF 25–40, white matter 106–130): 0 black, 160 white.
+        window: Window {
+            level_hu: 80.0,
+            width_hu: 160.0,
+        },
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+    Preset {
+        name: "ramp",
+        description: "benchmark: the paper's Table 1 alpha ramp (-700 to -300 HU), wall 50 %",
+        mode: Mode::Hybrid,
+        tf: "ramp",
+        iso: -500.0,
+        iso_opacity: 0.5,
+        iso_color: None,
+        iso2: None,
+        lumen: None,
+        window: AIR_TISSUE,
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+    Preset {
+        name: "complex",
+        description: "benchmark: the paper's Table 2 kind of TF, faint peaks, wall 50 %",
+        mode: Mode::Hybrid,
+        tf: "complex",
+        iso: -500.0,
+        iso_opacity: 0.5,
+        iso_color: None,
+        iso2: None,
+        lumen: None,
+        window: AIR_TISSUE,
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+];
+
+/// Every preset, in the table's order.
+pub fn iter() -> impl Iterator<Item = &'static Preset> {
+    ALL.iter()
+}
+
+/// The names of the presets that navigate a lumen, comma-separated (for messages).
+pub fn lumen_names() -> String {
+    names(iter().filter(|p| p.lumen.is_some()))
+}
+
+/// The names of every preset, comma-separated (for messages).
+pub fn all_names() -> String {
+    names(iter())
+}
+
+fn names<'a>(presets: impl Iterator<Item = &'a Preset>) -> String {
+    presets.map(|p| p.name).collect::<Vec<_>>().join(", ")
+}
+
+impl Preset {
+    /// The preset called `name` (surrounding space and ASCII case ignored).
+    pub fn find(name: &str) -> Option<&'static Preset> {
+        let name = name.trim();
+        iter().find(|p| p.name.eq_ignore_ascii_case(name))
+    }
+
+    /// The transfer function the preset names.
+    pub fn transfer_function(&self) -> TransferFunction {
+        TransferFunction::preset(self.tf).expect("every preset names a known transfer function")
+    }
+
+    /// The render settings of this preset: its mode, transfer function and surfaces, every
+    /// other field at [`RenderSettings`]' default.
+    pub fn settings(&self) -> RenderSettings {
+        let mut s = RenderSettings {
+            mode: self.mode,
+            iso_hu: self.iso,
+            iso_opacity: self.iso_opacity,
+            tf: self.transfer_function(),
+            ..RenderSettings::default()
+        };
+        if let Some(color) = self.iso_color {
+            s.iso_color = color;
+        }
+        if let Some(upper) = self.iso2 {
+            s.iso2_hu = upper.iso;
+            s.iso2_opacity = upper.opacity;
+            if let Some(color) = upper.color {
+                s.iso2_color = color;
+            }
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_lower_case_and_found_in_any_case() {
+        for (n, preset) in ALL.iter().enumerate() {
+            assert_eq!(preset.name, preset.name.to_ascii_lowercase());
+            assert!(ALL[..n].iter().all(|p| p.name != preset.name), "{preset:?}");
+            let shouted = format!(" {} ", preset.name.to_ascii_uppercase());
+            assert_eq!(Preset::find(&shouted), Some(preset));
+            assert!(!preset.description.is_empty() && !preset.description.contains('\n'));
+        }
+        assert_eq!(Preset::find("gastroscopy"), None);
+        assert_eq!(iter().count(), 7);
+        assert_eq!(
+            lumen_names(),
+            "colonoscopy, bronchoscopy, angioscopy, sinus, ventricles"
+        );
+    }
+
+    #[test]
+    fn every_preset_gives_valid_settings_with_its_named_transfer_function() {
+        for preset in ALL {
+            let s = preset.settings();
+            assert_eq!(s.validate(), Ok(()), "{}", preset.name);
+            assert_eq!(s.tf, TransferFunction::preset(preset.tf).unwrap());
+            assert!(preset.window.width_hu > 0.0);
+            assert_eq!(preset.iso2.is_some(), preset.mode == Mode::TwoIso);
+            assert!((10.0..=170.0).contains(&preset.fov_deg));
+        }
+    }
+
+    /// The values the presets had before they moved into this table: images must not change.
+    #[test]
+    fn settings_are_those_of_before_the_table() {
+        let base = RenderSettings::default();
+        let hybrid = |tf: &str, iso_hu: f64, iso_opacity: f32| RenderSettings {
+            tf: TransferFunction::preset(tf).unwrap(),
+            iso_hu,
+            iso_opacity,
+            ..base.clone()
+        };
+        let expected = [
+            ("colonoscopy", hybrid("colonoscopy", -500.0, 0.6)),
+            ("bronchoscopy", hybrid("bronchoscopy", -500.0, 0.6)),
+            ("sinus", hybrid("sinus", -500.0, 0.6)),
+            ("ventricles", hybrid("ventricles", 75.0, 0.6)),
+            ("ramp", hybrid("ramp", -500.0, 0.5)),
+            ("complex", hybrid("complex", -500.0, 0.5)),
+            (
+                "angioscopy",
+                RenderSettings {
+                    mode: Mode::TwoIso,
+                    iso_hu: 130.0,
+                    iso_opacity: 0.7,
+                    iso_color: [0.85, 0.35, 0.3],
+                    iso2_hu: 700.0,
+                    ..hybrid("angioscopy", 0.0, 0.0)
+                },
+            ),
+        ];
+        for (name, settings) in expected {
+            assert_eq!(Preset::find(name).unwrap().settings(), settings, "{name}");
+        }
+        assert_eq!(Mode::Hybrid, base.mode);
+    }
+
+    #[test]
+    fn windows_suit_each_procedure() {
+        let window = |name| Preset::find(name).unwrap().window;
+        // Lung parenchyma (−820 HU) is visible in the lung window, not black.
+        assert!(window("bronchoscopy").grey(-820.0) > 20);
+        // Enhanced blood (≈ 190 HU) and fat (≈ −100 HU) are told apart in the vessel window.
+        let vessel = window("angioscopy");
+        assert!(vessel.grey(190.0) > vessel.grey(-100.0) + 60);
+        // T1: CSF (30) darker than white matter (120).
+        let t1 = window("ventricles");
+        assert!(t1.grey(120.0) > t1.grey(30.0) + 100);
+        assert_eq!(window("colonoscopy"), Window::AIR_TISSUE);
+    }
+}
