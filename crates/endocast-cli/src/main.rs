@@ -4,6 +4,7 @@ mod commands;
 mod input;
 mod look;
 mod lumen;
+mod optics;
 mod parse;
 mod progress;
 mod route;

@@ -3,6 +3,7 @@
 use crate::input::InputArgs;
 use crate::look::{in_pool, LookArgs};
 use crate::lumen::LumenArgs;
+use crate::optics::{LensArgs, StereoArgs};
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -11,10 +12,12 @@ use endocast_core::navigate::{default_view, DefaultView, FramingReason};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
+use endocast_core::views::stereo::{self, StereoOutput};
+use endocast_core::views::Image;
 use endocast_core::Volume;
 use glam::DVec3;
 use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `endocast render`.
 #[derive(Args, Debug)]
@@ -28,6 +31,10 @@ pub struct RenderArgs {
     look: LookArgs,
     #[command(flatten)]
     lumen: LumenArgs,
+    #[command(flatten)]
+    lens: LensArgs,
+    #[command(flatten)]
+    stereo: StereoArgs,
     /// Eye position, world mm (LPS, as `endocast info` reports). Without it, an endoscopic
     /// preset looks along the largest lumen from its most central point; otherwise the view
     /// frames the whole volume from the front.
@@ -39,7 +46,8 @@ pub struct RenderArgs {
     /// Up direction (default: superior, +z; posterior when looking up or down).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     up: Option<[f64; 3]>,
-    /// Vertical field of view in degrees, 10–170 (default: the preset's, else 90).
+    /// Vertical field of view in degrees: 10–170 for a pinhole, up to 360 for a fisheye
+    /// (default: the preset's, else 90; fisheye 170); view height in mm for orthographic.
     #[arg(long, value_name = "DEG")]
     fov: Option<f64>,
     /// Distance from the eye to the near plane, mm (may lie inside tissue).
@@ -75,10 +83,34 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
     }
-    let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
+    let stereo = args.stereo.rig(|| {
+        prepared
+            .nearest_surface_mm(&camera)
+            .unwrap_or(FALLBACK_FOCUS_MM)
+    })?;
+    let frame = match stereo {
+        Some((rig, output)) => {
+            let frames = in_pool(args.look.threads, || prepared.render_stereo(&camera, &rig))?
+                .context("invalid stereo rig")?;
+            write_stereo(&args.output, &frames, output)?;
+            eprintln!(
+                "stereo: eye separation {:.2} mm, focus {:.1} mm",
+                rig.eye_separation_mm, rig.focus_mm
+            );
+            let [left, right] = frames;
+            let mut both = left;
+            both.stats.add(&right.stats);
+            both
+        }
+        None => {
+            let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
+            let [w, h] = [frame.width as u32, frame.height as u32];
+            endocast_io::image_out::write_png_rgb8(&args.output, w, h, &frame.rgb)
+                .context("cannot write the image")?;
+            frame
+        }
+    };
     let [w, h] = [frame.width as u32, frame.height as u32];
-    endocast_io::image_out::write_png_rgb8(&args.output, w, h, &frame.rgb)
-        .context("cannot write the image")?;
     if let Some(depth) = &args.depth_out {
         endocast_io::image_out::write_npy_f32(depth, w, h, &frame.depth_mm)
             .context("cannot write the depth image")?;
@@ -125,9 +157,43 @@ fn camera(
         .map(DVec3::from)
         .or(up)
         .unwrap_or_else(|| default_up(look_at - eye));
-    Camera::look_at(eye, look_at, up, fov_deg, args.size)
-        .and_then(|c| c.with_near_mm(args.near))
+    let (lo, hi) = volume.geometry().world_bounds();
+    let height_mm = (hi - lo).length();
+    let optics = args.lens.optics(preset, args.fov, args.near, height_mm)?;
+    optics
+        .camera(eye, look_at, up, args.size)
         .context("invalid camera")
+}
+
+/// The focus distance of a stereo pair whose view shows no surface, mm.
+const FALLBACK_FOCUS_MM: f64 = 10.0;
+
+/// Writes a stereo pair as `output` asks: one combined image at `path`, or for a pair
+/// `NAME-left.png` and `NAME-right.png` beside it.
+fn write_stereo(path: &Path, frames: &[Frame; 2], output: StereoOutput) -> Result<()> {
+    let [left, right] = [&frames[0], &frames[1]].map(Image::from_frame);
+    let (left, right) = (left?, right?);
+    let write = |path: &Path, image: &Image| {
+        let [w, h] = [image.width() as u32, image.height() as u32];
+        endocast_io::image_out::write_png_rgb8(path, w, h, image.rgb())
+            .with_context(|| format!("cannot write {}", path.display()))
+    };
+    if output == StereoOutput::Pair {
+        write(&beside(path, "left"), &left)?;
+        return write(&beside(path, "right"), &right);
+    }
+    write(path, &stereo::combine(&left, &right, output)?)
+}
+
+/// `dir/name.png` as `dir/name-ending.png`.
+fn beside(path: &Path, ending: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or_else(Default::default, |s| s.to_string_lossy());
+    let extension = path
+        .extension()
+        .map_or_else(|| "png".into(), |e| e.to_string_lossy());
+    path.with_file_name(format!("{stem}-{ending}.{extension}"))
 }
 
 /// The library's default view (see [`default_view`]) for `--preset` and the lumen options,

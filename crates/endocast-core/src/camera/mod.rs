@@ -19,6 +19,7 @@
 //! A fisheye's image is the circle `r ≤ 1` (a real endoscope's round picture); pixels outside it
 //! have no ray. The lens's distortion acts on `(u, v)` before the projection (see [`lens`]).
 
+mod framing;
 pub mod lens;
 mod projection;
 mod stereo;
@@ -26,12 +27,10 @@ mod stereo;
 #[cfg(test)]
 mod tests;
 
+pub use framing::{default_up, framing_eye, framing_pose};
 pub use lens::Lens;
 pub use projection::Projection;
-pub use stereo::{disparity_px, StereoRig};
-
-mod framing;
-pub use framing::{default_up, framing_eye, framing_pose};
+pub use stereo::{disparity_px, StereoRig, SEPARATION_PER_FOCUS};
 
 use glam::DVec3;
 use thiserror::Error;

@@ -82,6 +82,25 @@ impl Prepared<'_> {
         Ok(frames)
     }
 
+    /// The distance along the view axis (mm) of the nearest surface `camera` sees — the 5th
+    /// percentile of the hit depths of a render 64 pixels high — a focus distance that puts
+    /// the scene behind the screen; `None` where nothing is hit (or in a mode without hits).
+    pub fn nearest_surface_mm(&self, camera: &Camera) -> Option<f64> {
+        let [w, h] = camera.size();
+        let small_h = h.min(64);
+        let small_w = (w * small_h / h).max(1);
+        let small = camera.with_size([small_w, small_h]).ok()?;
+        let frame = self.render(&small);
+        let mut depths = forward_depths(&small, &frame);
+        depths.retain(|d| d.is_finite());
+        if depths.is_empty() {
+            return None;
+        }
+        let k = depths.len() / 20;
+        let (_, nth, _) = depths.select_nth_unstable_by(k, f64::total_cmp);
+        Some(*nth)
+    }
+
     /// Whether the right eye's searches may start from the left eye's emptiness.
     fn shares_emptiness(&self, left: &Camera, right: &Camera) -> bool {
         let pinhole = |c: &Camera| c.projection() == Projection::Pinhole && c.lens().is_ideal();

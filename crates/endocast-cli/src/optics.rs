@@ -1,0 +1,196 @@
+//! The camera options `render`, `fly` and `bench` share — the lens's projection, distortion
+//! and vignetting — and the stereo options of `render` and `fly`.
+
+use anyhow::{bail, Result};
+use clap::Args;
+use endocast_core::camera::{Lens, Optics, Projection, StereoRig};
+use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
+use endocast_core::views::stereo::StereoOutput;
+
+/// The field of a fisheye lens when neither `--fov` nor the preset gives one for it, degrees:
+/// a wide endoscope's.
+pub const FISHEYE_DEFAULT_FOV_DEG: f64 = 170.0;
+
+/// How the camera forms its image.
+#[derive(Args, Debug, Clone, Default)]
+pub struct LensArgs {
+    /// Lens projection: pinhole; equidistant or equisolid (fisheye: a round image, --fov up to
+    /// 360°, default 170°); orthographic (parallel rays: --fov is the view height in mm).
+    /// Default: the preset's, else pinhole.
+    #[arg(long, value_name = "PROJECTION", value_parser = parse_projection)]
+    pub lens: Option<Projection>,
+    /// Radial lens distortion (Brown–Conrady) on image coordinates normalised to the half
+    /// height: K1 < 0 is the barrel distortion of a real endoscope (e.g. -0.25,0.05).
+    #[arg(long, value_name = "K1,K2", value_parser = parse_pair, allow_hyphen_values = true)]
+    pub distortion: Option<[f64; 2]>,
+    /// Darkening toward the image edge, 0–1 (1: black corners).
+    #[arg(long, value_name = "0..1", default_value_t = 0.0)]
+    pub vignetting: f64,
+}
+
+impl LensArgs {
+    /// The optics for `fov` (the `--fov` given, if any) under `preset`, with `near_mm`. An
+    /// orthographic view without `--fov` is `default_height_mm` tall.
+    pub fn optics(
+        &self,
+        preset: Option<&Preset>,
+        fov: Option<f64>,
+        near_mm: f64,
+        default_height_mm: f64,
+    ) -> Result<Optics> {
+        let projection = self
+            .lens
+            .or(preset.map(|p| p.projection))
+            .unwrap_or(Projection::Pinhole);
+        let preset_fov = preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg);
+        let field = match (fov, projection) {
+            (Some(fov), _) => fov,
+            (None, Projection::Orthographic) => default_height_mm,
+            (None, p) if p.is_fisheye() && preset.is_none_or(|p| !p.projection.is_fisheye()) => {
+                FISHEYE_DEFAULT_FOV_DEG
+            }
+            (None, _) => preset_fov,
+        };
+        let (min, max) = projection.field_range();
+        if !(min..=max).contains(&field) {
+            bail!(
+                "--fov {field} lies outside {min}–{max} {} for --lens {}",
+                projection.field_unit(),
+                projection.name()
+            );
+        }
+        Ok(Optics {
+            projection,
+            field,
+            lens: Lens {
+                distortion: self.distortion.unwrap_or([0.0; 2]),
+                vignetting: self.vignetting,
+            },
+            near_mm,
+        })
+    }
+}
+
+/// Stereo viewing.
+#[derive(Args, Debug, Clone, Default)]
+pub struct StereoArgs {
+    /// Render a stereo pair (two off-axis eyes): anaglyph (red/blue, VIVENDI's), red-cyan,
+    /// dubois (colour anaglyph), side-by-side, top-bottom, or pair (OUT-left and OUT-right).
+    #[arg(long, value_name = "OUTPUT", value_parser = parse_stereo)]
+    pub stereo: Option<StereoOutput>,
+    /// Distance between the eyes, mm (default: the focus distance / 30).
+    #[arg(long, value_name = "MM", requires = "stereo")]
+    pub eye_separation: Option<f64>,
+    /// Distance of the zero-parallax (focus) plane, mm (default: the nearest surface in view,
+    /// so that the scene lies behind the screen).
+    #[arg(long, value_name = "MM", requires = "stereo")]
+    pub focus: Option<f64>,
+}
+
+impl StereoArgs {
+    /// The rig, the focus distance taken from `nearest` (mm) when not given; `None` without
+    /// `--stereo`.
+    pub fn rig(&self, nearest: impl FnOnce() -> f64) -> Result<Option<(StereoRig, StereoOutput)>> {
+        let Some(output) = self.stereo else {
+            return Ok(None);
+        };
+        let focus_mm = match self.focus {
+            Some(f) => f,
+            None => nearest(),
+        };
+        let eye_separation_mm = self
+            .eye_separation
+            .unwrap_or(focus_mm * endocast_core::camera::SEPARATION_PER_FOCUS);
+        for (name, value) in [
+            ("--focus", focus_mm),
+            ("--eye-separation", eye_separation_mm),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                bail!("{name} must be a positive number of mm, not {value}");
+            }
+        }
+        if eye_separation_mm >= 2.0 * focus_mm {
+            bail!("--eye-separation {eye_separation_mm} mm must be less than twice --focus {focus_mm} mm");
+        }
+        let rig = StereoRig {
+            eye_separation_mm,
+            focus_mm,
+        };
+        Ok(Some((rig, output)))
+    }
+}
+
+/// A projection by name.
+fn parse_projection(text: &str) -> Result<Projection, String> {
+    Projection::from_name(text).ok_or_else(|| {
+        format!("unknown lens {text:?}: use pinhole, equidistant, equisolid or orthographic")
+    })
+}
+
+/// A stereo output by name.
+fn parse_stereo(text: &str) -> Result<StereoOutput, String> {
+    StereoOutput::from_name(text).ok_or_else(|| {
+        format!("unknown stereo output {text:?}: use anaglyph, red-cyan, dubois, side-by-side, top-bottom or pair")
+    })
+}
+
+/// Two comma-separated finite numbers.
+fn parse_pair(text: &str) -> Result<[f64; 2], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [a, b] = parts[..] else {
+        return Err(format!("expected two numbers K1,K2, not {text:?}"));
+    };
+    let number = |s: &str| match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("{s:?} is not a finite number")),
+    };
+    Ok([number(a)?, number(b)?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lens_defaults_follow_the_projection() {
+        let args = |lens| LensArgs {
+            lens,
+            ..LensArgs::default()
+        };
+        let pinhole = args(None).optics(None, None, 0.0, 50.0).unwrap();
+        assert_eq!(
+            (pinhole.projection, pinhole.field),
+            (Projection::Pinhole, 90.0)
+        );
+        let fisheye = args(Some(Projection::Equidistant));
+        assert_eq!(fisheye.optics(None, None, 0.0, 50.0).unwrap().field, 170.0);
+        assert_eq!(
+            fisheye.optics(None, Some(200.0), 0.0, 50.0).unwrap().field,
+            200.0
+        );
+        let ortho = args(Some(Projection::Orthographic));
+        assert_eq!(ortho.optics(None, None, 0.0, 50.0).unwrap().field, 50.0);
+        assert!(args(None).optics(None, Some(200.0), 0.0, 50.0).is_err());
+        assert!(parse_pair("-0.2,0.05").is_ok());
+        assert!(parse_pair("nan,0").is_err() && parse_pair("1").is_err());
+        assert!(parse_projection("fisheye").is_err());
+    }
+
+    #[test]
+    fn stereo_defaults_put_the_focus_on_the_nearest_surface() {
+        let none = StereoArgs::default();
+        assert!(none.rig(|| 10.0).unwrap().is_none());
+        let args = StereoArgs {
+            stereo: Some(StereoOutput::Anaglyph),
+            ..StereoArgs::default()
+        };
+        let (rig, _) = args.rig(|| 12.0).unwrap().unwrap();
+        assert_eq!(rig.focus_mm, 12.0);
+        assert!((rig.eye_separation_mm - 0.4).abs() < 1e-12);
+        let bad = StereoArgs {
+            focus: Some(f64::NAN),
+            ..args
+        };
+        assert!(bad.rig(|| 12.0).is_err());
+    }
+}
