@@ -3,10 +3,12 @@
 //! and an overview of the lumen — while the [`Coverage`](crate::coverage::Coverage) of the wall
 //! is tracked.
 
+mod error;
 mod frames;
 mod overview;
 
-pub use frames::{Flight, FlightError, FlightOptions, Layout};
+pub use error::FlightError;
+pub use frames::{Flight, FlightOptions, Layout};
 pub use overview::{lumen_overview, Overview};
 
 use crate::animation::Animation;
