@@ -31,6 +31,7 @@ pub mod nrrd;
 mod open;
 pub mod path_file;
 pub mod raw;
+pub mod route_file;
 pub mod samples;
 mod text;
 pub mod transfer_json;
