@@ -6,7 +6,6 @@ mod look;
 mod lumen;
 mod parse;
 mod progress;
-mod route;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

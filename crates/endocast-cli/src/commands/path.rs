@@ -4,13 +4,13 @@
 use crate::input::InputArgs;
 use crate::lumen::LumenArgs;
 use crate::parse::parse_vec3;
-use crate::route::is_markups;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::navigate::{plan_path, PathEnd, PlannedPath};
 use endocast_core::path::SmoothOptions;
 use endocast_core::Volume;
 use endocast_io::path_file::{write_path_json, PathDocument};
+use endocast_io::route_file::is_markups;
 use glam::DVec3;
 use serde_json::json;
 use std::path::{Path, PathBuf};
