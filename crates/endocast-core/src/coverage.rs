@@ -130,6 +130,16 @@ impl Coverage {
         })
     }
 
+    /// The same wall with nothing seen yet: a fresh coverage for another pass over it (its
+    /// result can be [merged](Coverage::merge) with this one's).
+    pub fn cleared(&self) -> Self {
+        Self {
+            seen: Bits::new(self.size.iter().product()),
+            seen_count: 0,
+            ..self.clone()
+        }
+    }
+
     /// Number of wall voxels.
     pub fn total(&self) -> usize {
         self.wall_count

@@ -147,7 +147,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     );
     if let Some(forward) = flight.into_coverage() {
         let lumen = lumen.as_ref().context("coverage needs the lumen")?;
-        let seen = fly_back(args, &renderer, &route, &options, &settings, lumen, forward)?;
+        let seen = fly_back(args, &renderer, &route, &options, &settings, forward)?;
         let geometry = renderer.volume().geometry();
         fly_coverage::report(&args.output, geometry, lumen, &seen)?;
     }
@@ -162,20 +162,11 @@ fn fly_back(
     route: &Route,
     options: &FlightOptions,
     settings: &RenderSettings,
-    lumen: &Lumen,
     forward: Coverage,
 ) -> Result<WallSeen> {
-    let wall =
-        wall_coverage(lumen, renderer.volume().geometry()).context("no wall around the lumen")?;
-    let back = BackwardPass::new(
-        renderer,
-        route,
-        options,
-        args.frame_step,
-        args.look_ahead,
-        wall,
-    )
-    .context("cannot reverse the path")?;
+    let (step, look_ahead) = (args.frame_step, args.look_ahead);
+    let back = BackwardPass::new(renderer, route, options, step, look_ahead, &forward)
+        .context("cannot reverse the path")?;
     let Some(back) = back else {
         return Ok(WallSeen::forward_only(forward));
     };

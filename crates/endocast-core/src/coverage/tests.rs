@@ -315,6 +315,15 @@ fn the_mask_volume_labels_seen_and_unseen_wall_on_the_scan_grid() {
     }
     let count = |label: u8| labels.iter().filter(|&&l| l == label).count();
     assert_eq!(count(MASK_SEEN), coverage.seen_count());
+    let cleared = coverage.cleared();
+    assert_eq!(
+        (cleared.seen_count(), cleared.total()),
+        (0, coverage.total())
+    );
+    assert!(cleared.mask().iter().all(|&l| l != MASK_SEEN));
+    let mut again = cleared.clone();
+    again.merge(&coverage).unwrap();
+    assert_eq!(again, coverage);
     assert!(count(MASK_SEEN) > 0);
     assert_eq!(count(MASK_SEEN) + count(MASK_UNSEEN), coverage.total());
 }

@@ -169,7 +169,7 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
         flight.frame(n, shot, &settings).unwrap();
     }
     let forward = flight.into_coverage().unwrap();
-    let back = BackwardPass::new(&renderer, &route, &options, 5.0, 5.0, wall.clone())
+    let back = BackwardPass::new(&renderer, &route, &options, 5.0, 5.0, &forward)
         .unwrap()
         .unwrap();
     assert_eq!(back.shots().len(), shots.len());
@@ -179,6 +179,7 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
     assert_eq!(frames, shots.len());
     let seen = WallSeen::with_backward(forward.clone(), &backward).unwrap();
     assert_eq!(seen.wall_voxels(), wall.total());
+    assert_eq!(backward.total(), wall.total());
     assert_eq!(seen.seen_forward(), forward.seen_count());
     assert!(seen.seen_forward_backward() >= seen.seen_forward().max(backward.seen_count()));
     assert!(seen.fraction_forward_backward() > seen.fraction_forward());
@@ -202,7 +203,7 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
     .unwrap()])
     .unwrap();
     assert!(
-        BackwardPass::new(&renderer, &keys, &options, 5.0, 5.0, wall)
+        BackwardPass::new(&renderer, &keys, &options, 5.0, 5.0, &forward)
             .unwrap()
             .is_none()
     );

@@ -40,16 +40,17 @@ pub struct BackwardPass<'a> {
 }
 
 impl<'a> BackwardPass<'a> {
-    /// The pass back along `route`, shots every `step_mm` looking `look_ahead_mm` ahead (as the
-    /// forward flight takes them), recording into `wall` (normally a fresh [`wall_coverage`]).
-    /// `Ok(None)` for key frames, whose views have no natural reverse.
+    /// The pass back along `route`, filmed like the `forward` flight (its image size and field
+    /// of view), shots every `step_mm` looking `look_ahead_mm` ahead, recording into a fresh
+    /// coverage of the wall `forward_seen` covers. `Ok(None)` for key frames, whose views have
+    /// no natural reverse.
     pub fn new(
         renderer: &'a Renderer,
         route: &Route,
         forward: &FlightOptions,
         step_mm: f64,
         look_ahead_mm: f64,
-        wall: Coverage,
+        forward_seen: &Coverage,
     ) -> Result<Option<Self>, PathError> {
         let Some(back) = route.reversed(REVERSE_STEP_MM) else {
             return Ok(None);
@@ -61,7 +62,7 @@ impl<'a> BackwardPass<'a> {
             layout: Layout::Endoscope,
             window: Window::AIR_TISSUE,
         };
-        let flight = Flight::new(renderer, options).with_coverage(wall);
+        let flight = Flight::new(renderer, options).with_coverage(forward_seen.cleared());
         Ok(Some(Self { flight, shots }))
     }
 
