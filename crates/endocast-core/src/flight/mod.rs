@@ -14,7 +14,7 @@ pub use error::FlightError;
 pub use frames::{Flight, FlightOptions, Layout};
 pub use looks::ShotSettings;
 pub use overview::{lumen_overview, Overview};
-pub use wall::{wall_coverage, BackwardPass, WallSeen, UNSEEN_TINT};
+pub use wall::{wall_coverage, BackwardPass, WallSeen, REPORT_TINT};
 
 use crate::animation::{Animation, AnimationError, KeyFrame};
 use crate::path::{Path, PathError};

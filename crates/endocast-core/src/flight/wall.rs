@@ -18,8 +18,9 @@ use crate::Geometry;
 /// Sample step of the spline through the reversed route's samples, mm.
 const REVERSE_STEP_MM: f64 = 0.5;
 
-/// Colour and strength of the tint on wall never seen, in [`WallSeen::overview`].
-pub const UNSEEN_TINT: (Rgb, f32) = ([230, 40, 40], 0.8);
+/// Colour and strength of the tint on wall never seen in the coverage report's overview
+/// ([`WallSeen::overview`]; the dashboard tints more lightly, over its live overview).
+pub const REPORT_TINT: (Rgb, f32) = ([230, 40, 40], 0.8);
 
 /// The wall voxels around `lumen` (its bounding box grown by one voxel, where the wall is, and
 /// clipped to `geometry`'s grid), none seen yet.
@@ -154,7 +155,7 @@ impl WallSeen {
     }
 
     /// The lumen seen from the front ([`lumen_overview`], `size` pixels) with the wall the
-    /// forward pass never saw tinted in [`UNSEEN_TINT`].
+    /// forward pass never saw tinted in [`REPORT_TINT`].
     pub fn overview(
         &self,
         lumen: &Lumen,
@@ -162,7 +163,7 @@ impl WallSeen {
         size: [usize; 2],
     ) -> Result<Overview, FlightError> {
         let mut overview = lumen_overview(lumen, geometry, size)?;
-        let (color, amount) = UNSEEN_TINT;
+        let (color, amount) = REPORT_TINT;
         self.forward.tint_unseen(
             &mut overview.image,
             &overview.camera,
