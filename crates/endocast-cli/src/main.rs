@@ -7,7 +7,6 @@ mod lumen;
 mod optics;
 mod parse;
 mod progress;
-mod route;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

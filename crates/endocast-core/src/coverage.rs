@@ -22,7 +22,7 @@
 
 use crate::render::{Camera, Frame};
 use crate::views::{Image, Rgb};
-use crate::Geometry;
+use crate::{Geometry, Modality, ValueMap, Volume, VolumeError};
 use glam::{DAffine3, DVec3};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -128,6 +128,16 @@ impl Coverage {
             wall_count,
             seen_count: 0,
         })
+    }
+
+    /// The same wall with nothing seen yet: a fresh coverage for another pass over it (its
+    /// result can be [merged](Coverage::merge) with this one's).
+    pub fn cleared(&self) -> Self {
+        Self {
+            seen: Bits::new(self.size.iter().product()),
+            seen_count: 0,
+            ..self.clone()
+        }
     }
 
     /// Number of wall voxels.
@@ -252,6 +262,14 @@ impl Coverage {
                 }
             });
         out
+    }
+
+    /// [`Coverage::mask`] as a volume on the grid the coverage was made for (the scan's
+    /// geometry, unit value map, no modality), ready to write as NIfTI or NRRD.
+    pub fn mask_volume(&self) -> Result<Volume, VolumeError> {
+        let voxels = self.mask().into_iter().map(u16::from).collect();
+        let map = ValueMap::new(1.0, 0.0)?;
+        Volume::new(self.geometry, voxels, map, Modality::Unknown)
     }
 
     /// Tints in `color` (blended by `amount`, 0–1) the pixels of an overview `image`, rendered

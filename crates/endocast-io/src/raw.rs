@@ -1,27 +1,13 @@
 //! Headerless sample files, described by the caller (dimensions, spacing, type, byte order).
 
 use crate::error::{ReadError, Result};
-use crate::open::{Format, Loaded, OpenOptions, SourceInfo};
-use crate::samples::{read_voxels, ElementType, Endian, Rescale};
+pub use crate::loaded::RawSpec;
+use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
+use crate::samples::{read_voxels, Endian, Rescale};
 use endocast_core::{Geometry, Modality, Volume};
 use glam::DVec3;
 use std::io::{BufReader, Seek, SeekFrom};
 use std::path::Path;
-
-/// How to read a headerless file: an axis-aligned LPS grid starting at the origin.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RawSpec {
-    /// Samples along `i`, `j`, `k` (`i` fastest in the file).
-    pub dims: [usize; 3],
-    /// Voxel spacing in mm.
-    pub spacing_mm: [f64; 3],
-    /// Sample type.
-    pub element: ElementType,
-    /// Byte order of multi-byte samples.
-    pub endian: Endian,
-    /// Bytes to skip before the first sample.
-    pub header_bytes: u64,
-}
 
 /// Reads the raw file at `path` as `options.raw` describes it.
 pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {

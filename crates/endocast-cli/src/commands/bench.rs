@@ -5,15 +5,14 @@
 
 use crate::look::{find_preset, in_pool, LookArgs};
 use crate::parse::parse_size;
-use crate::route::read_route;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::presets::DEFAULT_FOV_DEG;
 use endocast_core::render::{Camera, Frame, Mode, RenderSettings, Renderer};
+use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::OpenOptions;
-use glam::DVec3;
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -167,56 +166,19 @@ fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, 
     Ok((Renderer::for_many_frames(loaded.volume), poses, vec![cell]))
 }
 
-/// Reads a camera path file: a JSON list of {"eye", "look_at", "up"} (world mm, the format the
-/// VTK peer script reads too), or a path as `endocast fly` takes it (then `frames` cameras
-/// spread evenly along it, looking 10 mm ahead).
-fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read the path {}", path.display()))?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    let Some(list) = value.as_array() else {
-        return route_poses(path, frames);
-    };
-    let vector = |item: &serde_json::Value, key: &str, n: usize| -> Result<DVec3> {
-        let v: Option<Vec<f64>> = item[key]
-            .as_array()
-            .and_then(|a| a.iter().map(serde_json::Value::as_f64).collect());
-        match v.as_deref() {
-            Some(&[x, y, z]) => Ok(DVec3::new(x, y, z)),
-            _ => bail!(
-                "{}: camera {n} has no {key:?} of three numbers",
-                path.display()
-            ),
-        }
-    };
-    let poses = list
-        .iter()
-        .enumerate()
-        .map(|(n, item)| {
-            Ok(Pose {
-                eye_mm: vector(item, "eye", n)?,
-                look_at_mm: vector(item, "look_at", n)?,
-                up: vector(item, "up", n)?,
-            })
-        })
-        .collect::<Result<Vec<_>>>()?;
-    if poses.is_empty() {
-        bail!("{}: the path has no cameras", path.display());
-    }
-    Ok(poses)
-}
+/// How far ahead the cameras taken along a route file look, mm.
+const LOOK_AHEAD_MM: f64 = 10.0;
 
-/// `frames` cameras spread evenly along a route file (see [`read_route`]).
-fn route_poses(path: &Path, frames: usize) -> Result<Vec<Pose>> {
-    let route = read_route(path)?;
-    let step = route.len_mm() / frames.saturating_sub(1).max(1) as f64;
-    let shots = route.shots(step, 10.0).context("cannot sample the path")?;
-    Ok(shots
-        .into_iter()
-        .take(frames)
-        .map(|shot| shot.pose)
-        .collect())
+/// The cameras of a camera path file: its list of {"eye", "look_at", "up"} (world mm, the format
+/// the VTK peer script reads too), or `frames` cameras spread evenly along a route file as
+/// `endocast fly` takes it, looking [`LOOK_AHEAD_MM`] ahead.
+fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
+    match read_camera_path(path).context("cannot read the path")? {
+        CameraPath::Cameras(poses) => Ok(poses),
+        CameraPath::Route(route) => route
+            .spread_poses(frames, LOOK_AHEAD_MM)
+            .context("cannot sample the path"),
+    }
 }
 
 /// Prints one table row (and appends a JSON line when asked).

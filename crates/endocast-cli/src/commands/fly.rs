@@ -2,20 +2,24 @@
 //! animated GIF or an MP4, as the endoscopic view alone or as a dashboard; optionally measuring
 //! how much of the lumen wall the flight showed.
 
+use crate::commands::fly_coverage;
 use crate::input::InputArgs;
 use crate::look::{set_threads, transfer_function, LookArgs};
 use crate::lumen::LumenArgs;
 use crate::parse::parse_size;
 use crate::progress::Progress;
-use crate::route::read_route;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use endocast_core::coverage::Coverage;
-use endocast_core::flight::{lumen_overview, Flight, FlightOptions, Layout, Shot};
+use endocast_core::flight::{
+    lumen_overview, wall_coverage, BackwardPass, Flight, FlightOptions, Layout, Route, Shot,
+    ShotSettings, WallSeen,
+};
 use endocast_core::navigate::{seed_voxel, Lumen};
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{RenderSettings, Renderer};
 use endocast_core::views::slices::Window;
+use endocast_io::route_file::read_route;
 use endocast_io::video::{open_sink, VideoOptions};
 use std::path::PathBuf;
 
@@ -93,7 +97,7 @@ pub fn run(args: &mut FlyArgs) -> Result<()> {
             args.frame_step
         );
     }
-    let route = read_route(&args.route)?;
+    let route = read_route(&args.route).context("cannot read the path")?;
     let shots = route
         .shots(args.frame_step, args.look_ahead)
         .context("cannot sample the route")?;
@@ -125,7 +129,7 @@ pub fn run(args: &mut FlyArgs) -> Result<()> {
         },
         window,
     };
-    let mut flight = Flight::new(&renderer, options);
+    let mut flight = Flight::new(&renderer, options.clone());
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {
@@ -133,13 +137,14 @@ pub fn run(args: &mut FlyArgs) -> Result<()> {
             flight = flight.with_overview(overview, route.points_mm(2.0)?)?;
         }
         if args.coverage {
-            flight = flight.with_coverage(wall_coverage(lumen, geometry)?);
+            let wall = wall_coverage(lumen, geometry).context("no wall around the lumen")?;
+            flight = flight.with_coverage(wall);
         }
     }
     let mut progress = Progress::new("flying", shots.len());
-    let mut tfs = TfCache::default();
+    let mut looks = ShotSettings::new(settings.clone(), transfer_function);
     for (n, shot) in shots.iter().enumerate() {
-        let shot_settings = tfs.settings_for(&settings, shot)?;
+        let shot_settings = looks.for_shot(shot)?;
         let (image, _) = flight.frame(n, shot, &shot_settings)?;
         sink.push_image(&image)?;
         progress.step();
@@ -154,16 +159,34 @@ pub fn run(args: &mut FlyArgs) -> Result<()> {
         progress.rate()
     );
     if let Some(forward) = flight.into_coverage() {
-        crate::commands::fly_coverage::report(
-            args,
-            &renderer,
-            &route,
-            &settings,
-            lumen.as_ref(),
-            &forward,
-        )?;
+        let lumen = lumen.as_ref().context("coverage needs the lumen")?;
+        let seen = fly_back(args, &renderer, &route, &options, &settings, forward)?;
+        let geometry = renderer.volume().geometry();
+        fly_coverage::report(&args.output, geometry, lumen, &seen)?;
     }
     Ok(())
+}
+
+/// Flies `route` back for coverage (with a progress line) and adds what it saw to `forward`;
+/// key frames are not flown back.
+fn fly_back(
+    args: &FlyArgs,
+    renderer: &Renderer,
+    route: &Route,
+    options: &FlightOptions,
+    settings: &RenderSettings,
+    forward: Coverage,
+) -> Result<WallSeen> {
+    let (step, look_ahead) = (args.frame_step, args.look_ahead);
+    let back = BackwardPass::new(renderer, route, options, step, look_ahead, &forward)
+        .context("cannot reverse the path")?;
+    let Some(back) = back else {
+        return Ok(WallSeen::forward_only(forward));
+    };
+    let mut progress = Progress::new("backward", back.shots().len());
+    let backward = back.fly(settings, || progress.step())?;
+    progress.finish();
+    Ok(WallSeen::with_backward(forward, &backward)?)
 }
 
 fn video_options(fps: f64) -> VideoOptions {
@@ -191,14 +214,6 @@ fn lumen_at_start(
         .with_context(|| format!("the route's start is not in a lumen {side} {threshold}"))
 }
 
-/// Coverage of the wall voxels around `lumen` (its box grown by one voxel, where the wall is).
-pub fn wall_coverage(lumen: &Lumen, geometry: &endocast_core::Geometry) -> Result<Coverage> {
-    let (lo, hi) = lumen.bounds();
-    let dims = geometry.dims();
-    let bbox = [0, 1, 2].map(|a| lo[a].saturating_sub(1)..(hi[a] + 2).min(dims[a]));
-    Coverage::new(geometry, |v| lumen.is_wall(v), &bbox).context("no wall around the lumen")
-}
-
 /// The dashboard's slice window: `--window` when given, else the preset's, else the window for
 /// air-filled lumens.
 fn slice_window(text: Option<&str>, preset: Option<&Preset>) -> Result<Window> {
@@ -218,34 +233,6 @@ fn parse_window(text: &str) -> Result<Window> {
         bail!("--window expects LEVEL,WIDTH, found {text:?}");
     };
     Window::new(level, width).with_context(|| format!("--window {text:?}"))
-}
-
-/// Render settings per shot: the flight's, with a key frame's isovalue, opacity and transfer
-/// function; each transfer function is read once.
-#[derive(Default)]
-struct TfCache {
-    loaded: Vec<(String, endocast_core::render::TransferFunction)>,
-}
-
-impl TfCache {
-    fn settings_for(&mut self, base: &RenderSettings, shot: &Shot) -> Result<RenderSettings> {
-        let mut settings = base.clone();
-        let Some(look) = &shot.look else {
-            return Ok(settings);
-        };
-        settings.iso_hu = look.iso_hu;
-        settings.iso_opacity = look.iso_opacity;
-        if let Some(name) = &look.tf {
-            if let Some((_, tf)) = self.loaded.iter().find(|(n, _)| n == name) {
-                settings.tf = tf.clone();
-            } else {
-                let tf = transfer_function(name)?;
-                settings.tf = tf.clone();
-                self.loaded.push((name.clone(), tf));
-            }
-        }
-        Ok(settings)
-    }
 }
 
 #[cfg(test)]

@@ -1,121 +1,54 @@
 //! The coverage report of `endocast fly --coverage`: the wall seen flying forward, and forward
 //! plus backward (the same path flown back), printed and written beside the video.
 
-use super::fly::{wall_coverage, FlyArgs};
-use crate::progress::Progress;
 use anyhow::{Context, Result};
-use endocast_core::coverage::Coverage;
-use endocast_core::flight::{lumen_overview, Flight, FlightOptions, Layout, Route};
+use endocast_core::flight::WallSeen;
 use endocast_core::navigate::Lumen;
-use endocast_core::render::{RenderSettings, Renderer};
-use endocast_core::views::slices::Window;
-use endocast_core::{Modality, ValueMap, Volume};
+use endocast_core::Geometry;
 use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Size of the coverage overview image, pixels.
 const OVERVIEW_PX: usize = 512;
 
-/// Flies the route backward for coverage, then prints and writes the forward and merged figures.
-pub fn report(
-    args: &FlyArgs,
-    renderer: &Renderer,
-    route: &Route,
-    settings: &RenderSettings,
-    lumen: Option<&Lumen>,
-    forward: &Coverage,
-) -> Result<()> {
-    let lumen = lumen.context("coverage needs the lumen")?;
-    let geometry = renderer.volume().geometry();
-    let mut both = forward.clone();
-    if let Some(back) = route.reversed(0.5) {
-        let back = back.context("cannot reverse the path")?;
-        let backward = fly_for_coverage(
-            args,
-            renderer,
-            &back,
-            settings,
-            wall_coverage(lumen, geometry)?,
-        )?;
-        both.merge(&backward)?;
-    }
+/// Prints the forward and merged figures of `seen` and writes, beside `output`,
+/// `OUT.coverage.json` (the figures), `OUT.coverage.png` (the lumen with the unseen wall in red)
+/// and `OUT.coverage.nii.gz` (the mask: 1 seen, 2 unseen wall voxels).
+pub fn report(output: &Path, geometry: &Geometry, lumen: &Lumen, seen: &WallSeen) -> Result<()> {
     println!(
         "coverage: {:.1} % of {} wall voxels seen flying forward, {:.1} % forward + backward",
-        100.0 * forward.seen_fraction(),
-        forward.total(),
-        100.0 * both.seen_fraction()
+        100.0 * seen.fraction_forward(),
+        seen.wall_voxels(),
+        100.0 * seen.fraction_forward_backward()
     );
     let json = json!({
-        "wall_voxels": forward.total(),
-        "seen_forward": forward.seen_count(),
-        "seen_forward_backward": both.seen_count(),
-        "fraction_forward": forward.seen_fraction(),
-        "fraction_forward_backward": both.seen_fraction(),
+        "wall_voxels": seen.wall_voxels(),
+        "seen_forward": seen.seen_forward(),
+        "seen_forward_backward": seen.seen_forward_backward(),
+        "fraction_forward": seen.fraction_forward(),
+        "fraction_forward_backward": seen.fraction_forward_backward(),
     });
     let text = serde_json::to_string_pretty(&json)?;
-    endocast_io::atomic::write_file(&beside(args, "json"), |w| w.write_all(text.as_bytes()))
+    endocast_io::atomic::write_file(&beside(output, "json"), |w| w.write_all(text.as_bytes()))
         .context("cannot write the coverage report")?;
-    let mut overview = lumen_overview(lumen, geometry, [OVERVIEW_PX; 2])?;
-    forward.tint_unseen(
-        &mut overview.image,
-        &overview.camera,
-        &overview.depth_mm,
-        [230, 40, 40],
-        0.8,
-    )?;
+    let overview = seen.overview(lumen, geometry, [OVERVIEW_PX; 2])?;
     let image = &overview.image;
     endocast_io::image_out::write_png_rgb8(
-        &beside(args, "png"),
+        &beside(output, "png"),
         image.width() as u32,
         image.height() as u32,
         image.rgb(),
     )
     .context("cannot write the coverage image")?;
-    let mask = mask_volume(renderer.volume(), forward)?;
-    endocast_io::write(&beside(args, "nii.gz"), &mask).context("cannot write the coverage mask")?;
+    let mask = seen.mask_volume()?;
+    endocast_io::write(&beside(output, "nii.gz"), &mask)
+        .context("cannot write the coverage mask")?;
     Ok(())
 }
 
-/// Flies `route` with the endoscope only, recording into `coverage`.
-fn fly_for_coverage(
-    args: &FlyArgs,
-    renderer: &Renderer,
-    route: &Route,
-    settings: &RenderSettings,
-    coverage: Coverage,
-) -> Result<Coverage> {
-    let shots = route.shots(args.frame_step, args.look_ahead)?;
-    let options = FlightOptions {
-        size: args.size,
-        fov_deg: args.fov,
-        layout: Layout::Endoscope,
-        window: Window::AIR_TISSUE,
-    };
-    let mut flight = Flight::new(renderer, options).with_coverage(coverage);
-    let mut progress = Progress::new("backward", shots.len());
-    for (n, shot) in shots.iter().enumerate() {
-        flight.frame(n, shot, settings)?;
-        progress.step();
-    }
-    progress.finish();
-    flight.into_coverage().context("coverage was not tracked")
-}
-
 /// `OUT.coverage.EXT` beside the output (OUT without its ending).
-fn beside(args: &FlyArgs, ending: &str) -> PathBuf {
-    let mut name = args.output.with_extension("").into_os_string();
+fn beside(output: &Path, ending: &str) -> PathBuf {
+    let mut name = output.with_extension("").into_os_string();
     name.push(format!(".coverage.{ending}"));
     PathBuf::from(name)
-}
-
-/// The coverage mask as a volume on the scan's grid: 1 seen, 2 unseen wall, 0 elsewhere.
-fn mask_volume(scan: &Volume, coverage: &Coverage) -> Result<Volume> {
-    let voxels = coverage.mask().into_iter().map(u16::from).collect();
-    let map = ValueMap::new(1.0, 0.0)?;
-    Ok(Volume::new(
-        *scan.geometry(),
-        voxels,
-        map,
-        Modality::Unknown,
-    )?)
 }

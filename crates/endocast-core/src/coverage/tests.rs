@@ -286,3 +286,44 @@ fn rejects_bad_input() {
     assert!(full.record(&camera, &frame).is_err());
     assert_eq!(full.seen_count(), 0);
 }
+
+#[test]
+fn the_mask_volume_labels_seen_and_unseen_wall_on_the_scan_grid() {
+    let (volume, _) = phantom::straight_tube(&PhantomOptions {
+        size: 16,
+        ..Default::default()
+    });
+    let g = *volume.geometry();
+    let mut coverage = Coverage::new(&g, threshold_wall(&volume, -500.0), &whole(&volume)).unwrap();
+    let first_wall = (0..16 * 16 * 16)
+        .map(|n| [n % 16, n / 16 % 16, n / 256])
+        .find(|&v| coverage.state(v).is_some())
+        .unwrap();
+    let p = DVec3::new(
+        first_wall[0] as f64,
+        first_wall[1] as f64,
+        first_wall[2] as f64,
+    );
+    assert!(coverage.mark_point(g.world_of(p)) > 0);
+    let mask = coverage.mask_volume().unwrap();
+    assert_eq!(mask.geometry(), &g);
+    assert_eq!(mask.dims(), g.dims());
+    let labels = coverage.mask();
+    for (stored, label) in mask.voxels().iter().zip(&labels) {
+        assert_eq!(*stored, u16::from(*label));
+        assert_eq!(mask.value_map().physical(*stored), f64::from(*label));
+    }
+    let count = |label: u8| labels.iter().filter(|&&l| l == label).count();
+    assert_eq!(count(MASK_SEEN), coverage.seen_count());
+    let cleared = coverage.cleared();
+    assert_eq!(
+        (cleared.seen_count(), cleared.total()),
+        (0, coverage.total())
+    );
+    assert!(cleared.mask().iter().all(|&l| l != MASK_SEEN));
+    let mut again = cleared.clone();
+    again.merge(&coverage).unwrap();
+    assert_eq!(again, coverage);
+    assert!(count(MASK_SEEN) > 0);
+    assert_eq!(count(MASK_SEEN) + count(MASK_UNSEEN), coverage.total());
+}

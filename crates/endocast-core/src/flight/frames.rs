@@ -1,47 +1,17 @@
 //! The frames of a flight: render each shot, track the wall seen, and lay out the dashboard.
 
+use super::error::FlightError;
 use super::overview::Overview;
 use super::Shot;
-use crate::coverage::{Coverage, CoverageError};
-use crate::path::PathError;
-use crate::render::SettingsError;
-use crate::render::{Camera, CameraError, Frame, Prepared, RenderSettings, RenderStats, Renderer};
+use crate::coverage::Coverage;
+use crate::render::{Camera, Frame, Prepared, RenderSettings, RenderStats, Renderer};
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
-use crate::views::{Image, Rgb, ViewError};
-use crate::{GeometryError, VolumeError};
+use crate::views::{Image, Rgb};
 use glam::DVec3;
-use thiserror::Error;
 
 /// Colour and strength of the tint on wall not seen yet, in the dashboard's overview.
 const UNSEEN_TINT: (Rgb, f32) = ([230, 40, 40], 0.55);
-
-/// Why a flight frame could not be made.
-#[derive(Debug, Error)]
-#[non_exhaustive]
-pub enum FlightError {
-    /// A shot's camera is invalid.
-    #[error(transparent)]
-    Camera(#[from] CameraError),
-    /// The render settings are invalid.
-    #[error(transparent)]
-    Settings(#[from] SettingsError),
-    /// A view could not be drawn.
-    #[error(transparent)]
-    View(#[from] ViewError),
-    /// Coverage could not be tracked.
-    #[error(transparent)]
-    Coverage(#[from] CoverageError),
-    /// The route could not be sampled.
-    #[error(transparent)]
-    Path(#[from] PathError),
-    /// The overview volume could not be built.
-    #[error(transparent)]
-    Geometry(#[from] GeometryError),
-    /// The overview volume could not be built.
-    #[error(transparent)]
-    Volume(#[from] VolumeError),
-}
 
 /// What each frame shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

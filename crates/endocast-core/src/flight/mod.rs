@@ -1,15 +1,22 @@
 //! A fly-through: the camera shots along a smooth [`Path`] or a key-frame [`Animation`], and
 //! the frames of the flight — the endoscopic view alone or a dashboard with the three slices
 //! and an overview of the lumen — while the [`Coverage`](crate::coverage::Coverage) of the wall
-//! is tracked.
+//! is tracked; the settings of each shot ([`ShotSettings`]: a key frame's look); and the
+//! coverage measurement, forward and back ([`wall_coverage`], [`BackwardPass`], [`WallSeen`]).
 
+mod error;
 mod frames;
+mod looks;
 mod overview;
+mod wall;
 
-pub use frames::{Flight, FlightError, FlightOptions, Layout};
+pub use error::FlightError;
+pub use frames::{Flight, FlightOptions, Layout};
+pub use looks::ShotSettings;
 pub use overview::{lumen_overview, Overview};
+pub use wall::{wall_coverage, BackwardPass, WallSeen, REPORT_TINT};
 
-use crate::animation::Animation;
+use crate::animation::{Animation, AnimationError, KeyFrame};
 use crate::path::{Path, PathError};
 use crate::pose::Pose;
 use glam::DVec3;
@@ -49,7 +56,35 @@ pub enum Route {
     Keys(Animation),
 }
 
+/// Sample step of the spline through a route's given points, mm (frames are taken from it at
+/// any spacing).
+pub const ROUTE_STEP_MM: f64 = 0.5;
+
 impl Route {
+    /// A path through `points_mm` (world mm), passing through each exactly, sampled every
+    /// [`ROUTE_STEP_MM`].
+    pub fn through_points(points_mm: &[DVec3]) -> Result<Self, PathError> {
+        Path::from_points_exact(points_mm, ROUTE_STEP_MM).map(Self::Path)
+    }
+
+    /// Key frames, played at constant speed.
+    pub fn from_key_frames(keys: Vec<KeyFrame>) -> Result<Self, AnimationError> {
+        Animation::new(keys).map(Self::Keys)
+    }
+
+    /// `frames` camera poses spread evenly from the start to the end of the route (both
+    /// included when `frames` ≥ 2), a path looking `look_ahead_mm` ahead: a benchmark's fixed
+    /// number of frames.
+    pub fn spread_poses(&self, frames: usize, look_ahead_mm: f64) -> Result<Vec<Pose>, PathError> {
+        let step_mm = self.len_mm() / frames.saturating_sub(1).max(1) as f64;
+        let shots = self.shots(step_mm, look_ahead_mm)?;
+        Ok(shots
+            .into_iter()
+            .take(frames)
+            .map(|shot| shot.pose)
+            .collect())
+    }
+
     /// Length of the route, mm of arc (key frames: of playback, see [`Animation`]).
     pub fn len_mm(&self) -> f64 {
         match self {

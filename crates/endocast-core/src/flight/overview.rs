@@ -2,7 +2,7 @@
 //! isosurface from the patient's front, so the path and the camera can be drawn on it and the
 //! unseen wall tinted.
 
-use super::frames::FlightError;
+use super::error::FlightError;
 use crate::navigate::Lumen;
 use crate::render::{Camera, Mode, RenderSettings, Renderer};
 use crate::views::Image;

@@ -1,6 +1,6 @@
 //! [`NavError`]: why a lumen, a distance field or a path could not be made.
 
-use super::lumen::LumenSide;
+use super::side::LumenSide;
 use thiserror::Error;
 
 /// A navigation request that cannot be served: each variant says what was expected and what

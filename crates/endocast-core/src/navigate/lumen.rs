@@ -7,38 +7,8 @@
 //! set over the volume, so its memory is bounded by `voxels / 8` bytes plus the stack of runs.
 
 use super::error::{check_finite, NavError};
+pub use super::side::LumenSide;
 use crate::{ValueMap, Volume};
-use std::fmt;
-
-/// Which side of the threshold the lumen lies on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum LumenSide {
-    /// The lumen is darker than the wall: air in CT, CSF in T1 MRI.
-    Below,
-    /// The lumen is brighter than the wall: contrast-filled vessels, CSF in T2 MRI.
-    Above,
-}
-
-impl LumenSide {
-    /// True when `value` lies strictly on this side of `threshold` (a voxel exactly at the
-    /// threshold is wall, like the renderer's isosurface).
-    #[inline]
-    pub fn holds(self, value: f64, threshold: f64) -> bool {
-        match self {
-            Self::Below => value < threshold,
-            Self::Above => value > threshold,
-        }
-    }
-}
-
-impl fmt::Display for LumenSide {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::Below => "below",
-            Self::Above => "above",
-        })
-    }
-}
 
 /// One bit per voxel of a box, `i` fastest.
 #[derive(Debug, Clone, PartialEq)]

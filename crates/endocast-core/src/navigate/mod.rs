@@ -25,6 +25,7 @@ mod error;
 mod lumen;
 mod plan;
 mod preset;
+mod side;
 #[cfg(test)]
 mod test_util;
 mod viewpoint;

@@ -9,6 +9,7 @@ use super::crossing::{bisect, crosses, first_crossing, Bracket, BISECTION_LEVELS
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
 #[cfg(target_arch = "x86_64")]
 use super::packet;
+use super::ray_task::{PixelOut, RayTask};
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
 use super::transfer::TfTable;
@@ -54,52 +55,6 @@ pub(crate) struct Params {
     pub refine_steps: u32,
     pub shade_dvr: bool,
     pub skip_empty: bool,
-}
-
-/// What a ray produced.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct PixelOut {
-    /// Premultiplied colour and opacity.
-    pub accum: Accum,
-    /// Distance to the first isosurface hit, mm (NaN where none).
-    pub depth_mm: f32,
-    /// Extreme stored value of MIP/MinIP (NaN otherwise or where no sample was taken).
-    pub value: f32,
-    /// Whether early termination stopped the ray.
-    pub terminated: bool,
-}
-
-impl Default for PixelOut {
-    fn default() -> Self {
-        Self {
-            accum: Accum::default(),
-            depth_mm: f32::NAN,
-            value: f32::NAN,
-            terminated: false,
-        }
-    }
-}
-
-/// One ray of a group rendered phase by phase ([`Integrator::run_group`]): its march, unit world
-/// direction and result, and what its phases hand on.
-#[derive(Debug, Clone)]
-pub(crate) struct RayTask {
-    pub march: RayMarch,
-    pub dir_world: Vec3,
-    pub out: PixelOut,
-    pub(crate) bracket: Option<Bracket>,
-}
-
-impl RayTask {
-    /// A ray not yet rendered.
-    pub fn new(march: RayMarch, dir_world: Vec3) -> Self {
-        Self {
-            march,
-            dir_world,
-            out: PixelOut::default(),
-            bracket: None,
-        }
-    }
 }
 
 /// The per-frame context of the integrators.

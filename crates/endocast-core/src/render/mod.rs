@@ -41,6 +41,7 @@ mod integrate;
 mod march;
 #[cfg(target_arch = "x86_64")]
 mod packet;
+mod ray_task;
 #[cfg(target_arch = "x86_64")]
 mod rays4;
 mod sample;
@@ -66,8 +67,9 @@ pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
 use frame::to_u8;
 use glam::{DAffine3, DVec3, Vec3};
-use integrate::{Integrator, Params, PixelOut, Probe, RayTask, Surface};
+use integrate::{Integrator, Params, Probe, Surface};
 use march::RayMarch;
+use ray_task::{PixelOut, RayTask};
 #[cfg(target_arch = "x86_64")]
 use rays4::RaySetup;
 use std::time::Instant;

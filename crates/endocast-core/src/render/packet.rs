@@ -12,8 +12,8 @@
 //! surface): at the sample after the crossing, the brick it was found in pending.
 
 use super::crossing::Bracket;
-use super::integrate::RayTask;
 use super::march::MarchStats;
+use super::ray_task::RayTask;
 use super::sample::avx2::trilinear;
 use super::sample::Sampler;
 use super::traverse::{BrickDda, Segment};

@@ -53,7 +53,7 @@ mod stack;
 mod values;
 
 use crate::error::{ReadError, Result};
-use crate::open::{Format, Loaded, OpenOptions, SourceInfo};
+use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use endocast_core::{Modality, Volume};
 use pixels::{FrameStats, SampleMap};
 use rayon::prelude::*;

@@ -2,7 +2,7 @@
 
 use super::scan::{ImageFile, Scanned};
 use crate::error::{ReadError, Result};
-use crate::open::SeriesSummary;
+use crate::loaded::SeriesSummary;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

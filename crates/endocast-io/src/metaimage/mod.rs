@@ -15,7 +15,7 @@ pub use header::{read_header, DataFile, DataStart, Header};
 pub use write::write;
 
 use crate::error::{ReadError, Result};
-use crate::open::{Format, Loaded, OpenOptions, SourceInfo};
+use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::{read_voxels, Endian, Rescale};
 use endocast_core::{Geometry, Modality, Volume};
 use flate2::bufread::ZlibDecoder;

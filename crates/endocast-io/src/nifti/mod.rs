@@ -21,7 +21,7 @@ mod write;
 pub use write::write;
 
 use crate::error::{ReadError, Result};
-use crate::open::{Format, Loaded, OpenOptions, SourceInfo};
+use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::{read_voxels, Endian, Rescale};
 use endocast_core::{Modality, Volume};
 use flate2::read::MultiGzDecoder;

@@ -6,7 +6,8 @@
 //! go straight from disk (through the decompressor) into the voxel buffer, and a volume split
 //! over files is converted exactly as one in a single file.
 
-use super::header::{ByteSkip, DataFiles, Encoding, Header};
+use super::fields::{ByteSkip, DataFiles, Encoding};
+use super::header::Header;
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
 use crate::samples::{read_voxels, ElementType, Endian, Rescale};

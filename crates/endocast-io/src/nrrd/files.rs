@@ -1,6 +1,6 @@
 //! The `data file` field: one detached file, a `LIST` of files, or a `%d` pattern of files.
 
-use super::header::DataFiles;
+use super::fields::DataFiles;
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
 use std::path::Path;

@@ -12,6 +12,7 @@
 //! Written: see [`write`].
 
 mod data;
+mod fields;
 mod files;
 mod header;
 mod values;
@@ -20,11 +21,12 @@ mod write;
 pub use write::write;
 
 use crate::error::{ReadError, Result};
-use crate::open::{Format, Loaded, OpenOptions, SourceInfo};
+use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::Endian;
 use endocast_core::{Geometry, Modality, Volume};
+use fields::{Center, DataFiles, Encoding, Space};
 use glam::{DMat3, DVec3};
-use header::{Center, DataFiles, Encoding, Header, Space};
+use header::Header;
 use std::path::Path;
 
 /// Reads the NRRD file (`.nrrd`) or detached header (`.nhdr`) at `path` into a volume in the

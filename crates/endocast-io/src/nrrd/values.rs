@@ -1,7 +1,7 @@
 //! Parsers of single NRRD field values: types, counts, encodings, spaces, vectors and the
 //! per-axis lists. Each error names the field and quotes what was found.
 
-use super::header::{ByteSkip, Center, Encoding, Space};
+use super::fields::{ByteSkip, Center, Encoding, Space};
 use crate::error::{ReadError, Result};
 use crate::samples::{ElementType, Endian};
 use std::path::Path;
