@@ -54,7 +54,7 @@ impl LensArgs {
         let (min, max) = projection.field_range();
         if !(min..=max).contains(&field) {
             bail!(
-                "--fov {field} lies outside {min}–{max} {} for --lens {}",
+                "invalid camera: --fov {field} lies outside {min}–{max} {} for --lens {}",
                 projection.field_unit(),
                 projection.name()
             );
