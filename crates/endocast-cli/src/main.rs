@@ -50,7 +50,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => commands::bench::run(&args),
         Command::Presets(args) => commands::presets::run(&args),
         Command::Path(args) => commands::path::run(&args),
-        Command::Fly(mut args) => commands::fly::run(&mut args),
+        Command::Fly(args) => commands::fly::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

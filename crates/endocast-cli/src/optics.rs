@@ -1,11 +1,12 @@
 //! The camera options `render`, `fly` and `bench` share — the lens's projection, distortion
 //! and vignetting — and the stereo options of `render` and `fly`.
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::{Lens, Optics, Projection, StereoRig};
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::views::stereo::StereoOutput;
+use std::path::{Path, PathBuf};
 
 /// The field of a fisheye lens when neither `--fov` nor the preset gives one for it, degrees:
 /// a wide endoscope's.
@@ -90,34 +91,29 @@ pub struct StereoArgs {
 impl StereoArgs {
     /// The rig, the focus distance taken from `nearest` (mm) when not given; `None` without
     /// `--stereo`.
-    pub fn rig(&self, nearest: impl FnOnce() -> f64) -> Result<Option<(StereoRig, StereoOutput)>> {
+    pub fn rig(
+        &self,
+        nearest: impl FnOnce() -> Option<f64>,
+    ) -> Result<Option<(StereoRig, StereoOutput)>> {
         let Some(output) = self.stereo else {
             return Ok(None);
         };
-        let focus_mm = match self.focus {
-            Some(f) => f,
-            None => nearest(),
-        };
-        let eye_separation_mm = self
-            .eye_separation
-            .unwrap_or(focus_mm * endocast_core::camera::SEPARATION_PER_FOCUS);
-        for (name, value) in [
-            ("--focus", focus_mm),
-            ("--eye-separation", eye_separation_mm),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                bail!("{name} must be a positive number of mm, not {value}");
-            }
-        }
-        if eye_separation_mm >= 2.0 * focus_mm {
-            bail!("--eye-separation {eye_separation_mm} mm must be less than twice --focus {focus_mm} mm");
-        }
-        let rig = StereoRig {
-            eye_separation_mm,
-            focus_mm,
-        };
+        let rig = StereoRig::for_view(self.eye_separation, self.focus, nearest)
+            .context("invalid --stereo options")?;
         Ok(Some((rig, output)))
     }
+}
+
+/// `dir/name.ext` as `dir/name-ending.ext` (a folder `dir/name` as `dir/name-ending`).
+pub fn beside(path: &Path, ending: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or_else(Default::default, |s| s.to_string_lossy());
+    let name = match path.extension() {
+        Some(e) => format!("{stem}-{ending}.{}", e.to_string_lossy()),
+        None => format!("{stem}-{ending}"),
+    };
+    path.with_file_name(name)
 }
 
 /// A projection by name.
@@ -179,18 +175,20 @@ mod tests {
     #[test]
     fn stereo_defaults_put_the_focus_on_the_nearest_surface() {
         let none = StereoArgs::default();
-        assert!(none.rig(|| 10.0).unwrap().is_none());
+        assert!(none.rig(|| Some(10.0)).unwrap().is_none());
         let args = StereoArgs {
             stereo: Some(StereoOutput::Anaglyph),
             ..StereoArgs::default()
         };
-        let (rig, _) = args.rig(|| 12.0).unwrap().unwrap();
+        let (rig, _) = args.rig(|| Some(12.0)).unwrap().unwrap();
+        let (blind, _) = args.rig(|| None).unwrap().unwrap();
+        assert_eq!(blind.focus_mm, endocast_core::camera::FALLBACK_FOCUS_MM);
         assert_eq!(rig.focus_mm, 12.0);
         assert!((rig.eye_separation_mm - 0.4).abs() < 1e-12);
         let bad = StereoArgs {
             focus: Some(f64::NAN),
             ..args
         };
-        assert!(bad.rig(|| 12.0).is_err());
+        assert!(bad.rig(|| Some(12.0)).is_err());
     }
 }

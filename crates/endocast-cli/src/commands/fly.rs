@@ -6,22 +6,24 @@ use crate::commands::fly_coverage;
 use crate::input::InputArgs;
 use crate::look::{set_threads, transfer_function, LookArgs};
 use crate::lumen::LumenArgs;
+use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::parse_size;
 use crate::progress::Progress;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use endocast_core::coverage::Coverage;
 use endocast_core::flight::{
-    lumen_overview, wall_coverage, BackwardPass, Flight, FlightOptions, Layout, Route, Shot,
-    ShotSettings, WallSeen,
+    lumen_overview, wall_coverage, BackwardPass, Flight, FlightOptions, FlightStereo, Layout,
+    Route, Shot, ShotSettings, WallSeen,
 };
 use endocast_core::navigate::{seed_voxel, Lumen};
-use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
+use endocast_core::presets::Preset;
 use endocast_core::render::{RenderSettings, Renderer};
 use endocast_core::views::slices::Window;
+use endocast_core::views::stereo::StereoOutput;
 use endocast_io::route_file::read_route;
-use endocast_io::video::{open_sink, VideoOptions};
-use std::path::PathBuf;
+use endocast_io::video::{open_sink, FrameSink, VideoOptions};
+use std::path::{Path, PathBuf};
 
 /// Arguments of `endocast fly`.
 #[derive(Args, Debug)]
@@ -48,13 +50,14 @@ pub struct FlyArgs {
     /// How far ahead on the path the camera looks, mm.
     #[arg(long, value_name = "MM", default_value_t = 10.0)]
     pub(crate) look_ahead: f64,
-    /// Vertical field of view, degrees (default: the preset's, else 90; key frames carry their
-    /// own).
+    /// Vertical field of view, degrees (default: the preset's, else 90; fisheye 170; key frames
+    /// carry their own); view height in mm for an orthographic lens.
     #[arg(long = "fov", value_name = "DEG")]
     fov_deg: Option<f64>,
-    /// The field of view flown with: `--fov`, else the preset's; set by [`run`].
-    #[arg(skip = DEFAULT_FOV_DEG)]
-    pub(crate) fov: f64,
+    #[command(flatten)]
+    lens: LensArgs,
+    #[command(flatten)]
+    stereo: StereoArgs,
     /// Endoscope image size, pixels.
     #[arg(long, value_name = "WxH", default_value = "384x384", value_parser = parse_size)]
     pub(crate) size: [usize; 2],
@@ -81,13 +84,9 @@ enum LayoutArg {
     Dashboard,
 }
 
-/// Runs `endocast fly`, first filling in the preset's field of view.
-pub fn run(args: &mut FlyArgs) -> Result<()> {
+/// Runs `endocast fly`.
+pub fn run(args: &FlyArgs) -> Result<()> {
     let preset = args.look.preset()?;
-    args.fov = args
-        .fov_deg
-        .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
-    let args = &*args;
     set_threads(args.look.threads)?;
     let settings = args.look.settings()?;
     let window = slice_window(args.window.as_deref(), preset)?;
@@ -97,12 +96,12 @@ pub fn run(args: &mut FlyArgs) -> Result<()> {
             args.frame_step
         );
     }
+    let stereo = flight_stereo(args)?;
     let route = read_route(&args.route).context("cannot read the path")?;
     let shots = route
         .shots(args.frame_step, args.look_ahead)
         .context("cannot sample the route")?;
-    let mut sink =
-        open_sink(&args.output, &video_options(args.fps)).context("cannot write the video")?;
+    let mut sinks = Sinks::open(&args.output, args.fps, stereo.map(|s| s.output))?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
@@ -119,10 +118,15 @@ pub fn run(args: &mut FlyArgs) -> Result<()> {
     } else {
         None
     };
+    let (lo, hi) = loaded.volume.geometry().world_bounds();
+    let optics = args
+        .lens
+        .optics(preset, args.fov_deg, 0.0, (hi - lo).length())?;
     let renderer = Renderer::for_many_frames(loaded.volume);
     let options = FlightOptions {
         size: args.size,
-        fov_deg: args.fov,
+        optics,
+        stereo,
         layout: match args.layout {
             LayoutArg::Endoscope => Layout::Endoscope,
             LayoutArg::Dashboard => Layout::Dashboard,
@@ -145,12 +149,11 @@ pub fn run(args: &mut FlyArgs) -> Result<()> {
     let mut looks = ShotSettings::new(settings.clone(), transfer_function);
     for (n, shot) in shots.iter().enumerate() {
         let shot_settings = looks.for_shot(shot)?;
-        let (image, _) = flight.frame(n, shot, &shot_settings)?;
-        sink.push_image(&image)?;
+        sinks.push(&mut flight, n, shot, &shot_settings)?;
         progress.step();
     }
     progress.finish();
-    let written = sink.finish()?;
+    let written = sinks.finish()?;
     println!(
         "{}: {} frames along {:.1} mm ({:.1} frames/s)",
         written.display(),
@@ -187,6 +190,78 @@ fn fly_back(
     let backward = back.fly(settings, || progress.step())?;
     progress.finish();
     Ok(WallSeen::with_backward(forward, &backward)?)
+}
+
+/// The stereo options as the flight takes them; side-by-side and top-bottom frames are twice
+/// the size, so they go with the endoscopic view alone.
+fn flight_stereo(args: &FlyArgs) -> Result<Option<FlightStereo>> {
+    let Some(output) = args.stereo.stereo else {
+        return Ok(None);
+    };
+    let doubled = matches!(output, StereoOutput::SideBySide | StereoOutput::TopBottom);
+    if doubled && args.layout == LayoutArg::Dashboard {
+        bail!(
+            "--stereo {} needs --layout endoscope (the dashboard takes anaglyphs)",
+            output.name()
+        );
+    }
+    Ok(Some(FlightStereo {
+        output,
+        eye_separation_mm: args.stereo.eye_separation,
+        focus_mm: args.stereo.focus,
+    }))
+}
+
+/// Where the frames go: one film, or for a stereo pair a left and a right one.
+enum Sinks {
+    One(Box<dyn FrameSink>),
+    Pair([Box<dyn FrameSink>; 2]),
+}
+
+impl Sinks {
+    /// The film(s) at `output`: `NAME-left` and `NAME-right` beside it for a pair.
+    fn open(output: &Path, fps: f64, stereo: Option<StereoOutput>) -> Result<Self> {
+        let options = video_options(fps);
+        let open = |path: &Path| open_sink(path, &options).context("cannot write the video");
+        Ok(match stereo {
+            Some(StereoOutput::Pair) => Self::Pair([
+                open(&beside(output, "left"))?,
+                open(&beside(output, "right"))?,
+            ]),
+            _ => Self::One(open(output)?),
+        })
+    }
+
+    /// Renders and writes frame `n`.
+    fn push(
+        &mut self,
+        flight: &mut Flight<'_>,
+        n: usize,
+        shot: &Shot,
+        settings: &RenderSettings,
+    ) -> Result<()> {
+        match self {
+            Self::One(sink) => sink.push_image(&flight.frame(n, shot, settings)?.0)?,
+            Self::Pair([left, right]) => {
+                let ([l, r], _) = flight.stereo_frame(shot, settings)?;
+                left.push_image(&l)?;
+                right.push_image(&r)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Finishes the film(s); returns where the (first) one is.
+    fn finish(self) -> Result<PathBuf> {
+        Ok(match self {
+            Self::One(sink) => sink.finish()?,
+            Self::Pair([left, right]) => {
+                let written = left.finish()?;
+                right.finish()?;
+                written
+            }
+        })
+    }
 }
 
 fn video_options(fps: f64) -> VideoOptions {

@@ -3,7 +3,7 @@
 use crate::input::InputArgs;
 use crate::look::{in_pool, LookArgs};
 use crate::lumen::LumenArgs;
-use crate::optics::{LensArgs, StereoArgs};
+use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -83,11 +83,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
     }
-    let stereo = args.stereo.rig(|| {
-        prepared
-            .nearest_surface_mm(&camera)
-            .unwrap_or(FALLBACK_FOCUS_MM)
-    })?;
+    let stereo = args.stereo.rig(|| prepared.nearest_surface_mm(&camera))?;
     let frame = match stereo {
         Some((rig, output)) => {
             let frames = in_pool(args.look.threads, || prepared.render_stereo(&camera, &rig))?
@@ -165,9 +161,6 @@ fn camera(
         .context("invalid camera")
 }
 
-/// The focus distance of a stereo pair whose view shows no surface, mm.
-const FALLBACK_FOCUS_MM: f64 = 10.0;
-
 /// Writes a stereo pair as `output` asks: one combined image at `path`, or for a pair
 /// `NAME-left.png` and `NAME-right.png` beside it.
 fn write_stereo(path: &Path, frames: &[Frame; 2], output: StereoOutput) -> Result<()> {
@@ -183,17 +176,6 @@ fn write_stereo(path: &Path, frames: &[Frame; 2], output: StereoOutput) -> Resul
         return write(&beside(path, "right"), &right);
     }
     write(path, &stereo::combine(&left, &right, output)?)
-}
-
-/// `dir/name.png` as `dir/name-ending.png`.
-fn beside(path: &Path, ending: &str) -> PathBuf {
-    let stem = path
-        .file_stem()
-        .map_or_else(Default::default, |s| s.to_string_lossy());
-    let extension = path
-        .extension()
-        .map_or_else(|| "png".into(), |e| e.to_string_lossy());
-    path.with_file_name(format!("{stem}-{ending}.{extension}"))
 }
 
 /// The library's default view (see [`default_view`]) for `--preset` and the lumen options,

@@ -30,7 +30,7 @@ mod tests;
 pub use framing::{default_up, framing_eye, framing_pose};
 pub use lens::Lens;
 pub use projection::Projection;
-pub use stereo::{disparity_px, StereoRig, SEPARATION_PER_FOCUS};
+pub use stereo::{disparity_px, StereoRig, FALLBACK_FOCUS_MM, SEPARATION_PER_FOCUS};
 
 use glam::DVec3;
 use thiserror::Error;
@@ -137,6 +137,18 @@ impl Default for Optics {
 }
 
 impl Optics {
+    /// The same optics with the field of an angular projection set to `fov_deg` (a key frame's
+    /// field of view); an orthographic view keeps its height.
+    pub fn with_fov(self, fov_deg: f64) -> Self {
+        match self.projection {
+            Projection::Orthographic => self,
+            _ => Self {
+                field: fov_deg,
+                ..self
+            },
+        }
+    }
+
     /// The camera at `eye_mm` looking at `look_at_mm` with `up`, of `size` pixels.
     pub fn camera(
         &self,

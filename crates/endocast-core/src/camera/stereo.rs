@@ -10,6 +10,9 @@ use super::{Camera, CameraError, EyeShift, Projection};
 /// half-height at 90°.
 pub const SEPARATION_PER_FOCUS: f64 = 1.0 / 30.0;
 
+/// The focus distance of a view that shows no surface, mm.
+pub const FALLBACK_FOCUS_MM: f64 = 10.0;
+
 /// A stereo rig: eye separation and focus distance, mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StereoRig {
@@ -27,6 +30,41 @@ impl StereoRig {
             eye_separation_mm: focus_mm * SEPARATION_PER_FOCUS,
             focus_mm,
         }
+    }
+
+    /// The rig for a view: `focus_mm` when given, else the nearest surface in view
+    /// (`nearest`, mm; [`FALLBACK_FOCUS_MM`] where it sees none), so the scene lies behind the
+    /// screen; `eye_separation_mm` when given, else the 1/30 rule. Fails on a non-positive or
+    /// non-finite distance, or eyes farther apart than twice the focus distance.
+    pub fn for_view(
+        eye_separation_mm: Option<f64>,
+        focus_mm: Option<f64>,
+        nearest: impl FnOnce() -> Option<f64>,
+    ) -> Result<Self, CameraError> {
+        let focus_mm = match focus_mm {
+            Some(f) => f,
+            None => nearest().unwrap_or(FALLBACK_FOCUS_MM),
+        };
+        let eye_separation_mm = eye_separation_mm.unwrap_or(focus_mm * SEPARATION_PER_FOCUS);
+        for (name, value) in [
+            ("focus distance", focus_mm),
+            ("eye separation", eye_separation_mm),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(CameraError::BadStereo(format!(
+                    "the {name} must be a positive number of mm, not {value}"
+                )));
+            }
+        }
+        if eye_separation_mm >= 2.0 * focus_mm {
+            return Err(CameraError::BadStereo(format!(
+                "the eye separation {eye_separation_mm} mm must be less than twice the focus distance {focus_mm} mm"
+            )));
+        }
+        Ok(Self {
+            eye_separation_mm,
+            focus_mm,
+        })
     }
 
     /// The left and right eyes of `camera`.

@@ -3,10 +3,12 @@
 use super::error::FlightError;
 use super::overview::Overview;
 use super::Shot;
+use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
 use crate::render::{Camera, Frame, Prepared, RenderSettings, RenderStats, Renderer};
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
+use crate::views::stereo::{self, StereoOutput};
 use crate::views::{Image, Rgb};
 use glam::DVec3;
 
@@ -28,12 +30,28 @@ pub enum Layout {
 pub struct FlightOptions {
     /// Endoscope image size, pixels.
     pub size: [usize; 2],
-    /// Vertical field of view, degrees (a key frame's overrides it).
-    pub fov_deg: f64,
+    /// The camera's projection, field, lens and near distance (a key frame's field of view
+    /// overrides the field).
+    pub optics: Optics,
+    /// Stereo: both eyes rendered and combined into each frame; `None` for one eye.
+    pub stereo: Option<FlightStereo>,
     /// What each frame shows.
     pub layout: Layout,
     /// Display window of the slices.
     pub window: Window,
+}
+
+/// How a flight is filmed in stereo.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlightStereo {
+    /// How the eyes are combined (a pair: see [`Flight::stereo_frame`]).
+    pub output: StereoOutput,
+    /// Distance between the eyes, mm; `None`: the focus distance / 30 (see
+    /// [`StereoRig::for_view`]).
+    pub eye_separation_mm: Option<f64>,
+    /// Distance of the zero-parallax plane, mm; `None`: the nearest surface in each frame's
+    /// view.
+    pub focus_mm: Option<f64>,
 }
 
 /// The dashboard's fixed parts.
@@ -52,8 +70,9 @@ pub struct Flight<'a> {
     dashboard: Option<DashboardParts>,
     coverage: Option<Coverage>,
     prepared: Option<Prepared<'a>>,
-    /// The frame rendered into, its buffers reused from shot to shot.
-    frame: Frame,
+    /// The frames rendered into (the second for a stereo pair's right eye), their buffers
+    /// reused from shot to shot.
+    frames: [Frame; 2],
 }
 
 impl<'a> Flight<'a> {
@@ -66,7 +85,7 @@ impl<'a> Flight<'a> {
             dashboard: None,
             coverage: None,
             prepared: None,
-            frame: Frame::default(),
+            frames: [Frame::default(), Frame::default()],
         }
     }
 
@@ -110,34 +129,82 @@ impl<'a> Flight<'a> {
     }
 
     /// Frame number `index` for `shot`, rendered with `settings`, and the render's statistics.
+    /// A stereo flight's frame combines both eyes as its output says (a pair's frame is the
+    /// left eye; [`Flight::stereo_frame`] gives both).
     pub fn frame(
         &mut self,
         index: usize,
         shot: &Shot,
         settings: &RenderSettings,
     ) -> Result<(Image, RenderStats), FlightError> {
-        let pose = &shot.pose;
-        let fov = shot.fov_deg.unwrap_or(self.options.fov_deg);
-        let camera = Camera::look_at(
-            pose.eye_mm,
-            pose.look_at_mm,
-            pose.up,
-            fov,
-            self.options.size,
-        )?;
-        prepared(&mut self.prepared, self.renderer, settings)?
-            .render_into(&camera, &mut self.frame);
-        let frame = &self.frame;
-        if let Some(coverage) = &mut self.coverage {
-            coverage.record(&camera, frame)?;
-        }
-        let endoscope = Image::from_frame(frame)?;
-        let stats = frame.stats;
+        let (camera, eyes, stats) = self.render_shot(shot, settings)?;
+        let endoscope = match (self.options.stereo, eyes) {
+            (Some(stereo), Some([left, right])) => stereo::combine(&left, &right, stereo.output)?,
+            _ => Image::from_frame(&self.frames[0])?,
+        };
         let image = match self.options.layout {
             Layout::Endoscope => endoscope,
             Layout::Dashboard => self.dashboard_frame(index, shot, &camera, &endoscope)?,
         };
         Ok((image, stats))
+    }
+
+    /// The left and right views of `shot` in a stereo flight (the endoscopic view alone, for
+    /// writing as two films); a flight without stereo gives its one view twice.
+    pub fn stereo_frame(
+        &mut self,
+        shot: &Shot,
+        settings: &RenderSettings,
+    ) -> Result<([Image; 2], RenderStats), FlightError> {
+        let (_, eyes, stats) = self.render_shot(shot, settings)?;
+        let eyes = match eyes {
+            Some(eyes) => eyes,
+            None => {
+                let view = Image::from_frame(&self.frames[0])?;
+                [view.clone(), view]
+            }
+        };
+        Ok((eyes, stats))
+    }
+
+    /// Renders `shot` — one eye into `frames[0]`, or a stereo pair into both — and records the
+    /// wall it saw (the left eye's, for a pair). Returns the camera, the two eyes' images for
+    /// a pair, and the statistics of everything rendered.
+    fn render_shot(
+        &mut self,
+        shot: &Shot,
+        settings: &RenderSettings,
+    ) -> Result<(Camera, Option<[Image; 2]>, RenderStats), FlightError> {
+        let pose = &shot.pose;
+        let optics = match shot.fov_deg {
+            Some(fov) => self.options.optics.with_fov(fov),
+            None => self.options.optics,
+        };
+        let camera = optics.camera(pose.eye_mm, pose.look_at_mm, pose.up, self.options.size)?;
+        let prepared = prepared(&mut self.prepared, self.renderer, settings)?;
+        let (seen_by, eyes) = match self.options.stereo {
+            None => {
+                prepared.render_into(&camera, &mut self.frames[0]);
+                (camera, None)
+            }
+            Some(stereo) => {
+                let rig = StereoRig::for_view(stereo.eye_separation_mm, stereo.focus_mm, || {
+                    prepared.nearest_surface_mm(&camera)
+                })?;
+                prepared.render_stereo_into(&camera, &rig, &mut self.frames)?;
+                let [left, right] = &self.frames;
+                let eyes = [Image::from_frame(left)?, Image::from_frame(right)?];
+                (rig.eyes(&camera)?[0], Some(eyes))
+            }
+        };
+        let mut stats = self.frames[0].stats;
+        if eyes.is_some() {
+            stats.add(&self.frames[1].stats);
+        }
+        if let Some(coverage) = &mut self.coverage {
+            coverage.record(&seen_by, &self.frames[0])?;
+        }
+        Ok((camera, eyes, stats))
     }
 
     fn dashboard_frame(

@@ -11,7 +11,7 @@ mod overview;
 mod wall;
 
 pub use error::FlightError;
-pub use frames::{Flight, FlightOptions, Layout};
+pub use frames::{Flight, FlightOptions, FlightStereo, Layout};
 pub use looks::ShotSettings;
 pub use overview::{lumen_overview, Overview};
 pub use wall::{wall_coverage, BackwardPass, WallSeen, REPORT_TINT};

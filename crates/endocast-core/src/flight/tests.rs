@@ -1,5 +1,6 @@
 use super::*;
 use crate::animation::KeyFrame;
+use crate::camera::Optics;
 use crate::coverage::Coverage;
 use crate::navigate::{Lumen, LumenSide};
 use crate::phantom::{self, PhantomOptions};
@@ -54,7 +55,8 @@ fn a_dashboard_frame_is_wider_than_the_view_and_coverage_grows() {
     let route = straight(15.0);
     let flight_options = FlightOptions {
         size: [48, 48],
-        fov_deg: 90.0,
+        optics: Optics::default(),
+        stereo: None,
         layout: Layout::Dashboard,
         window: Window::AIR_TISSUE,
     };
@@ -152,7 +154,8 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
     let renderer = Renderer::new(volume);
     let options = FlightOptions {
         size: [32, 32],
-        fov_deg: 90.0,
+        optics: Optics::default(),
+        stereo: None,
         layout: Layout::Endoscope,
         window: Window::AIR_TISSUE,
     };

@@ -59,7 +59,8 @@ impl<'a> BackwardPass<'a> {
         let shots = back?.shots(step_mm, look_ahead_mm)?;
         let options = FlightOptions {
             size: forward.size,
-            fov_deg: forward.fov_deg,
+            optics: forward.optics,
+            stereo: None,
             layout: Layout::Endoscope,
             window: Window::AIR_TISSUE,
         };
