@@ -4,18 +4,20 @@
 //! ramp and a complex transfer function; with a scan and `--path` it measures one setting.
 
 use crate::look::{find_preset, in_pool, LookArgs};
+use crate::optics::{LensArgs, StereoArgs};
 use crate::parse::parse_size;
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use endocast_core::camera::StereoRig;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
-use endocast_core::presets::DEFAULT_FOV_DEG;
-use endocast_core::render::{Camera, Frame, Mode, RenderSettings, Renderer};
+use endocast_core::render::{Camera, Frame, Mode, Prepared, RenderSettings, Renderer};
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::OpenOptions;
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 /// Arguments of `endocast bench`.
 #[derive(Args, Debug)]
@@ -43,6 +45,12 @@ pub struct BenchArgs {
     fov: Option<f64>,
     #[command(flatten)]
     look: LookArgs,
+    #[command(flatten)]
+    lens: LensArgs,
+    /// Also time each camera as a stereo pair (the output named is not written) and report
+    /// the pair's cost against one eye's.
+    #[command(flatten)]
+    stereo: StereoArgs,
     /// Also append one JSON line per measured setting to this file.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
@@ -55,6 +63,7 @@ struct Cell {
 }
 
 /// Timings of one setting over the whole path.
+#[derive(Default)]
 struct Measured {
     ms: Vec<f64>,
     samples: u64,
@@ -63,24 +72,26 @@ struct Measured {
 /// Runs `endocast bench`.
 pub fn run(args: &BenchArgs) -> Result<()> {
     let preset = args.look.preset()?;
-    let fov_deg = args
-        .fov
-        .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
     let (renderer, poses, cells) = match &args.volume {
         None => paper_protocol(args)?,
         Some(volume) => one_setting(args, volume)?,
     };
+    let (lo, hi) = renderer.volume().geometry().world_bounds();
+    let optics = args
+        .lens
+        .optics(preset, args.fov, 0.0, (hi - lo).length())?;
     let cameras: Vec<Camera> = poses
         .iter()
-        .map(|p| Camera::look_at(p.eye_mm, p.look_at_mm, p.up, fov_deg, args.image))
+        .map(|p| optics.camera(p.eye_mm, p.look_at_mm, p.up, args.image))
         .collect::<Result<_, _>>()
         .context("invalid camera on the path")?;
     println!(
-        "{} frames of {}×{}, {}° vertical field of view, {} threads",
+        "{} frames of {}×{}, {} lens, field {}, {} threads",
         cameras.len(),
         args.image[0],
         args.image[1],
-        fov_deg,
+        optics.projection.name(),
+        optics.field,
         args.look.threads.unwrap_or_else(rayon::current_num_threads)
     );
     println!("| setting | min fps | avg fps | max fps | median ms | Msamples/s |");
@@ -89,22 +100,67 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let prepared = renderer
             .prepare(&cell.settings)
             .context("invalid settings")?;
-        let measured = in_pool(args.look.threads, || {
-            let mut m = Measured {
-                ms: Vec::with_capacity(cameras.len()),
-                samples: 0,
-            };
-            let mut frame = Frame::default();
-            for camera in &cameras {
-                prepared.render_into(camera, &mut frame);
-                m.ms.push(frame.stats.time.as_secs_f64() * 1e3);
-                m.samples += frame.stats.samples;
-            }
-            m
-        })?;
-        report(args, fov_deg, cell, &measured)?;
+        let (mono, pair) = in_pool(args.look.threads, || measure(args, &prepared, &cameras))?;
+        report(args, optics.field, &cell.name, &mono?)?;
+        if let Some((pair, ratios)) = pair {
+            report(
+                args,
+                optics.field,
+                &format!("{}, stereo pair", cell.name),
+                &pair,
+            )?;
+            let mut ratios = ratios;
+            ratios.sort_by(f64::total_cmp);
+            println!(
+                "|   pair ÷ one eye, median of the frames (min–max) | {:.2} ({:.2}–{:.2}) | | | | |",
+                ratios[ratios.len() / 2],
+                ratios[0],
+                ratios[ratios.len() - 1]
+            );
+        }
     }
     Ok(())
+}
+
+/// Renders every camera with `prepared` (one eye), and with `--stereo` also as a stereo pair
+/// right after it; returns the one-eye timings and, for pairs, their timings (the whole
+/// [`Prepared::render_stereo_into`], from the pair's shared start-up to its second eye) and
+/// the per-frame ratio of a pair's time to one eye's.
+fn measure(
+    args: &BenchArgs,
+    prepared: &Prepared<'_>,
+    cameras: &[Camera],
+) -> (Result<Measured>, Option<(Measured, Vec<f64>)>) {
+    let (mut mono, mut frame) = (Measured::default(), Frame::default());
+    let mut pair = args
+        .stereo
+        .stereo
+        .map(|_| (Measured::default(), Vec::new()));
+    let mut frames = [Frame::default(), Frame::default()];
+    for camera in cameras {
+        prepared.render_into(camera, &mut frame);
+        let one_ms = frame.stats.time.as_secs_f64() * 1e3;
+        mono.ms.push(one_ms);
+        mono.samples += frame.stats.samples;
+        let Some((pair, ratios)) = &mut pair else {
+            continue;
+        };
+        let nearest = || prepared.nearest_surface_mm(camera);
+        let rig = match StereoRig::for_view(args.stereo.eye_separation, args.stereo.focus, nearest)
+        {
+            Ok(rig) => rig,
+            Err(error) => return (Err(error).context("invalid --stereo options"), None),
+        };
+        let start = Instant::now();
+        if let Err(error) = prepared.render_stereo_into(camera, &rig, &mut frames) {
+            return (Err(error).context("invalid stereo camera"), None);
+        }
+        let pair_ms = start.elapsed().as_secs_f64() * 1e3;
+        pair.ms.push(pair_ms);
+        pair.samples += frames[0].stats.samples + frames[1].stats.samples;
+        ratios.push(pair_ms / one_ms);
+    }
+    (Ok(mono), pair)
 }
 
 /// The colon phantom, its fly path, and the paper's table cells.
@@ -182,7 +238,7 @@ fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
 }
 
 /// Prints one table row (and appends a JSON line when asked).
-fn report(args: &BenchArgs, fov_deg: f64, cell: &Cell, m: &Measured) -> Result<()> {
+fn report(args: &BenchArgs, fov_deg: f64, name: &str, m: &Measured) -> Result<()> {
     let total_s: f64 = m.ms.iter().sum::<f64>() / 1e3;
     let fps: Vec<f64> = m.ms.iter().map(|ms| 1e3 / ms).collect();
     let min = fps.iter().copied().fold(f64::INFINITY, f64::min);
@@ -192,13 +248,10 @@ fn report(args: &BenchArgs, fov_deg: f64, cell: &Cell, m: &Measured) -> Result<(
     sorted.sort_by(f64::total_cmp);
     let median = sorted[sorted.len() / 2];
     let msamples = m.samples as f64 / total_s / 1e6;
-    println!(
-        "| {} | {min:.1} | {avg:.1} | {max:.1} | {median:.1} | {msamples:.0} |",
-        cell.name
-    );
+    println!("| {name} | {min:.1} | {avg:.1} | {max:.1} | {median:.1} | {msamples:.0} |");
     if let Some(file) = &args.json {
         let line = json!({
-            "setting": cell.name,
+            "setting": name,
             "frames": m.ms.len(),
             "image": args.image,
             "fov_deg": fov_deg,

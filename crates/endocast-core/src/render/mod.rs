@@ -352,10 +352,8 @@ impl Prepared<'_> {
             columns.clear();
             tasks.clear();
             let xs = rect.x0..rect.x1;
-            self.row_tasks(camera, y, xs, &mut columns, &mut tasks);
-            if let Some(starts) = starts {
-                self.start_late(integrator, camera, y, starts, &columns, &mut tasks);
-            }
+            let late = starts.map(|starts| (integrator, starts));
+            self.row_tasks(camera, y, xs, late, &mut columns, &mut tasks);
             integrator.run_group(&mut tasks);
             let row = tile.pixels.len();
             tile.pixels.resize(row + rect.x1 - rect.x0, missed);
@@ -436,7 +434,11 @@ impl Prepared<'_> {
 
     /// The ray of pixel `(x, y)` ready to render, or `None` where it misses the volume.
     fn task(&self, camera: &Camera, x: usize, y: usize) -> Option<RayTask> {
-        let ray = self.ray(camera, x, y)?;
+        self.task_of(&self.ray(camera, x, y)?, x, y)
+    }
+
+    /// Pixel `(x, y)`'s `ray` ready to render, or `None` where it misses the volume.
+    fn task_of(&self, ray: &PixelRay, x: usize, y: usize) -> Option<RayTask> {
         let (bricks, step) = (self.renderer.grid.bricks(), self.step_mm as f32);
         let march = RayMarch::new(&ray.voxel, ray.range?, bricks, step, self.offset(x, y));
         Some(RayTask::new(march, ray.world.dir.as_vec3()))
@@ -450,6 +452,7 @@ impl Prepared<'_> {
         camera: &Camera,
         y: usize,
         xs: std::ops::Range<usize>,
+        late: Option<(&Integrator<'_>, &SearchStarts)>,
         columns: &mut Vec<usize>,
         tasks: &mut Vec<RayTask>,
     ) {
@@ -464,7 +467,18 @@ impl Prepared<'_> {
                 for (x, lane) in (x0..xs.end).zip(lanes) {
                     let Some(lane) = lane else { continue };
                     let (step, offset) = (self.step_mm as f32, self.offset(x, y));
-                    let march = RayMarch::with_walk(lane.dda, &lane.ray, lane.range, step, offset);
+                    let mut march =
+                        RayMarch::with_walk(lane.dda, &lane.ray, lane.range, step, offset);
+                    if let Some((integrator, starts)) = late {
+                        self.start_late(
+                            integrator,
+                            starts,
+                            [x, y],
+                            &lane.ray,
+                            lane.range,
+                            &mut march,
+                        );
+                    }
                     columns.push(x);
                     tasks.push(RayTask::new(march, lane.dir_world.as_vec3()));
                 }
@@ -472,49 +486,59 @@ impl Prepared<'_> {
             return;
         }
         for x in xs {
-            if let Some(task) = self.task(camera, x, y) {
-                columns.push(x);
-                tasks.push(task);
+            let Some(ray) = self.ray(camera, x, y) else {
+                continue;
+            };
+            let Some(mut task) = self.task_of(&ray, x, y) else {
+                continue;
+            };
+            if let (Some((integrator, starts)), Some(range)) = (late, ray.range) {
+                self.start_late(
+                    integrator,
+                    starts,
+                    [x, y],
+                    &ray.voxel,
+                    range,
+                    &mut task.march,
+                );
             }
+            columns.push(x);
+            tasks.push(task);
         }
     }
 
-    /// Moves the searches of row `y`'s rays to their `starts` where the samples before the
-    /// region known to be empty (up to the check distance) all lie on the eye's side of the
-    /// isovalue; the sample grid stays the ray's own.
+    /// Moves the search of pixel `[x, y]`'s `march` (along `ray` over `range`) to its start
+    /// in `starts`, where the samples before the region known to be empty (up to the check
+    /// distance) all lie on the eye's side of the isovalue; the sample grid stays the ray's.
     fn start_late(
         &self,
         integrator: &Integrator<'_>,
-        camera: &Camera,
-        y: usize,
         starts: &SearchStarts,
-        columns: &[usize],
-        tasks: &mut [RayTask],
+        [x, y]: [usize; 2],
+        ray: &VoxelRay,
+        (t0, t1): (f64, f64),
+        march: &mut RayMarch,
     ) {
-        let iso = self.params.lower.iso;
-        for (&x, task) in columns.iter().zip(tasks) {
-            let Some((check, start)) = starts.at(x, y) else {
-                continue;
-            };
-            let (grid, end) = (task.march.grid(), task.march.parts().2);
-            if start <= grid.t_start {
-                continue;
-            }
-            let rising = integrator.rising(&task.march, iso);
-            let prefix = (0..end).take_while(|&n| n == 0 || grid.t_of(n - 1) <= check);
-            let empty = prefix
-                .map(|n| integrator.sampler.value(grid.at(grid.t_of(n))))
-                .all(|v| (v < iso) == rising);
-            if empty {
-                let Some(ray) = self.ray(camera, x, y) else {
-                    continue;
-                };
-                let Some((t0, t1)) = ray.range else { continue };
-                let t_start = f64::from(start).min(t1);
-                let dda = BrickDda::new(&ray.voxel, (t_start, t1), self.renderer.grid.bricks());
-                let (step, offset) = (self.step_mm as f32, self.offset(x, y));
-                task.march = RayMarch::with_walk(dda, &ray.voxel, (t0, t1), step, offset);
-            }
+        let Some((check, start)) = starts.at(x, y) else {
+            return;
+        };
+        let (grid, end) = (march.grid(), march.parts().2);
+        if start <= grid.t_start {
+            return;
+        }
+        let (eye, clear) = starts.clear;
+        let empty = (grid.at(check + grid.step) - eye).length() < clear || {
+            // The samples up to the first one past `check`, one by one.
+            let iso = self.params.lower.iso;
+            let rising = integrator.rising(march, iso);
+            let mut prefix = (0..end).take_while(|&n| n == 0 || grid.t_of(n - 1) <= check);
+            prefix.all(|n| (integrator.sampler.value(grid.at(grid.t_of(n))) < iso) == rising)
+        };
+        if empty {
+            let t_start = f64::from(start).min(t1);
+            let dda = BrickDda::new(ray, (t_start, t1), self.renderer.grid.bricks());
+            let (step, offset) = (self.step_mm as f32, self.offset(x, y));
+            *march = RayMarch::with_walk(dda, ray, (t0, t1), step, offset);
         }
     }
 

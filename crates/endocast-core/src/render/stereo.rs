@@ -24,14 +24,20 @@
 //! of the isovalue, or a mode that composites in front of the surface (DVR, two-iso, MIP) —
 //! the eyes share only the prepared state.
 
-use super::{Frame, Mode, Prepared};
+use super::{Frame, Mode, Prepared, BRICK_VOX};
+
+/// How many bricks around the eye [`Prepared::clear_radius_vox`] looks at.
+const CLEAR_BRICKS: usize = 3;
 use crate::camera::{Camera, CameraError, Projection, StereoRig};
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 /// Where each pixel's isosurface search of the second eye may start (see the module doc).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SearchStarts {
+    /// The eye in voxel space, and the radius (voxels) of a ball around it that holds no
+    /// iso-active brick: samples inside it need no check.
+    pub clear: (Vec3, f32),
     width: usize,
     /// Per pixel: the distance along the ray (mm) up to which samples must be checked one by
     /// one, and the distance from which the search may start; NaN where it starts at the eye.
@@ -101,6 +107,39 @@ impl Prepared<'_> {
         Some(*nth)
     }
 
+    /// The distance (voxels) from `eye` to the nearest brick that may hold the isosurface,
+    /// looked for up to [`CLEAR_BRICKS`] bricks away (0 where the eye's own brick may).
+    fn clear_radius_vox(&self, eye: Vec3) -> f32 {
+        let grid = &self.renderer.grid;
+        let bricks = grid.bricks();
+        let edge = BRICK_VOX as f32;
+        let home = grid.brick_at(eye);
+        if self.activity.iso.get(home) {
+            return 0.0;
+        }
+        let centre = (eye / edge).floor().as_ivec3();
+        let reach = CLEAR_BRICKS as i32;
+        let mut nearest = edge * reach as f32;
+        for k in -reach..=reach {
+            for j in -reach..=reach {
+                for i in -reach..=reach {
+                    let b = centre + glam::IVec3::new(i, j, k);
+                    let inside = (0..3).all(|a| b[a] >= 0 && (b[a] as usize) < bricks[a]);
+                    if !inside {
+                        continue;
+                    }
+                    let index = grid.index(b.to_array().map(|c| c as usize));
+                    if self.activity.iso.get(index) {
+                        let lo = b.as_vec3() * edge;
+                        let gap = (lo - eye).max(eye - (lo + edge)).max(Vec3::ZERO);
+                        nearest = nearest.min(gap.length());
+                    }
+                }
+            }
+        }
+        nearest
+    }
+
     /// Whether the right eye's searches may start from the left eye's emptiness.
     fn shares_emptiness(&self, left: &Camera, right: &Camera) -> bool {
         let pinhole = |c: &Camera| c.projection() == Projection::Pinhole && c.lens().is_ideal();
@@ -139,30 +178,82 @@ impl Prepared<'_> {
         let k = rig.eye_separation_mm / tan_half * h as f64 / 2.0;
         let spacing = self.renderer.volume.geometry().spacing_mm().max_element();
         let margin = 0.5 * spacing + 2.0 * self.step_mm;
-        let forward_depth = forward_depths(left, left_frame);
+        let forward_depth = pinhole_forward_depths(left, left_frame);
+        let column_min = column_minima(&forward_depth, [w, h]);
+        let cosines = PinholeCosines::of(right);
         let mut starts = vec![[f32::NAN; 2]; w * h];
-        starts.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            let columns = RowBounds::new(&forward_depth, [w, h], y, k, margin);
-            for (x, start) in row.iter_mut().enumerate() {
-                let q = x as f64 + 0.5 - k / rig.focus_mm;
-                let Some((z_enter, z_safe)) = columns.empty_span(q, k) else {
-                    continue;
-                };
-                let Some(ray) = right.pixel_ray(x, y) else {
-                    continue;
-                };
-                let cos = ray.dir.dot(right.forward());
-                let (check, skip) = (z_enter / cos, z_safe / cos);
-                if skip > check + 2.0 * self.step_mm {
-                    *start = [check as f32, skip as f32];
+        starts.par_chunks_mut(w).enumerate().for_each_init(
+            || RowBounds::with_width(w),
+            |bounds, (y, row)| {
+                bounds.fill(&column_min[y * w..][..w], k, margin);
+                let mut walker = bounds.walker();
+                for (x, start) in row.iter_mut().enumerate() {
+                    let q = x as f64 + 0.5 - k / rig.focus_mm;
+                    let Some((z_enter, z_safe)) = walker.empty_span(q, k) else {
+                        continue;
+                    };
+                    let cos = cosines.at(x, y);
+                    let (check, skip) = (z_enter / cos, z_safe / cos);
+                    if skip > check + 2.0 * self.step_mm {
+                        *start = [check as f32, skip as f32];
+                    }
                 }
-            }
-        });
-        SearchStarts { width: w, starts }
+            },
+        );
+        let eye = right.shared_origin().unwrap_or_else(|| right.eye_mm());
+        let eye = self.voxel_from_world.transform_point3(eye).as_vec3();
+        let clear = (eye, self.clear_radius_vox(eye));
+        SearchStarts {
+            clear,
+            width: w,
+            starts,
+        }
     }
 }
 
-/// The left eye's hit depths along its view axis (mm); `+∞` where a ray hit nothing.
+/// The cosine between a pinhole camera's pixel rays and its view axis, in closed form (the
+/// rays pass through `forward + right·sx + up·sy`).
+struct PinholeCosines {
+    /// `sx` of column 0 and its step per column; `sy` of row 0 and its step per row.
+    sx: (f64, f64),
+    sy: (f64, f64),
+}
+
+impl PinholeCosines {
+    fn of(camera: &Camera) -> Self {
+        let [w, h] = camera.size().map(|n| n as f64);
+        let tan = (camera.fov_deg().to_radians() / 2.0).tan();
+        let shift = camera.eye_shift().map_or(0.0, |e| e.offset_mm / e.focus_mm);
+        Self {
+            sx: ((1.0 / w - 1.0) * tan * w / h - shift, 2.0 * tan / h),
+            sy: ((1.0 - 1.0 / h) * tan, -2.0 * tan / h),
+        }
+    }
+
+    #[inline]
+    fn at(&self, x: usize, y: usize) -> f64 {
+        let sx = self.sx.0 + self.sx.1 * x as f64;
+        let sy = self.sy.0 + self.sy.1 * y as f64;
+        1.0 / (1.0 + sx * sx + sy * sy).sqrt()
+    }
+}
+
+/// A pinhole's hit depths along its view axis (mm); `+∞` where a ray hit nothing.
+fn pinhole_forward_depths(camera: &Camera, frame: &Frame) -> Vec<f64> {
+    let [w, _] = camera.size();
+    let cosines = PinholeCosines::of(camera);
+    frame
+        .depth_mm
+        .par_iter()
+        .enumerate()
+        .map(|(i, &d)| match d.is_finite() {
+            true => f64::from(d) * cosines.at(i % w, i / w),
+            false => f64::INFINITY,
+        })
+        .collect()
+}
+
+/// Any camera's hit depths along its view axis (mm); `+∞` where a ray hit nothing.
 fn forward_depths(camera: &Camera, frame: &Frame) -> Vec<f64> {
     let [w, _] = camera.size();
     frame
@@ -176,7 +267,21 @@ fn forward_depths(camera: &Camera, frame: &Frame) -> Vec<f64> {
         .collect()
 }
 
-/// One row of the left image as the right rays of that row see it.
+/// Per pixel, the smallest forward depth of its column of three rows (`y − 1 ..= y + 1`).
+fn column_minima(depths: &[f64], [w, h]: [usize; 2]) -> Vec<f64> {
+    let mut out = vec![f64::INFINITY; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for r in y.saturating_sub(1)..=(y + 1).min(h - 1) {
+            for (m, d) in row.iter_mut().zip(&depths[r * w..][..w]) {
+                *m = m.min(*d);
+            }
+        }
+    });
+    out
+}
+
+/// One row of the left image as the right rays of that row see it (buffers reused from row to
+/// row).
 struct RowBounds {
     /// Per left column `j`: the conservative empty depth `Z_j` (mm).
     depth: Vec<f64>,
@@ -185,52 +290,71 @@ struct RowBounds {
 }
 
 impl RowBounds {
-    /// Row `y` of `depths` (`[w, h]`), each column's depth the 3×3 minimum less `margin`.
-    fn new(depths: &[f64], [w, h]: [usize; 2], y: usize, k: f64, margin: f64) -> Self {
-        let rows = y.saturating_sub(1)..=(y + 1).min(h - 1);
-        let column_min: Vec<f64> = (0..w)
-            .map(|j| {
-                rows.clone()
-                    .map(|r| depths[r * w + j])
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .collect();
-        let depth: Vec<f64> = (0..w)
-            .map(|j| {
-                let around = &column_min[j.saturating_sub(1)..=(j + 1).min(w - 1)];
-                around.iter().copied().fold(f64::INFINITY, f64::min) - margin
-            })
-            .collect();
-        let mut suffix = vec![f64::INFINITY; w];
+    fn with_width(w: usize) -> Self {
+        Self {
+            depth: vec![0.0; w],
+            suffix: vec![0.0; w],
+        }
+    }
+
+    /// Takes a row of three-row column minima: each column's depth is the minimum over it and
+    /// its two neighbours, less `margin`.
+    fn fill(&mut self, column_min: &[f64], k: f64, margin: f64) {
+        let w = column_min.len();
+        for j in 0..w {
+            let around = &column_min[j.saturating_sub(1)..=(j + 1).min(w - 1)];
+            self.depth[j] = around.iter().copied().fold(f64::INFINITY, f64::min) - margin;
+        }
         let mut running = f64::INFINITY;
         for j in (0..w).rev() {
-            let g = if depth[j] > 0.0 {
-                j as f64 - k / depth[j]
+            let g = if self.depth[j] > 0.0 {
+                j as f64 - k / self.depth[j]
             } else {
                 f64::NEG_INFINITY
             };
             running = running.min(g);
-            suffix[j] = running;
+            self.suffix[j] = running;
         }
-        Self { depth, suffix }
     }
 
-    /// For the right ray with `q = x + ½ − K/f`: the depth where it enters the left image
-    /// (`x_L = w`) and the depth where it leaves the known-empty region; `None` where it never
-    /// enters or leaves at once.
-    fn empty_span(&self, q: f64, k: f64) -> Option<(f64, f64)> {
-        let w = self.depth.len();
+    /// A walk along the row's pixels, left to right.
+    fn walker(&self) -> RowWalker<'_> {
+        RowWalker {
+            bounds: self,
+            below: 0,
+        }
+    }
+}
+
+/// The right rays of one row, taken left to right (`q` growing), so the suffix-minimum search
+/// moves one way: `O(w)` a row.
+struct RowWalker<'a> {
+    bounds: &'a RowBounds,
+    /// How many leading suffix minima are ≤ the last `q` (they are non-decreasing).
+    below: usize,
+}
+
+impl RowWalker<'_> {
+    /// For the right ray with `q = x + ½ − K/f` (not smaller than the last call's): the depth
+    /// where it enters the left image (`x_L = w`) and the depth where it leaves the
+    /// known-empty region; `None` where it never enters or leaves at once.
+    fn empty_span(&mut self, q: f64, k: f64) -> Option<(f64, f64)> {
+        let (depth, suffix) = (&self.bounds.depth, &self.bounds.suffix);
+        let w = depth.len();
         if w as f64 - q <= 0.0 {
             return None;
         }
         let z_enter = k / (w as f64 - q);
-        let lo = q.floor().max(0.0) as usize;
-        // The largest column j ≥ lo with g_j ≤ q: the last suffix minimum ≤ q.
-        let count = self.suffix[lo.min(w)..].partition_point(|&m| m <= q);
-        let z_safe = if count > 0 {
-            let j = lo + count - 1;
+        let lo = (q.floor().max(0.0) as usize).min(w);
+        // The largest column j ≥ lo with g_j ≤ q: the last suffix minimum ≤ q (non-decreasing
+        // in j, and the answer non-decreasing in q).
+        while self.below < w && suffix[self.below] <= q {
+            self.below += 1;
+        }
+        let z_safe = if self.below > lo {
+            let j = self.below - 1;
             let z_entry = k / (j as f64 + 1.0 - q);
-            z_entry.max(self.depth[j])
+            z_entry.max(depth[j])
         } else if q < 0.0 {
             // Leaves the left image through its left edge.
             k / -q
@@ -238,5 +362,27 @@ impl RowBounds {
             f64::INFINITY
         };
         (z_safe > z_enter).then_some((z_enter, z_safe))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn closed_form_cosines_are_the_rays() {
+        let camera = Camera::look_at(DVec3::ZERO, DVec3::Z, DVec3::Y, 75.0, [37, 20]).unwrap();
+        let rig = StereoRig {
+            eye_separation_mm: 1.0,
+            focus_mm: 9.0,
+        };
+        for eye in [camera, rig.eyes(&camera).unwrap()[1]] {
+            let cosines = PinholeCosines::of(&eye);
+            for (x, y) in [(0, 0), (36, 19), (18, 3)] {
+                let cos = eye.pixel_ray(x, y).unwrap().dir.dot(eye.forward());
+                assert!((cosines.at(x, y) - cos).abs() < 1e-12);
+            }
+        }
     }
 }
