@@ -80,11 +80,21 @@ pub struct StereoArgs {
     #[arg(long, value_name = "OUTPUT", value_parser = parse_stereo)]
     pub stereo: Option<StereoOutput>,
     /// Distance between the eyes, mm (default: the focus distance / 30).
-    #[arg(long, value_name = "MM", requires = "stereo")]
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "stereo",
+        allow_negative_numbers = true
+    )]
     pub eye_separation: Option<f64>,
     /// Distance of the zero-parallax (focus) plane, mm (default: the nearest surface in view,
     /// so that the scene lies behind the screen).
-    #[arg(long, value_name = "MM", requires = "stereo")]
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "stereo",
+        allow_negative_numbers = true
+    )]
     pub focus: Option<f64>,
 }
 

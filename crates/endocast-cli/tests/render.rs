@@ -90,3 +90,97 @@ fn bad_render_options_are_clear_errors() {
         fails_with(&args, needle);
     }
 }
+
+/// A PNG's width and height.
+fn png_size(path: &std::path::Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap();
+    assert!(
+        bytes.starts_with(b"\x89PNG"),
+        "{} is no PNG",
+        path.display()
+    );
+    let be = |at: usize| u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap());
+    (be(16), be(20))
+}
+
+#[test]
+fn lenses_and_stereo_outputs_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = dir.path().join("shell.nii.gz");
+    let v = volume.to_str().unwrap();
+    assert!(
+        endocast(&["phantom", "sphere-shell", "-o", v, "--size", "48"])
+            .status
+            .success()
+    );
+    let render = |extra: &[&str], out: &str| {
+        let png = dir.path().join(out);
+        let mut args = vec!["render", v, "-o", png.to_str().unwrap(), "--mode", "iso"];
+        args.extend_from_slice(&["--eye", "0,0,0", "--look-at", "0,0,1", "--size", "40x30"]);
+        args.extend_from_slice(extra);
+        let result = endocast(&args);
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert!(result.status.success(), "{extra:?}: {stderr}");
+        png
+    };
+    // A 200° fisheye from the centre: a round image, rays at the radius everywhere in it.
+    let depth = dir.path().join("fisheye.npy");
+    let fisheye = [
+        "--lens",
+        "equidistant",
+        "--fov",
+        "200",
+        "--distortion",
+        "-0.1,0.02",
+    ];
+    let mut args = fisheye.to_vec();
+    args.extend_from_slice(&[
+        "--vignetting",
+        "0.3",
+        "--depth-out",
+        depth.to_str().unwrap(),
+    ]);
+    render(&args, "fisheye.png");
+    let (_, depths) = read_npy(&depth);
+    let hits: Vec<f32> = depths.iter().copied().filter(|d| d.is_finite()).collect();
+    assert!(
+        hits.len() > 500 && hits.len() < depths.len(),
+        "a round image"
+    );
+    assert!(hits.iter().all(|d| (d - 16.8).abs() < 0.1), "0.35 × 48 mm");
+    render(&["--lens", "orthographic", "--fov", "30"], "ortho.png");
+    // Stereo: combined images, the doubled layouts, and a pair of files.
+    for (output, size) in [
+        ("anaglyph", (40, 30)),
+        ("dubois", (40, 30)),
+        ("side-by-side", (80, 30)),
+    ] {
+        let png = render(
+            &["--stereo", output, "--focus", "10"],
+            &format!("{output}.png"),
+        );
+        assert_eq!(png_size(&png), size, "{output}");
+    }
+    let top_bottom = render(&["--stereo", "top-bottom"], "tb.png");
+    assert_eq!(png_size(&top_bottom), (40, 60));
+    render(&["--stereo", "pair", "--eye-separation", "0.5"], "eyes.png");
+    for eye in ["eyes-left.png", "eyes-right.png"] {
+        assert_eq!(png_size(&dir.path().join(eye)), (40, 30), "{eye}");
+    }
+    let png = dir.path().join("x.png");
+    let base = ["render", v, "-o", png.to_str().unwrap()];
+    let with = |extra: &[&'static str]| -> Vec<&str> { [&base[..], extra].concat() };
+    fails_with(&with(&["--lens", "fisheye"]), "unknown lens");
+    fails_with(
+        &with(&["--lens", "equidistant", "--fov", "400"]),
+        "invalid camera",
+    );
+    fails_with(&with(&["--distortion", "nan,0"]), "not a finite number");
+    fails_with(&with(&["--vignetting", "2"]), "vignetting");
+    fails_with(&with(&["--stereo", "anaglyph", "--focus", "-3"]), "focus");
+    fails_with(&with(&["--stereo", "wobble"]), "unknown stereo output");
+    fails_with(
+        &with(&["--stereo", "anaglyph", "--lens", "orthographic"]),
+        "orthographic",
+    );
+}
