@@ -219,6 +219,23 @@ impl Camera {
         let sy = d.dot(self.up) / z / self.tan_half_fov;
         Some(((sx + 1.0) / 2.0 * w, (1.0 - sy) / 2.0 * h))
     }
+
+    /// The same camera with every pixel sampled `(dx, dy)` pixels away from its centre (`+x`
+    /// right, `+y` down): pixel `(x, y)` looks along [`Camera::direction`]`(x + ½ + dx,
+    /// y + ½ + dy)` of this camera, up to rounding (sub-pixel jitter for still frames). The
+    /// shift moves the image plane's centre, stored in `forward`, which is then no longer of
+    /// unit length: the near plane and [`Camera::project`] move with it by a part in `height`
+    /// per pixel of offset. `(0, 0)` gives the camera back unchanged.
+    pub fn with_pixel_offset(self, dx: f64, dy: f64) -> Self {
+        if dx == 0.0 && dy == 0.0 {
+            return self;
+        }
+        let per_pixel = 2.0 * self.tan_half_fov / self.height as f64;
+        Self {
+            forward: self.forward + self.right * (dx * per_pixel) - self.up * (dy * per_pixel),
+            ..self
+        }
+    }
 }
 
 #[cfg(test)]

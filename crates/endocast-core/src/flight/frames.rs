@@ -11,6 +11,7 @@ use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Wi
 use crate::views::{Image, Rgb, ViewError};
 use crate::{GeometryError, VolumeError};
 use glam::DVec3;
+use std::sync::Arc;
 use thiserror::Error;
 
 /// Colour and strength of the tint on wall not seen yet, in the dashboard's overview.
@@ -76,20 +77,20 @@ struct DashboardParts {
 
 /// Renders the frames of a flight, one shot at a time (memory does not grow with the length).
 #[derive(Debug)]
-pub struct Flight<'a> {
-    renderer: &'a Renderer,
+pub struct Flight {
+    renderer: Arc<Renderer>,
     options: FlightOptions,
     dashboard: Option<DashboardParts>,
     coverage: Option<Coverage>,
-    prepared: Option<Prepared<'a>>,
+    prepared: Option<Prepared>,
     /// The frame rendered into, its buffers reused from shot to shot.
     frame: Frame,
 }
 
-impl<'a> Flight<'a> {
+impl Flight {
     /// A flight over `renderer`'s volume. With [`Layout::Dashboard`], call
     /// [`Flight::with_overview`] before the first frame.
-    pub fn new(renderer: &'a Renderer, options: FlightOptions) -> Self {
+    pub fn new(renderer: Arc<Renderer>, options: FlightOptions) -> Self {
         Self {
             renderer,
             options,
@@ -155,13 +156,13 @@ impl<'a> Flight<'a> {
             fov,
             self.options.size,
         )?;
-        prepared(&mut self.prepared, self.renderer, settings)?
+        prepared(&mut self.prepared, &self.renderer, settings)?
             .render_into(&camera, &mut self.frame);
         let frame = &self.frame;
         if let Some(coverage) = &mut self.coverage {
             coverage.record(&camera, frame)?;
         }
-        let endoscope = Image::from_frame(frame)?;
+        let endoscope = Image::from_frame(frame, settings.background)?;
         let stats = frame.stats;
         let image = match self.options.layout {
             Layout::Endoscope => endoscope,
@@ -227,15 +228,20 @@ fn cross_options(slices: &SliceOptions) -> SliceOptions {
     }
 }
 
-/// The prepared renderer in `slot` for `settings`, re-prepared only when they change.
-fn prepared<'s, 'a>(
-    slot: &'s mut Option<Prepared<'a>>,
-    renderer: &'a Renderer,
+/// The prepared renderer in `slot` for `settings`, updated only when they change.
+fn prepared<'s>(
+    slot: &'s mut Option<Prepared>,
+    renderer: &Arc<Renderer>,
     settings: &RenderSettings,
-) -> Result<&'s Prepared<'a>, FlightError> {
+) -> Result<&'s Prepared, FlightError> {
     let prepared = match slot.take() {
-        Some(p) if p.settings() == settings => p,
-        _ => renderer.prepare(settings)?,
+        Some(mut p) => {
+            if p.settings() != settings {
+                p.update(settings)?;
+            }
+            p
+        }
+        None => renderer.prepare(settings)?,
     };
     Ok(slot.insert(prepared))
 }

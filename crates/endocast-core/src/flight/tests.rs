@@ -4,6 +4,7 @@ use crate::coverage::Coverage;
 use crate::navigate::{Lumen, LumenSide};
 use crate::phantom::{self, PhantomOptions};
 use crate::render::{Mode, RenderSettings, Renderer};
+use std::sync::Arc;
 use crate::views::slices::Window;
 
 fn straight(len: f64) -> Route {
@@ -50,7 +51,7 @@ fn a_dashboard_frame_is_wider_than_the_view_and_coverage_grows() {
     let (volume, _) = phantom::straight_tube(&options);
     let lumen = Lumen::from_seed(&volume, [20, 20, 20], -480.0, LumenSide::Below).unwrap();
     let geometry = *volume.geometry();
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let route = straight(15.0);
     let flight_options = FlightOptions {
         size: [48, 48],
@@ -58,7 +59,7 @@ fn a_dashboard_frame_is_wider_than_the_view_and_coverage_grows() {
         layout: Layout::Dashboard,
         window: Window::AIR_TISSUE,
     };
-    let flight = Flight::new(&renderer, flight_options);
+    let flight = Flight::new(renderer, flight_options);
     let overview = lumen_overview(&lumen, &geometry, flight.overview_size().unwrap()).unwrap();
     let (lo, hi) = lumen.bounds();
     let bbox = [0, 1, 2].map(|a| lo[a].saturating_sub(1)..(hi[a] + 2).min(geometry.dims()[a]));
