@@ -10,12 +10,15 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
-use endocast_core::render::{Camera, Frame, Mode, RenderSettings, Renderer, TransferFunction};
+use endocast_core::render::{
+    Camera, Frame, Mode, Quality, RenderOptions, RenderSettings, Renderer, TransferFunction,
+};
 use endocast_io::OpenOptions;
 use glam::DVec3;
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Arguments of `endocast bench`.
 #[derive(Args, Debug)]
@@ -41,6 +44,9 @@ pub struct BenchArgs {
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 90.0)]
     fov: f64,
+    /// Cast rays at full, half or quarter resolution (upsampled to --image, edge-aware).
+    #[arg(long, default_value = "full", value_parser = parse_quality)]
+    quality: Quality,
     #[command(flatten)]
     look: LookArgs,
     /// Also append one JSON line per measured setting to this file.
@@ -66,16 +72,19 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         None => paper_protocol(args)?,
         Some(volume) => one_setting(args, volume)?,
     };
+    let renderer = Arc::new(renderer);
+    let options = RenderOptions::new().quality(args.quality);
     let cameras: Vec<Camera> = poses
         .iter()
         .map(|p| Camera::look_at(p.eye_mm, p.look_at_mm, p.up, args.fov, args.image))
         .collect::<Result<_, _>>()
         .context("invalid camera on the path")?;
     println!(
-        "{} frames of {}×{}, {}° vertical field of view, {} threads",
+        "{} frames of {}×{} ({} quality), {}° vertical field of view, {} threads",
         cameras.len(),
         args.image[0],
         args.image[1],
+        args.quality.name(),
         args.fov,
         args.look.threads.unwrap_or_else(rayon::current_num_threads)
     );
@@ -92,7 +101,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             };
             let mut frame = Frame::default();
             for camera in &cameras {
-                prepared.render_into(camera, &mut frame);
+                // Nothing cancels it.
+                let _ = prepared.render_with(camera, &options, &mut frame);
                 m.ms.push(frame.stats.time.as_secs_f64() * 1e3);
                 m.samples += frame.stats.samples;
             }
@@ -101,6 +111,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         report(args, cell, &measured)?;
     }
     Ok(())
+}
+
+/// A `--quality` level by name.
+fn parse_quality(name: &str) -> Result<Quality, String> {
+    Quality::from_name(name).ok_or_else(|| format!("{name:?}: expected full, half or quarter"))
 }
 
 /// The colon phantom, its fly path, and the paper's table cells.

@@ -17,6 +17,7 @@ use endocast_core::render::{RenderSettings, Renderer};
 use endocast_core::views::slices::Window;
 use endocast_io::video::{open_sink, VideoOptions};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Arguments of `endocast fly`.
 #[derive(Args, Debug)]
@@ -102,7 +103,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     } else {
         None
     };
-    let renderer = Renderer::for_many_frames(loaded.volume);
+    let renderer = Arc::new(Renderer::for_many_frames(loaded.volume));
     let options = FlightOptions {
         size: args.size,
         fov_deg: args.fov,
@@ -112,7 +113,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         },
         window: parse_window(&args.window)?,
     };
-    let mut flight = Flight::new(&renderer, options);
+    let mut flight = Flight::new(Arc::clone(&renderer), options);
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {

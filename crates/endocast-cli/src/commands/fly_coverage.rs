@@ -12,6 +12,7 @@ use endocast_core::views::slices::Window;
 use endocast_core::{Modality, ValueMap, Volume};
 use serde_json::json;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Size of the coverage overview image, pixels.
 const OVERVIEW_PX: usize = 512;
@@ -19,7 +20,7 @@ const OVERVIEW_PX: usize = 512;
 /// Flies the route backward for coverage, then prints and writes the forward and merged figures.
 pub fn report(
     args: &FlyArgs,
-    renderer: &Renderer,
+    renderer: &Arc<Renderer>,
     route: &Route,
     settings: &RenderSettings,
     lumen: Option<&Lumen>,
@@ -79,7 +80,7 @@ pub fn report(
 /// Flies `route` with the endoscope only, recording into `coverage`.
 fn fly_for_coverage(
     args: &FlyArgs,
-    renderer: &Renderer,
+    renderer: &Arc<Renderer>,
     route: &Route,
     settings: &RenderSettings,
     coverage: Coverage,
@@ -91,7 +92,7 @@ fn fly_for_coverage(
         layout: Layout::Endoscope,
         window: Window::AIR_TISSUE,
     };
-    let mut flight = Flight::new(renderer, options).with_coverage(coverage);
+    let mut flight = Flight::new(Arc::clone(renderer), options).with_coverage(coverage);
     let mut progress = Progress::new("backward", shots.len());
     for (n, shot) in shots.iter().enumerate() {
         flight.frame(n, shot, settings)?;

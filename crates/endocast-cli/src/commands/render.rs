@@ -13,6 +13,7 @@ use endocast_core::{Geometry, Volume};
 use glam::DVec3;
 use serde_json::json;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Arguments of `endocast render`.
 #[derive(Args, Debug)]
@@ -65,7 +66,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     let camera = camera(args, &loaded.volume, &settings)?;
-    let renderer = Renderer::new(loaded.volume);
+    let renderer = Arc::new(Renderer::new(loaded.volume));
     let prepared = renderer
         .prepare(&settings)
         .context("invalid render settings")?;
@@ -74,7 +75,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
     let [w, h] = [frame.width as u32, frame.height as u32];
-    endocast_io::image_out::write_png_rgb8(&args.output, w, h, &frame.rgb)
+    let rgb = frame.to_rgb8(settings.background);
+    endocast_io::image_out::write_png_rgb8(&args.output, w, h, &rgb)
         .context("cannot write the image")?;
     if let Some(depth) = &args.depth_out {
         endocast_io::image_out::write_npy_f32(depth, w, h, &frame.depth_mm)
@@ -175,7 +177,7 @@ fn framing_eye(geometry: &Geometry, fov_deg: f64) -> (DVec3, DVec3) {
     (centre - DVec3::Y * distance, centre)
 }
 
-fn print_trace(prepared: &Prepared<'_>, camera: &Camera, x: usize, y: usize) -> Result<()> {
+fn print_trace(prepared: &Prepared, camera: &Camera, x: usize, y: usize) -> Result<()> {
     let [w, h] = camera.size();
     if x >= w || y >= h {
         bail!("--debug-pixel {x},{y} lies outside the {w}×{h} image");

@@ -63,6 +63,8 @@ mod transfer;
 pub mod traverse;
 
 #[cfg(test)]
+mod interactive_tests;
+#[cfg(test)]
 mod tests;
 
 pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
