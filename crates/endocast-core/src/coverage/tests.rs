@@ -2,8 +2,8 @@ use super::*;
 use crate::phantom::{self, PhantomOptions};
 use crate::pose::{fly_through, Pose};
 use crate::render::{Mode, Premultiplied, RenderSettings, Renderer};
-use std::sync::Arc;
 use crate::Volume;
+use std::sync::Arc;
 
 /// Wall voxels by threshold: not lumen (below `iso_hu` is lumen) and 6-adjacent to lumen.
 fn threshold_wall(volume: &Volume, iso_hu: f64) -> impl Fn([usize; 3]) -> bool + Sync + '_ {

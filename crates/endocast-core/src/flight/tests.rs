@@ -4,8 +4,8 @@ use crate::coverage::Coverage;
 use crate::navigate::{Lumen, LumenSide};
 use crate::phantom::{self, PhantomOptions};
 use crate::render::{Mode, RenderSettings, Renderer};
-use std::sync::Arc;
 use crate::views::slices::Window;
+use std::sync::Arc;
 
 fn straight(len: f64) -> Route {
     let points = [DVec3::ZERO, DVec3::new(0.0, 0.0, len)];

@@ -173,7 +173,13 @@ impl Frame {
     /// The layers the frame holds.
     pub fn layers(&self) -> Layers {
         let n = self.len();
-        let has = |len: usize, layer: Layers| if len == n && n > 0 { layer } else { Layers::NONE };
+        let has = |len: usize, layer: Layers| {
+            if len == n && n > 0 {
+                layer
+            } else {
+                Layers::NONE
+            }
+        };
         has(self.hit_mm.len(), Layers::HIT_POSITION)
             | has(self.normal.len(), Layers::NORMAL)
             | has(self.layer_depths_mm.len(), Layers::DEPTHS)
@@ -225,10 +231,12 @@ impl Frame {
         self.depth_mm.resize(n, f32::NAN);
         self.value.resize(n, f32::NAN);
         let size = |on: Layers| if layers.contains(on) { n } else { 0 };
-        self.hit_mm.resize(size(Layers::HIT_POSITION), [f32::NAN; 3]);
+        self.hit_mm
+            .resize(size(Layers::HIT_POSITION), [f32::NAN; 3]);
         self.normal.resize(size(Layers::NORMAL), [f32::NAN; 3]);
         let depths = size(Layers::DEPTHS);
-        self.layer_depths_mm.resize(depths, [f32::NAN; DEPTH_LAYERS]);
+        self.layer_depths_mm
+            .resize(depths, [f32::NAN; DEPTH_LAYERS]);
     }
 }
 

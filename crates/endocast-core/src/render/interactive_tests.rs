@@ -28,7 +28,10 @@ fn iso() -> RenderSettings {
 
 /// A camera at the shell's centre (plus `offset_vox`) looking along +z.
 fn camera_in(renderer: &Renderer, shell: &SphereShell, offset_vox: DVec3, size: usize) -> Camera {
-    let eye = renderer.volume().geometry().world_of(shell.centre_vox + offset_vox);
+    let eye = renderer
+        .volume()
+        .geometry()
+        .world_of(shell.centre_vox + offset_vox);
     let forward = DVec3::new(0.2, -0.1, 1.0);
     Camera::look_at(eye, eye + forward, DVec3::Y, 90.0, [size, size]).unwrap()
 }
@@ -70,7 +73,11 @@ fn prepared_is_owned_shareable_and_updates_in_place() {
             ..iso()
         };
         assert!(prepared.update(&bad).is_err());
-        assert_eq!(prepared.settings(), &iso(), "a failed update keeps the settings");
+        assert_eq!(
+            prepared.settings(),
+            &iso(),
+            "a failed update keeps the settings"
+        );
         prepared.render(&camera)
     });
     let updated = worker.join().unwrap();
@@ -113,7 +120,13 @@ fn a_maximum_distance_before_the_wall_ends_the_rays_and_one_behind_it_changes_no
         }
         // Per pixel: the left half ends before the wall, the right half behind it.
         let split: Vec<f32> = (0..n)
-            .map(|i| if i % 20 < 10 { nearest - 1.0 } else { f32::INFINITY })
+            .map(|i| {
+                if i % 20 < 10 {
+                    nearest - 1.0
+                } else {
+                    f32::INFINITY
+                }
+            })
             .collect();
         let options = RenderOptions::new().max_distance_mm(&split);
         prepared.render_with(&camera, &options, &mut frame).unwrap();
@@ -154,7 +167,10 @@ fn optional_layers_give_hit_points_normals_and_the_surfaces_behind() {
             // Into the shell, out of it into the air outside, then nothing.
             let [first, second, third, _] = frame.layer_depths_mm[i];
             assert_eq!(first.to_bits(), frame.depth_mm[i].to_bits());
-            assert!((f64::from(second) - outer).abs() < 0.1, "{second} vs {outer}");
+            assert!(
+                (f64::from(second) - outer).abs() < 0.1,
+                "{second} vs {outer}"
+            );
             assert!(third.is_nan());
         }
     }
@@ -240,7 +256,9 @@ fn reduced_quality_keeps_a_silhouette_sharp() {
     let full = prepared.render(&camera);
     let mut quarter = Frame::default();
     let options = RenderOptions::new().quality(Quality::Quarter);
-    prepared.render_with(&camera, &options, &mut quarter).unwrap();
+    prepared
+        .render_with(&camera, &options, &mut quarter)
+        .unwrap();
     let (hits, misses) = (
         full.depth_mm.iter().filter(|d| d.is_finite()).count(),
         full.depth_mm.iter().filter(|d| d.is_nan()).count(),
@@ -250,7 +268,10 @@ fn reduced_quality_keeps_a_silhouette_sharp() {
     for (i, c) in quarter.color.iter().enumerate() {
         let hit = quarter.depth_mm[i].is_finite();
         let alpha = c.alpha();
-        assert!(if hit { alpha == 1.0 } else { alpha == 0.0 }, "pixel {i}: {alpha}");
+        assert!(
+            if hit { alpha == 1.0 } else { alpha == 0.0 },
+            "pixel {i}: {alpha}"
+        );
     }
 }
 
@@ -266,10 +287,14 @@ fn a_still_of_one_frame_is_the_plain_render_and_more_frames_smooth_it() {
     let prepared = renderer.prepare(&settings).unwrap();
     let plain = prepared.render(&camera);
     let mut still = Still::new();
-    let one = still.render_next(&prepared, &camera, &RenderOptions::new()).unwrap();
+    let one = still
+        .render_next(&prepared, &camera, &RenderOptions::new())
+        .unwrap();
     assert_same_frame(one, &plain, "one frame");
     for _ in 1..4 {
-        still.render_next(&prepared, &camera, &RenderOptions::new()).unwrap();
+        still
+            .render_next(&prepared, &camera, &RenderOptions::new())
+            .unwrap();
     }
     assert_eq!(still.frames(), 4);
     let average = still.frame();
@@ -308,13 +333,20 @@ fn the_progressive_sequence_ends_in_the_full_image_unless_the_view_changes() {
         ..ProgressiveOptions::default()
     };
     let delivered = Mutex::new(Vec::new());
-    progressive(&prepared, &camera, &generation, 7, &options, |stage, frame| {
-        assert_eq!([frame.width, frame.height], [40, 40]);
-        if stage == Stage::Full {
-            assert_same_frame(frame, &plain, "the full stage");
-        }
-        delivered.lock().unwrap().push(stage);
-    })
+    progressive(
+        &prepared,
+        &camera,
+        &generation,
+        7,
+        &options,
+        |stage, frame| {
+            assert_eq!([frame.width, frame.height], [40, 40]);
+            if stage == Stage::Full {
+                assert_same_frame(frame, &plain, "the full stage");
+            }
+            delivered.lock().unwrap().push(stage);
+        },
+    )
     .unwrap();
     let expected = [
         Stage::Preview(Quality::Quarter),

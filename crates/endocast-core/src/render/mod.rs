@@ -72,9 +72,9 @@ pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
 pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
 pub use options::{Cancelled, Progress, Quality, RenderOptions};
 pub use progressive::progressive;
-pub use still::{Jitter, Still};
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
 pub use settings::{Crossing, Mode, RenderSettings, SettingsError};
+pub use still::{Jitter, Still};
 pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
 use frame::to_u8;
@@ -384,6 +384,10 @@ impl Prepared {
     /// maximum distances, stopping between tiles when their cancel flag is set (then `frame`'s
     /// content is unspecified and the call returns [`Cancelled`]). `frame.stats.time` is the
     /// whole call's time, upsampling included.
+    ///
+    /// # Panics
+    ///
+    /// When the options' maximum distances are not one per pixel of `camera`.
     pub fn render_with(
         &self,
         camera: &Camera,

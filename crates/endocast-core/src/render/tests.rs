@@ -178,7 +178,13 @@ fn dvr_of_a_homogeneous_slab_follows_beer_lambert_at_any_step() {
                 );
             }
         }
-        images.push(frame.color.iter().map(Premultiplied::alpha).collect::<Vec<_>>());
+        images.push(
+            frame
+                .color
+                .iter()
+                .map(Premultiplied::alpha)
+                .collect::<Vec<_>>(),
+        );
     }
     for image in &images[1..] {
         for (a, b) in image.iter().zip(&images[0]) {
@@ -217,9 +223,15 @@ fn assert_same<T: PartialEq + std::fmt::Debug>(a: &[T], b: &[T], what: &str) {
 fn assert_same_image(a: &Frame, b: &Frame, what: &str) {
     let bits = |v: &[Premultiplied]| {
         let bits = |c: &Premultiplied| c.rgb.map(f32::to_bits).to_vec();
-        v.iter().map(|c| (bits(c), c.transmittance.to_bits())).collect::<Vec<_>>()
+        v.iter()
+            .map(|c| (bits(c), c.transmittance.to_bits()))
+            .collect::<Vec<_>>()
     };
-    assert_same(&bits(&a.color), &bits(&b.color), &format!("{what}: colours"));
+    assert_same(
+        &bits(&a.color),
+        &bits(&b.color),
+        &format!("{what}: colours"),
+    );
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(a.layers(), b.layers(), "{what}: layers");
     assert_same(
@@ -646,7 +658,9 @@ fn sheared_anisotropic_grids_shade_and_measure_in_millimetres() {
         }
     }
     let map = ValueMap::new(1.0, -1024.0).unwrap();
-    let renderer = Arc::new(Renderer::new(Volume::new(g, voxels, map, Modality::Ct).unwrap()));
+    let renderer = Arc::new(Renderer::new(
+        Volume::new(g, voxels, map, Modality::Ct).unwrap(),
+    ));
     let prepared = renderer.prepare(&settings(Mode::Iso)).unwrap();
     let camera = Camera::look_at(
         centre,

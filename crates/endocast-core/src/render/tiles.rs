@@ -212,7 +212,12 @@ impl Tiling {
     }
 
     /// Puts one optional layer of the tiles together into `layer` (rows in parallel).
-    fn copy_layer<T: Send>(&self, tiles: &[Tile], layer: &mut [T], of: impl Fn(&Extra) -> T + Sync) {
+    fn copy_layer<T: Send>(
+        &self,
+        tiles: &[Tile],
+        layer: &mut [T],
+        of: impl Fn(&Extra) -> T + Sync,
+    ) {
         layer
             .par_chunks_mut(self.width)
             .enumerate()
