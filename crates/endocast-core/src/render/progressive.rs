@@ -18,7 +18,8 @@
 //!
 //! let (volume, shell) = phantom::sphere_shell(&PhantomOptions { size: 32, ..Default::default() });
 //! let centre_mm = volume.geometry().world_of(shell.centre_vox);
-//! let settings = RenderSettings { mode: Mode::Iso, iso_hu: -480.0, ..RenderSettings::default() };
+//! let mut settings = RenderSettings::default();
+//! (settings.mode, settings.iso_hu) = (Mode::Iso, -480.0);
 //! let prepared = Arc::new(Renderer::new(volume)).prepare(&settings).unwrap();
 //! let camera = Camera::look_at(centre_mm, centre_mm + DVec3::Z, DVec3::Y, 90.0, [32, 32]).unwrap();
 //! let generation = AtomicU64::new(0);
