@@ -397,3 +397,28 @@ fn the_progressive_driver_drops_the_frame_in_flight() {
     // longer than a millisecond, so the sequence never ends.
     assert_eq!(result, Err(Cancelled));
 }
+
+#[test]
+fn reduced_quality_takes_any_size_and_field_of_view() {
+    let (renderer, truth) = shell(24);
+    let prepared = renderer.prepare(&iso()).unwrap();
+    let eye = renderer.volume().geometry().world_of(truth.centre_vox);
+    assert_eq!(Quality::from_name(" Quarter"), Some(Quality::Quarter));
+    assert_eq!(Quality::Quarter.reduced_size([37, 23]), [10, 6]);
+    assert_eq!(Quality::Half.reduced_size([1, 3]), [1, 2]);
+    let mut frame = Frame::default();
+    for (fov, size) in [
+        (FOV_RANGE_DEG.0, [37, 23]),
+        (FOV_RANGE_DEG.1, [3, 1]),
+        (90.0, [1, 1]),
+    ] {
+        let camera = Camera::look_at(eye, eye + DVec3::X, DVec3::Z, fov, size).unwrap();
+        for quality in Quality::ALL {
+            let options = RenderOptions::new().quality(quality);
+            prepared.render_with(&camera, &options, &mut frame).unwrap();
+            assert_eq!([frame.width, frame.height], size, "{fov}° {quality:?}");
+            let radius = truth.inner_radius_vox as f32;
+            assert!(frame.depth_mm.iter().all(|d| (d - radius).abs() < 0.1));
+        }
+    }
+}

