@@ -54,7 +54,7 @@ const SCENES: [Scene; 4] = [
 ];
 
 fn same(a: &Frame, b: &Frame, what: &str) {
-    assert_eq!(a.rgb, b.rgb, "{what}: colours");
+    assert_eq!(a.color, b.color, "{what}: colours");
     let bits = |f: &Frame| f.depth_mm.iter().map(|d| d.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(a), bits(b), "{what}: depths");
 }
@@ -73,7 +73,7 @@ fn stereo_pairs_in_real_scans_equal_two_plain_renders() {
         let mut options = OpenOptions::default();
         options.orientation = scene.orientation.map(str::to_owned);
         let volume = endocast_io::open(&path, &options).unwrap().volume;
-        let renderer = Renderer::new(volume);
+        let renderer = std::sync::Arc::new(Renderer::new(volume));
         let camera = Optics::default()
             .camera(
                 DVec3::from(scene.eye),

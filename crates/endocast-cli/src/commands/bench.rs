@@ -11,12 +11,15 @@ use clap::Args;
 use endocast_core::camera::StereoRig;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
-use endocast_core::render::{Camera, Frame, Mode, Prepared, RenderSettings, Renderer};
+use endocast_core::render::{
+    Camera, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, Renderer,
+};
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::OpenOptions;
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Arguments of `endocast bench`.
@@ -43,6 +46,9 @@ pub struct BenchArgs {
     /// Vertical field of view in degrees (default: the preset's, else 90).
     #[arg(long, value_name = "DEG")]
     fov: Option<f64>,
+    /// Cast rays at full, half or quarter resolution (upsampled to --image, edge-aware).
+    #[arg(long, default_value = "full", value_parser = parse_quality)]
+    quality: Quality,
     #[command(flatten)]
     look: LookArgs,
     #[command(flatten)]
@@ -80,16 +86,19 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let optics = args
         .lens
         .optics(preset, args.fov, 0.0, (hi - lo).length())?;
+    let renderer = Arc::new(renderer);
+    let options = RenderOptions::new().quality(args.quality);
     let cameras: Vec<Camera> = poses
         .iter()
         .map(|p| optics.camera(p.eye_mm, p.look_at_mm, p.up, args.image))
         .collect::<Result<_, _>>()
         .context("invalid camera on the path")?;
     println!(
-        "{} frames of {}×{}, {} lens, field {}, {} threads",
+        "{} frames of {}×{} ({} quality), {} lens, field {}, {} threads",
         cameras.len(),
         args.image[0],
         args.image[1],
+        args.quality.name(),
         optics.projection.name(),
         optics.field,
         args.look.threads.unwrap_or_else(rayon::current_num_threads)
@@ -100,7 +109,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let prepared = renderer
             .prepare(&cell.settings)
             .context("invalid settings")?;
-        let (mono, pair) = in_pool(args.look.threads, || measure(args, &prepared, &cameras))?;
+        let (mono, pair) = in_pool(args.look.threads, || {
+            measure(args, &prepared, &options, &cameras)
+        })?;
         report(args, optics.field, &cell.name, &mono?)?;
         if let Some((pair, ratios)) = pair {
             report(
@@ -128,7 +139,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 /// the per-frame ratio of a pair's time to one eye's.
 fn measure(
     args: &BenchArgs,
-    prepared: &Prepared<'_>,
+    prepared: &Prepared,
+    options: &RenderOptions<'_>,
     cameras: &[Camera],
 ) -> (Result<Measured>, Option<(Measured, Vec<f64>)>) {
     let (mut mono, mut frame) = (Measured::default(), Frame::default());
@@ -138,7 +150,8 @@ fn measure(
         .map(|_| (Measured::default(), Vec::new()));
     let mut frames = [Frame::default(), Frame::default()];
     for camera in cameras {
-        prepared.render_into(camera, &mut frame);
+        // Nothing cancels it.
+        let _ = prepared.render_with(camera, options, &mut frame);
         let one_ms = frame.stats.time.as_secs_f64() * 1e3;
         mono.ms.push(one_ms);
         mono.samples += frame.stats.samples;
@@ -161,6 +174,11 @@ fn measure(
         ratios.push(pair_ms / one_ms);
     }
     (Ok(mono), pair)
+}
+
+/// A `--quality` level by name.
+fn parse_quality(name: &str) -> Result<Quality, String> {
+    Quality::from_name(name).ok_or_else(|| format!("{name:?}: expected full, half or quarter"))
 }
 
 /// The colon phantom, its fly path, and the paper's table cells.

@@ -24,6 +24,7 @@ use endocast_core::views::stereo::StereoOutput;
 use endocast_io::route_file::read_route;
 use endocast_io::video::{open_sink, FrameSink, VideoOptions};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Arguments of `endocast fly`.
 #[derive(Args, Debug)]
@@ -122,7 +123,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     let optics = args
         .lens
         .optics(preset, args.fov_deg, 0.0, (hi - lo).length())?;
-    let renderer = Renderer::for_many_frames(loaded.volume);
+    let renderer = Arc::new(Renderer::for_many_frames(loaded.volume));
     let options = FlightOptions {
         size: args.size,
         optics,
@@ -133,7 +134,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         },
         window,
     };
-    let mut flight = Flight::new(&renderer, options.clone());
+    let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {
@@ -174,15 +175,22 @@ pub fn run(args: &FlyArgs) -> Result<()> {
 /// key frames are not flown back.
 fn fly_back(
     args: &FlyArgs,
-    renderer: &Renderer,
+    renderer: &Arc<Renderer>,
     route: &Route,
     options: &FlightOptions,
     settings: &RenderSettings,
     forward: Coverage,
 ) -> Result<WallSeen> {
     let (step, look_ahead) = (args.frame_step, args.look_ahead);
-    let back = BackwardPass::new(renderer, route, options, step, look_ahead, &forward)
-        .context("cannot reverse the path")?;
+    let back = BackwardPass::new(
+        Arc::clone(renderer),
+        route,
+        options,
+        step,
+        look_ahead,
+        &forward,
+    )
+    .context("cannot reverse the path")?;
     let Some(back) = back else {
         return Ok(WallSeen::forward_only(forward));
     };
@@ -235,7 +243,7 @@ impl Sinks {
     /// Renders and writes frame `n`.
     fn push(
         &mut self,
-        flight: &mut Flight<'_>,
+        flight: &mut Flight,
         n: usize,
         shot: &Shot,
         settings: &RenderSettings,

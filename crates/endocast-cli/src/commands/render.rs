@@ -18,6 +18,7 @@ use endocast_core::Volume;
 use glam::DVec3;
 use serde_json::json;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Arguments of `endocast render`.
 #[derive(Args, Debug)]
@@ -76,7 +77,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     let camera = camera(args, preset, &loaded.volume, &settings)?;
-    let renderer = Renderer::new(loaded.volume);
+    let renderer = Arc::new(Renderer::new(loaded.volume));
     let prepared = renderer
         .prepare(&settings)
         .context("invalid render settings")?;
@@ -88,7 +89,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Some((rig, output)) => {
             let frames = in_pool(args.look.threads, || prepared.render_stereo(&camera, &rig))?
                 .context("invalid stereo rig")?;
-            write_stereo(&args.output, &frames, output)?;
+            write_stereo(&args.output, &frames, output, settings.background)?;
             eprintln!(
                 "stereo: eye separation {:.2} mm, focus {:.1} mm",
                 rig.eye_separation_mm, rig.focus_mm
@@ -101,7 +102,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         None => {
             let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
             let [w, h] = [frame.width as u32, frame.height as u32];
-            endocast_io::image_out::write_png_rgb8(&args.output, w, h, &frame.rgb)
+            let rgb = frame.to_rgb8(settings.background);
+            endocast_io::image_out::write_png_rgb8(&args.output, w, h, &rgb)
                 .context("cannot write the image")?;
             frame
         }
@@ -163,8 +165,13 @@ fn camera(
 
 /// Writes a stereo pair as `output` asks: one combined image at `path`, or for a pair
 /// `NAME-left.png` and `NAME-right.png` beside it.
-fn write_stereo(path: &Path, frames: &[Frame; 2], output: StereoOutput) -> Result<()> {
-    let [left, right] = [&frames[0], &frames[1]].map(Image::from_frame);
+fn write_stereo(
+    path: &Path,
+    frames: &[Frame; 2],
+    output: StereoOutput,
+    background: [f32; 3],
+) -> Result<()> {
+    let [left, right] = [&frames[0], &frames[1]].map(|f| Image::from_frame(f, background));
     let (left, right) = (left?, right?);
     let write = |path: &Path, image: &Image| {
         let [w, h] = [image.width() as u32, image.height() as u32];
@@ -218,7 +225,7 @@ fn triple(v: DVec3) -> String {
     format!("{:.2},{:.2},{:.2}", v.x, v.y, v.z)
 }
 
-fn print_trace(prepared: &Prepared<'_>, camera: &Camera, x: usize, y: usize) -> Result<()> {
+fn print_trace(prepared: &Prepared, camera: &Camera, x: usize, y: usize) -> Result<()> {
     let [w, h] = camera.size();
     if x >= w || y >= h {
         bail!("--debug-pixel {x},{y} lies outside the {w}×{h} image");

@@ -1,8 +1,9 @@
 use super::*;
 use crate::phantom::{self, PhantomOptions};
 use crate::pose::{fly_through, Pose};
-use crate::render::{Mode, RenderSettings, Renderer};
+use crate::render::{Mode, Premultiplied, RenderSettings, Renderer};
 use crate::Volume;
+use std::sync::Arc;
 
 /// Wall voxels by threshold: not lumen (below `iso_hu` is lumen) and 6-adjacent to lumen.
 fn threshold_wall(volume: &Volume, iso_hu: f64) -> impl Fn([usize; 3]) -> bool + Sync + '_ {
@@ -30,7 +31,7 @@ fn iso_settings() -> RenderSettings {
 }
 
 /// Records the frames of `poses` (90° cameras of `size²` pixels) into a fresh coverage.
-fn fly(renderer: &Renderer, wall: &Coverage, poses: &[Pose], size: usize) -> Coverage {
+fn fly(renderer: &Arc<Renderer>, wall: &Coverage, poses: &[Pose], size: usize) -> Coverage {
     let prepared = renderer.prepare(&iso_settings()).unwrap();
     let mut coverage = wall.clone();
     for p in poses {
@@ -77,7 +78,7 @@ fn a_straight_flight_sees_the_tube_ahead_of_its_first_frame() {
             }
         })
         .collect();
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let ahead = fly(&renderer, &wall, &forward, 96);
     // The first frame shows the wall from z₀ + R·m(φ) on, where m(φ) = max(|cos φ|, |sin φ|)
     // is where a square 90° image's edge cuts the wall at azimuth φ (mean 0.9003); later frames
@@ -133,7 +134,7 @@ fn unseen_wall_is_tinted_in_an_overview() {
     let g = *volume.geometry();
     let wall = Coverage::new(&g, threshold_wall(&volume, -500.0), &whole(&volume)).unwrap();
     let axis = tube.centreline.points()[0];
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let mut coverage = wall.clone();
     // Mark by hand everything at k ≥ 24: the wall surface points of that half.
     for k in 24..48 {
@@ -147,7 +148,7 @@ fn unseen_wall_is_tinted_in_an_overview() {
     let centre = g.world_of(axis + DVec3::Z * 24.0);
     let view = Camera::look_at(centre + DVec3::X * 80.0, centre, DVec3::Z, 50.0, [64, 64]).unwrap();
     let frame = renderer.prepare(&iso_settings()).unwrap().render(&view);
-    let mut image = Image::from_frame(&frame).unwrap();
+    let mut image = Image::from_frame(&frame, iso_settings().background).unwrap();
     let red = [255, 0, 0];
     let tinted = coverage
         .tint_unseen(&mut image, &view, &frame.depth_mm, red, 1.0)
@@ -225,7 +226,7 @@ fn a_forward_flight_misses_the_far_sides_of_the_folds() {
     let g = *volume.geometry();
     let wall = Coverage::new(&g, threshold_wall(&volume, -500.0), &whole(&volume)).unwrap();
     let forward = fly_through(&g, |s| line.point_at(s), line.length_vox(), 48, 6.0).unwrap();
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let ahead = fly(&renderer, &wall, &forward, 96);
     let back = fly(&renderer, &wall, &backwards(&forward), 96);
     let mut both = ahead.clone();
@@ -277,11 +278,10 @@ fn rejects_bad_input() {
     let frame = Frame {
         width: 4,
         height: 3,
-        rgb: vec![0; 36],
-        alpha: vec![0.0; 12],
+        color: vec![Premultiplied::default(); 12],
         depth_mm: vec![1.0; 12],
         value: vec![0.0; 12],
-        stats: Default::default(),
+        ..Frame::default()
     };
     assert!(full.record(&camera, &frame).is_err());
     assert_eq!(full.seen_count(), 0);

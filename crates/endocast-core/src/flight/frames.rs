@@ -11,6 +11,7 @@ use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Wi
 use crate::views::stereo::{self, StereoOutput};
 use crate::views::{Image, Rgb};
 use glam::DVec3;
+use std::sync::Arc;
 
 /// Colour and strength of the tint on wall not seen yet, in the dashboard's overview.
 const UNSEEN_TINT: (Rgb, f32) = ([230, 40, 40], 0.55);
@@ -64,21 +65,21 @@ struct DashboardParts {
 
 /// Renders the frames of a flight, one shot at a time (memory does not grow with the length).
 #[derive(Debug)]
-pub struct Flight<'a> {
-    renderer: &'a Renderer,
+pub struct Flight {
+    renderer: Arc<Renderer>,
     options: FlightOptions,
     dashboard: Option<DashboardParts>,
     coverage: Option<Coverage>,
-    prepared: Option<Prepared<'a>>,
+    prepared: Option<Prepared>,
     /// The frames rendered into (the second for a stereo pair's right eye), their buffers
     /// reused from shot to shot.
     frames: [Frame; 2],
 }
 
-impl<'a> Flight<'a> {
+impl Flight {
     /// A flight over `renderer`'s volume. With [`Layout::Dashboard`], call
     /// [`Flight::with_overview`] before the first frame.
-    pub fn new(renderer: &'a Renderer, options: FlightOptions) -> Self {
+    pub fn new(renderer: Arc<Renderer>, options: FlightOptions) -> Self {
         Self {
             renderer,
             options,
@@ -140,7 +141,7 @@ impl<'a> Flight<'a> {
         let (camera, eyes, stats) = self.render_shot(shot, settings)?;
         let endoscope = match (self.options.stereo, eyes) {
             (Some(stereo), Some([left, right])) => stereo::combine(&left, &right, stereo.output)?,
-            _ => Image::from_frame(&self.frames[0])?,
+            _ => Image::from_frame(&self.frames[0], settings.background)?,
         };
         let image = match self.options.layout {
             Layout::Endoscope => endoscope,
@@ -160,7 +161,7 @@ impl<'a> Flight<'a> {
         let eyes = match eyes {
             Some(eyes) => eyes,
             None => {
-                let view = Image::from_frame(&self.frames[0])?;
+                let view = Image::from_frame(&self.frames[0], settings.background)?;
                 [view.clone(), view]
             }
         };
@@ -181,7 +182,7 @@ impl<'a> Flight<'a> {
             None => self.options.optics,
         };
         let camera = optics.camera(pose.eye_mm, pose.look_at_mm, pose.up, self.options.size)?;
-        let prepared = prepared(&mut self.prepared, self.renderer, settings)?;
+        let prepared = prepared(&mut self.prepared, &self.renderer, settings)?;
         let (seen_by, eyes) = match self.options.stereo {
             None => {
                 prepared.render_into(&camera, &mut self.frames[0]);
@@ -193,7 +194,11 @@ impl<'a> Flight<'a> {
                 })?;
                 prepared.render_stereo_into(&camera, &rig, &mut self.frames)?;
                 let [left, right] = &self.frames;
-                let eyes = [Image::from_frame(left)?, Image::from_frame(right)?];
+                let background = settings.background;
+                let eyes = [
+                    Image::from_frame(left, background)?,
+                    Image::from_frame(right, background)?,
+                ];
                 (rig.eyes(&camera)?[0], Some(eyes))
             }
         };
@@ -264,15 +269,20 @@ fn cross_options(slices: &SliceOptions) -> SliceOptions {
     }
 }
 
-/// The prepared renderer in `slot` for `settings`, re-prepared only when they change.
-fn prepared<'s, 'a>(
-    slot: &'s mut Option<Prepared<'a>>,
-    renderer: &'a Renderer,
+/// The prepared renderer in `slot` for `settings`, updated only when they change.
+fn prepared<'s>(
+    slot: &'s mut Option<Prepared>,
+    renderer: &Arc<Renderer>,
     settings: &RenderSettings,
-) -> Result<&'s Prepared<'a>, FlightError> {
+) -> Result<&'s Prepared, FlightError> {
     let prepared = match slot.take() {
-        Some(p) if p.settings() == settings => p,
-        _ => renderer.prepare(settings)?,
+        Some(mut p) => {
+            if p.settings() != settings {
+                p.update(settings)?;
+            }
+            p
+        }
+        None => renderer.prepare(settings)?,
     };
     Ok(slot.insert(prepared))
 }

@@ -8,6 +8,7 @@ use crate::render::{Camera, Mode, RenderSettings, Renderer};
 use crate::views::Image;
 use crate::{Geometry, Modality, ValueMap, Volume};
 use glam::DVec3;
+use std::sync::Arc;
 
 /// Voxels of empty margin around the lumen's box, so its surface closes at the box's faces.
 const MARGIN: usize = 2;
@@ -51,10 +52,10 @@ pub fn lumen_overview(
         iso_color: [0.8, 0.75, 0.65],
         ..RenderSettings::default()
     };
-    let renderer = Renderer::new(mask);
+    let renderer = Arc::new(Renderer::new(mask));
     let frame = renderer.prepare(&settings)?.render(&camera);
     Ok(Overview {
-        image: Image::from_frame(&frame)?,
+        image: Image::from_frame(&frame, settings.background)?,
         camera,
         depth_mm: frame.depth_mm,
     })

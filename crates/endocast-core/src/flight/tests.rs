@@ -6,6 +6,7 @@ use crate::navigate::{Lumen, LumenSide};
 use crate::phantom::{self, PhantomOptions};
 use crate::render::{Mode, RenderSettings, Renderer, TransferFunction};
 use crate::views::slices::Window;
+use std::sync::Arc;
 
 fn straight(len: f64) -> Route {
     let points = [DVec3::ZERO, DVec3::new(0.0, 0.0, len)];
@@ -51,7 +52,7 @@ fn a_dashboard_frame_is_wider_than_the_view_and_coverage_grows() {
     let (volume, _) = phantom::straight_tube(&options);
     let lumen = Lumen::from_seed(&volume, [20, 20, 20], -480.0, LumenSide::Below).unwrap();
     let geometry = *volume.geometry();
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let route = straight(15.0);
     let flight_options = FlightOptions {
         size: [48, 48],
@@ -60,7 +61,7 @@ fn a_dashboard_frame_is_wider_than_the_view_and_coverage_grows() {
         layout: Layout::Dashboard,
         window: Window::AIR_TISSUE,
     };
-    let flight = Flight::new(&renderer, flight_options);
+    let flight = Flight::new(renderer, flight_options);
     let overview = lumen_overview(&lumen, &geometry, flight.overview_size().unwrap()).unwrap();
     let (lo, hi) = lumen.bounds();
     let bbox = [0, 1, 2].map(|a| lo[a].saturating_sub(1)..(hi[a] + 2).min(geometry.dims()[a]));
@@ -151,7 +152,7 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
     });
     let lumen = Lumen::from_seed(&volume, [20, 20, 20], -480.0, LumenSide::Below).unwrap();
     let geometry = *volume.geometry();
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let options = FlightOptions {
         size: [32, 32],
         optics: Optics::default(),
@@ -166,13 +167,13 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
     };
     let route = straight(15.0);
     let wall = wall_coverage(&lumen, &geometry).unwrap();
-    let mut flight = Flight::new(&renderer, options.clone()).with_coverage(wall.clone());
+    let mut flight = Flight::new(renderer.clone(), options.clone()).with_coverage(wall.clone());
     let shots = route.shots(5.0, 5.0).unwrap();
     for (n, shot) in shots.iter().enumerate() {
         flight.frame(n, shot, &settings).unwrap();
     }
     let forward = flight.into_coverage().unwrap();
-    let back = BackwardPass::new(&renderer, &route, &options, 5.0, 5.0, &forward)
+    let back = BackwardPass::new(renderer.clone(), &route, &options, 5.0, 5.0, &forward)
         .unwrap()
         .unwrap();
     assert_eq!(back.shots().len(), shots.len());
@@ -206,7 +207,7 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
     .unwrap()])
     .unwrap();
     assert!(
-        BackwardPass::new(&renderer, &keys, &options, 5.0, 5.0, &forward)
+        BackwardPass::new(renderer.clone(), &keys, &options, 5.0, 5.0, &forward)
             .unwrap()
             .is_none()
     );

@@ -14,6 +14,7 @@ use crate::render::{RenderSettings, Renderer};
 use crate::views::slices::Window;
 use crate::views::Rgb;
 use crate::Geometry;
+use std::sync::Arc;
 
 /// Sample step of the spline through the reversed route's samples, mm.
 const REVERSE_STEP_MM: f64 = 0.5;
@@ -35,18 +36,18 @@ pub fn wall_coverage(lumen: &Lumen, geometry: &Geometry) -> Result<Coverage, Cov
 /// endoscope view alone at the forward flight's image size and field of view, recording into a
 /// coverage of its own.
 #[derive(Debug)]
-pub struct BackwardPass<'a> {
-    flight: Flight<'a>,
+pub struct BackwardPass {
+    flight: Flight,
     shots: Vec<Shot>,
 }
 
-impl<'a> BackwardPass<'a> {
+impl BackwardPass {
     /// The pass back along `route`, filmed like the `forward` flight (its image size and field
     /// of view), shots every `step_mm` looking `look_ahead_mm` ahead, recording into a fresh
     /// coverage of the wall `forward_seen` covers. `Ok(None)` for key frames, whose views have
     /// no natural reverse.
     pub fn new(
-        renderer: &'a Renderer,
+        renderer: Arc<Renderer>,
         route: &Route,
         forward: &FlightOptions,
         step_mm: f64,

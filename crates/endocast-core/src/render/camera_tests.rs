@@ -37,14 +37,14 @@ fn a_180_degree_fisheye_from_the_sphere_centre_sees_the_shell_at_its_radius() {
     let camera = along_k(&volume, shell.centre_vox, 33)
         .with_projection(Projection::Equidistant, 180.0)
         .unwrap();
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let frame = renderer.prepare(&iso()).unwrap().render(&camera);
     let (mut seen, mut worst) = (0, 0.0f64);
     for y in 0..33 {
         for x in 0..33 {
             let depth = f64::from(frame.depth_mm[x + 33 * y]);
             if camera.pixel_ray(x, y).is_none() {
-                assert!(depth.is_nan() && frame.alpha[x + 33 * y] == 0.0);
+                assert!(depth.is_nan() && frame.color[x + 33 * y].alpha() == 0.0);
                 continue;
             }
             worst = worst.max((depth - shell.inner_radius_vox).abs());
@@ -87,7 +87,7 @@ fn a_straight_tube_through_the_fisheye_is_a_circle_on_axis_and_bends_off_axis() 
     });
     let last_k = (volume.dims()[2] - 1) as f64;
     let axis = tube.centreline.points()[0];
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let prepared = renderer.prepare(&iso()).unwrap();
     for offset in [DVec3::ZERO, DVec3::new(6.0, 3.0, 0.0)] {
         let eye_vox = DVec3::new(axis.x, axis.y, last_k - 20.0) + offset;
@@ -155,7 +155,7 @@ fn stereo_disparity_on_rendered_images_follows_the_off_axis_formula() {
         eye_separation_mm: 2.0,
         focus_mm: 20.0,
     };
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let prepared = renderer.prepare(&iso()).unwrap();
     let [left, right] = rig.eyes(&centre).unwrap().map(|eye| prepared.render(&eye));
     for ball in balls {
@@ -219,7 +219,7 @@ fn every_camera_gives_the_one_ray_pixels() {
     ];
     cameras.extend(rig.eyes(&base).unwrap());
     cameras.extend(rig.eyes(&fisheye).unwrap());
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     for (mode, jitter) in [(Mode::Iso, false), (Mode::Hybrid, true), (Mode::Dvr, false)] {
         let settings = RenderSettings {
             mode,
@@ -235,8 +235,8 @@ fn every_camera_gives_the_one_ray_pixels() {
             for (y, x) in (0..h).flat_map(|y| (0..w).map(move |x| (y, x))) {
                 let trace = prepared.trace_pixel(camera, x, y);
                 let (i, what) = (x + w * y, format!("{mode:?} {camera:?} ({x}, {y})"));
-                assert_eq!(trace.rgb[..], frame.rgb[3 * i..3 * i + 3], "{what}");
-                assert_eq!(trace.alpha, frame.alpha[i], "{what}");
+                assert_eq!(trace.rgb, frame.pixel(x, y, settings.background), "{what}");
+                assert_eq!(trace.alpha, frame.color[i].alpha(), "{what}");
                 assert_eq!(
                     trace.depth_mm.to_bits(),
                     frame.depth_mm[i].to_bits(),

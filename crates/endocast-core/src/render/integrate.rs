@@ -236,10 +236,22 @@ impl Integrator<'_> {
     /// starts with the first sample past the crossing.
     fn search<P: Probe>(&self, march: &mut RayMarch, iso: f32, probe: &mut P) -> Option<Bracket> {
         let rising = self.rising(march, iso);
+        self.search_from(march, (iso, rising), (0.0, 0.0), probe)
+    }
+
+    /// [`Self::search`] for a crossing in the direction `rising`, the walk's last sample so far
+    /// being `previous` (`(t, value)`; ignored on a fresh march): resumes a march a search left
+    /// after its hit, whose next sample is the one after that crossing.
+    fn search_from<P: Probe>(
+        &self,
+        march: &mut RayMarch,
+        (iso, rising): (f32, bool),
+        mut previous: (f32, f32),
+        probe: &mut P,
+    ) -> Option<Bracket> {
         let active = |b| self.iso_active(b);
         let grid = march.grid();
-        // The sample before the one under test, and the bracket once a crossing is found.
-        let mut previous = (0.0f32, 0.0f32);
+        // `previous`: the sample before the one under test; `hit`: the bracket once found.
         let mut hit = None;
         if P::TRACES {
             march.walk(&self.sampler, Walk::SEARCH, active, |s: Sample| {
@@ -279,6 +291,32 @@ impl Integrator<'_> {
             after: previous,
             rising,
         })
+    }
+
+    /// The distances of the successive crossings of the lower isovalue along a fresh march,
+    /// nearest first, into `depths_mm` (left as they are past the last crossing): the first as
+    /// [`Self::run`] finds it, then each next one by resuming the search after the hit, in the
+    /// other direction (out of the wall, into the next). The march is left after the last
+    /// crossing found.
+    pub fn crossings(&self, march: &mut RayMarch, depths_mm: &mut [f32]) {
+        let iso = self.params.lower.iso;
+        let mut rising = self.rising(march, iso);
+        let mut previous = (0.0, 0.0);
+        for depth in depths_mm {
+            let Some(bracket) = self.search_from(march, (iso, rising), previous, &mut ()) else {
+                return;
+            };
+            *depth = self.refine(march.grid(), iso, bracket);
+            previous = bracket.after;
+            rising = !rising;
+        }
+    }
+
+    /// The unit world normal of the lower isosurface's field at distance `t_mm` along `march`'s
+    /// ray (up the value gradient).
+    pub fn normal_at(&self, march: &RayMarch, t_mm: f32) -> Vec3 {
+        let gradient = self.sampler.gradient(march.grid().at(t_mm));
+        self.shader.normal(gradient)
     }
 
     /// Bisection of the bracket `(t, value)` before and after a crossing (the two samples the

@@ -164,6 +164,27 @@ impl RayMarch {
         march
     }
 
+    /// Ends the ray at `t_max_mm` from the eye if it ends later (opaque geometry in front of
+    /// the volume's far side): no sample at or past it is taken, and the brick walk stops
+    /// there. NaN leaves the ray as it is. For a march not yet walked.
+    pub fn limit(&mut self, t_max_mm: f32) {
+        debug_assert!(self.next == 0 && !self.has_previous);
+        if t_max_mm < self.dda.t_end {
+            self.dda.t_end = t_max_mm.max(self.dda.t);
+            self.end = self.end.min(self.index_at(t_max_mm).max(0));
+        }
+    }
+
+    /// Moves the sample grid by `shift` steps (wrapped to an offset in 0–1): a still frame's
+    /// per-frame jitter. For a march not yet walked.
+    pub fn shift_grid(&mut self, shift: f32) {
+        debug_assert!(self.next == 0 && !self.has_previous);
+        let offset = self.grid.offset + shift;
+        self.grid.offset = offset - offset.floor();
+        // The end as `with_walk` sets it, from the range's end the brick walk keeps.
+        self.end = self.index_at(self.dda.t_end).max(0);
+    }
+
     /// The first sample index at or after `t`.
     #[inline]
     fn index_at(&self, t: f32) -> i32 {

@@ -6,8 +6,16 @@
 //!   for many frames, a copy of its voxels brick by brick for the sample batches
 //!   ([`BrickedVoxels`]), built once;
 //! - [`Prepared`]: what the settings imply — the transfer function's [`TfTable`] and the
-//!   brick [`Activity`] — rebuilt in milliseconds whenever an isovalue or the TF changes;
+//!   brick [`Activity`] — rebuilt in milliseconds whenever an isovalue or the TF changes
+//!   ([`Prepared::update`]); it shares the renderer through an [`Arc`], so a worker thread can
+//!   own it;
 //! - [`Camera`]: one per frame.
+//!
+//! A frame holds float layers ([`Frame`]): the background and the 8-bit conversion come last.
+//! [`Prepared::render_with`] renders at a [`Quality`] level, fills optional [`Layers`], ends
+//! rays at a per-pixel maximum distance, and can be cancelled between tiles; [`Still`]
+//! accumulates jittered frames and [`progressive`] runs quarter → half → full → still while the
+//! view stands.
 //!
 //! Each pixel's ray is moved into voxel space, starts on the near plane (eye inside the volume)
 //! or where it enters the volume, walks the brick grid ([`traverse`]), samples only in active
@@ -19,10 +27,11 @@
 //! use endocast_core::phantom::{self, PhantomOptions};
 //! use endocast_core::render::{Camera, Mode, RenderSettings, Renderer};
 //! use glam::DVec3;
+//! use std::sync::Arc;
 //!
 //! let (volume, shell) = phantom::sphere_shell(&PhantomOptions { size: 32, ..Default::default() });
 //! let centre_mm = volume.geometry().world_of(shell.centre_vox);
-//! let renderer = Renderer::new(volume);
+//! let renderer = Arc::new(Renderer::new(volume));
 //! let mut settings = RenderSettings::default();
 //! settings.mode = Mode::Iso;
 //! settings.iso_hu = -480.0; // the phantom's air/tissue mid-value lies on its surface
@@ -39,14 +48,18 @@ mod crossing;
 mod frame;
 mod integrate;
 mod march;
+mod options;
 #[cfg(target_arch = "x86_64")]
 mod packet;
+pub mod progressive;
+pub mod quality;
 mod ray_task;
 #[cfg(target_arch = "x86_64")]
 mod rays4;
 mod sample;
 mod settings;
 mod stereo;
+mod still;
 mod tiles;
 mod transfer;
 pub mod traverse;
@@ -54,15 +67,20 @@ pub mod traverse;
 #[cfg(test)]
 mod camera_tests;
 #[cfg(test)]
+mod interactive_tests;
+#[cfg(test)]
 mod tests;
 
 pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
 
 use crate::camera::Ray;
 pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
-pub use frame::{Frame, RenderStats};
+pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
+pub use options::{Cancelled, Progress, Quality, RenderOptions};
+pub use progressive::progressive;
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
 pub use settings::{Crossing, Mode, RenderSettings, SettingsError};
+pub use still::{Jitter, Still};
 pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
 use frame::to_u8;
@@ -72,9 +90,10 @@ use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
 #[cfg(target_arch = "x86_64")]
 use rays4::RaySetup;
+use std::sync::Arc;
 use std::time::Instant;
 use stereo::SearchStarts;
-use tiles::{Pixel, Tile, TileRect, Tiling, TILE};
+use tiles::{Control, Extra, Pixel, Tile, TileRect, Tiling, TILE};
 use traverse::{BrickDda, VoxelRay};
 
 use crate::Volume;
@@ -153,13 +172,33 @@ impl Renderer {
     }
 
     /// Classifies the bricks and tabulates the transfer function for `settings` (cheap: about a
-    /// millisecond for a 512³ volume). Fails when a setting is out of range.
-    pub fn prepare(&self, settings: &RenderSettings) -> Result<Prepared<'_>, SettingsError> {
+    /// millisecond for a 512³ volume): [`Prepared::new`] on a share of this renderer. Fails
+    /// when a setting is out of range.
+    pub fn prepare(self: &Arc<Self>, settings: &RenderSettings) -> Result<Prepared, SettingsError> {
+        Prepared::new(Arc::clone(self), settings)
+    }
+}
+
+/// What the settings imply for one renderer: the lookup table, the brick classification and
+/// the integrators' numbers.
+#[derive(Debug)]
+struct Derived {
+    settings: RenderSettings,
+    table: TfTable,
+    activity: Activity,
+    params: Params,
+    shader: Shader,
+    step_mm: f64,
+}
+
+impl Derived {
+    fn new(renderer: &Renderer, settings: &RenderSettings) -> Result<Self, SettingsError> {
         settings.validate()?;
-        let geometry = self.volume.geometry();
-        let map = self.volume.value_map();
+        let volume = &renderer.volume;
+        let geometry = volume.geometry();
+        let map = volume.value_map();
         let step_mm = settings.step_mm(geometry.spacing_mm().min_element());
-        let mut table = TfTable::new(&settings.tf, map, self.volume.stored_range(), step_mm);
+        let mut table = TfTable::new(&settings.tf, map, volume.stored_range(), step_mm);
         let stored = |hu: f64| map.stored_from_physical(hu) as f32;
         // A negative scale turns the order of stored values around; keep "lower" lower.
         let (lower_hu, upper_hu) = if map.scale() > 0.0 {
@@ -172,7 +211,7 @@ impl Renderer {
             table.make_transparent_between(stored(lower_hu), stored(upper_hu));
             isovalues.push(stored(settings.iso2_hu));
         }
-        let activity = Activity::classify(&self.grid, &isovalues, &table);
+        let activity = Activity::classify(&renderer.grid, &isovalues, &table);
         let surface = |iso_hu: f64, opacity: f32, color: [f32; 3]| Surface {
             iso: stored(iso_hu),
             opacity,
@@ -189,23 +228,23 @@ impl Renderer {
             skip_empty: settings.skip_empty,
         };
         let shader = Shader::new(geometry.world_from_voxel().matrix3, settings.lighting);
-        Ok(Prepared {
-            renderer: self,
+        Ok(Self {
             settings: settings.clone(),
             table,
             activity,
             params,
             shader,
             step_mm,
-            voxel_from_world: geometry.voxel_from_world(),
         })
     }
 }
 
-/// A renderer with its settings applied: renders frames for any camera.
+/// A renderer with its settings applied: renders frames for any camera. It holds a share of
+/// its [`Renderer`], so it can be moved to and owned by a worker thread (it is `Send + Sync`),
+/// and [`Prepared::update`] applies new settings in place.
 #[derive(Debug)]
-pub struct Prepared<'a> {
-    renderer: &'a Renderer,
+pub struct Prepared {
+    renderer: Arc<Renderer>,
     settings: RenderSettings,
     table: TfTable,
     activity: Activity,
@@ -265,7 +304,42 @@ impl Probe for Vec<TraceSample> {
     }
 }
 
-impl Prepared<'_> {
+impl Prepared {
+    /// `renderer` with `settings` applied: classifies the bricks and tabulates the transfer
+    /// function (about a millisecond for a 512³ volume). Fails when a setting is out of range.
+    pub fn new(renderer: Arc<Renderer>, settings: &RenderSettings) -> Result<Self, SettingsError> {
+        let d = Derived::new(&renderer, settings)?;
+        let voxel_from_world = renderer.volume.geometry().voxel_from_world();
+        Ok(Self {
+            renderer,
+            settings: d.settings,
+            table: d.table,
+            activity: d.activity,
+            params: d.params,
+            shader: d.shader,
+            step_mm: d.step_mm,
+            voxel_from_world,
+        })
+    }
+
+    /// Applies new `settings` in place (re-classifies the bricks and re-tabulates the transfer
+    /// function: milliseconds). On an out-of-range setting the old ones stay in force.
+    pub fn update(&mut self, settings: &RenderSettings) -> Result<(), SettingsError> {
+        let d = Derived::new(&self.renderer, settings)?;
+        self.settings = d.settings;
+        self.table = d.table;
+        self.activity = d.activity;
+        self.params = d.params;
+        self.shader = d.shader;
+        self.step_mm = d.step_mm;
+        Ok(())
+    }
+
+    /// The renderer.
+    pub fn renderer(&self) -> &Arc<Renderer> {
+        &self.renderer
+    }
+
     /// The settings in force.
     pub fn settings(&self) -> &RenderSettings {
         &self.settings
@@ -316,22 +390,51 @@ impl Prepared<'_> {
     /// [`Self::render`] into `frame`, reusing its buffers (a loop over many frames of one size
     /// then allocates none: fresh buffers cost about 2 ms a frame in page faults).
     pub fn render_into(&self, camera: &Camera, frame: &mut Frame) {
-        self.render_with_starts(camera, frame, None);
+        // Without a cancel flag nothing can cancel it.
+        let _ = self.render_with(camera, &RenderOptions::new(), frame);
     }
 
-    /// [`Self::render_into`], the isosurface searches starting at `starts` where given (the
-    /// second eye of a stereo pair, [`stereo`]).
-    fn render_with_starts(
+    /// Renders into `frame` as `options` ask: at their quality, with their optional layers and
+    /// maximum distances, stopping between tiles when their cancel flag is set (then `frame`'s
+    /// content is unspecified and the call returns [`Cancelled`]). `frame.stats.time` is the
+    /// whole call's time, upsampling included.
+    ///
+    /// # Panics
+    ///
+    /// When the options' maximum distances are not one per pixel of `camera`.
+    pub fn render_with(
         &self,
         camera: &Camera,
+        options: &RenderOptions<'_>,
         frame: &mut Frame,
-        starts: Option<&SearchStarts>,
-    ) {
+    ) -> Result<(), Cancelled> {
         let start = Instant::now();
-        let integrator = self.integrator(camera);
-        let tile = |rect| self.tile(&integrator, camera, rect, starts);
-        Tiling::new(camera.size()).render_into(tile, frame);
+        match options.quality {
+            Quality::Full => self.render_tiles(camera, options, frame)?,
+            reduced => quality::render_reduced(self, camera, reduced, options, frame)?,
+        }
         frame.stats.time = start.elapsed();
+        Ok(())
+    }
+
+    /// Renders every pixel of `camera` into `frame` (full quality for this camera).
+    fn render_tiles(
+        &self,
+        camera: &Camera,
+        options: &RenderOptions<'_>,
+        frame: &mut Frame,
+    ) -> Result<(), Cancelled> {
+        let [w, h] = camera.size();
+        if let Some(max) = options.max_distance_mm {
+            assert_eq!(max.len(), w * h, "one maximum distance per pixel");
+        }
+        let integrator = self.integrator(camera);
+        let tile = |rect| self.tile(&integrator, camera, options, rect);
+        let control = Control {
+            cancel: options.cancel,
+            progress: options.progress,
+        };
+        Tiling::new(camera.size()).render_into(tile, frame, options.layers, control)
     }
 
     /// Renders the pixels of `rect`, each row's rays as one group.
@@ -339,31 +442,80 @@ impl Prepared<'_> {
         &self,
         integrator: &Integrator<'_>,
         camera: &Camera,
+        options: &RenderOptions<'_>,
         rect: TileRect,
-        starts: Option<&SearchStarts>,
     ) -> Tile {
+        let pixels = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
         let mut tile = Tile {
-            pixels: Vec::with_capacity((rect.x1 - rect.x0) * (rect.y1 - rect.y0)),
+            pixels: Vec::with_capacity(pixels),
+            extras: Vec::new(),
             stats: RenderStats::default(),
         };
+        let layers = options.layers;
+        if !layers.is_empty() {
+            tile.extras = vec![Extra::default(); pixels];
+        }
+        let width = camera.size()[0];
         let missed = self.pixel_of(&PixelOut::default());
         let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
         for y in rect.y0..rect.y1 {
             columns.clear();
             tasks.clear();
-            let xs = rect.x0..rect.x1;
-            let late = starts.map(|starts| (integrator, starts));
-            self.row_tasks(camera, y, xs, late, &mut columns, &mut tasks);
+            // A still frame's shifted grid is not the one the starts were checked on.
+            let late = options.starts.filter(|_| options.grid_shift == 0.0);
+            let late = late.map(|starts| (integrator, starts));
+            self.row_tasks(camera, y, rect.x0..rect.x1, late, &mut columns, &mut tasks);
+            if options.grid_shift != 0.0 || options.max_distance_mm.is_some() {
+                for (&x, task) in columns.iter().zip(&mut tasks) {
+                    adjust(&mut task.march, options, x + width * y);
+                }
+            }
             integrator.run_group(&mut tasks);
             let row = tile.pixels.len();
             tile.pixels.resize(row + rect.x1 - rect.x0, missed);
             for (&x, task) in columns.iter().zip(&mut tasks) {
                 vignette(camera, x, y, &mut task.out);
-                tile.pixels[row + x - rect.x0] = self.pixel_of(&task.out);
+                let task = &*task;
+                let i = row + x - rect.x0;
+                tile.pixels[i] = self.pixel_of(&task.out);
                 count_ray(&mut tile.stats, task);
+                if !layers.is_empty() {
+                    let extra = &mut tile.extras[i];
+                    self.extra(integrator, camera, options, (x, y), task, extra);
+                }
             }
         }
         tile
+    }
+
+    /// The optional layers of pixel `(x, y)`, whose ray `task` has been rendered.
+    fn extra(
+        &self,
+        integrator: &Integrator<'_>,
+        camera: &Camera,
+        options: &RenderOptions<'_>,
+        (x, y): (usize, usize),
+        task: &RayTask,
+        extra: &mut Extra,
+    ) {
+        let layers = options.layers;
+        let depth = task.out.depth_mm;
+        if !depth.is_nan() {
+            if layers.contains(Layers::HIT_POSITION) {
+                if let Some(hit) = camera.point_at(x, y, f64::from(depth)) {
+                    extra.hit_mm = hit.as_vec3().to_array();
+                }
+            }
+            if layers.contains(Layers::NORMAL) {
+                extra.normal = integrator.normal_at(&task.march, depth).to_array();
+            }
+        }
+        if layers.contains(Layers::DEPTHS) {
+            if let Some(mut fresh) = self.task(camera, x, y) {
+                adjust(&mut fresh.march, options, x + camera.size()[0] * y);
+                integrator.crossings(&mut fresh.march, &mut extra.depths_mm);
+            }
+        }
     }
 
     /// Traces pixel `(x, y)` of `camera` and returns every sample (the `--debug-pixel` aid).
@@ -553,8 +705,10 @@ impl Prepared<'_> {
     fn pixel_of(&self, out: &PixelOut) -> Pixel {
         let map = self.renderer.volume.value_map();
         Pixel {
-            rgb: self.display(&out.accum),
-            alpha: out.accum.alpha(),
+            color: Premultiplied {
+                rgb: out.accum.rgb.to_array(),
+                transmittance: out.accum.transmittance,
+            },
             depth_mm: out.depth_mm,
             value: (f64::from(out.value) * map.scale() + map.offset()) as f32,
         }
@@ -566,6 +720,17 @@ fn vignette(camera: &Camera, x: usize, y: usize, out: &mut PixelOut) {
     if camera.lens().vignetting > 0.0 {
         let f = camera.vignetting(x as f64 + 0.5, y as f64 + 0.5) as f32;
         out.accum.rgb *= f;
+    }
+}
+
+/// Applies a render's per-frame grid shift and the pixel's maximum distance (pixel index `i`)
+/// to a march not yet walked.
+fn adjust(march: &mut RayMarch, options: &RenderOptions<'_>, i: usize) {
+    if options.grid_shift != 0.0 {
+        march.shift_grid(options.grid_shift);
+    }
+    if let Some(max) = options.max_distance_mm {
+        march.limit(max[i]);
     }
 }
 

@@ -24,7 +24,7 @@
 //! of the isovalue, or a mode that composites in front of the surface (DVR, two-iso, MIP) —
 //! the eyes share only the prepared state.
 
-use super::{Frame, Mode, Prepared, BRICK_VOX};
+use super::{Frame, Mode, Prepared, RenderOptions, BRICK_VOX};
 
 /// How many bricks around the eye [`Prepared::clear_radius_vox`] looks at.
 const CLEAR_BRICKS: usize = 3;
@@ -53,7 +53,7 @@ impl SearchStarts {
     }
 }
 
-impl Prepared<'_> {
+impl Prepared {
     /// Renders the left and right eyes of `camera` under `rig` into `frames` (their buffers
     /// reused), the right eye's searches starting past the space the left eye showed empty
     /// where that is exact (see the module doc). The images are those of two independent
@@ -70,7 +70,9 @@ impl Prepared<'_> {
         match self.shares_emptiness(&left, &right) {
             true => {
                 let starts = self.search_starts(&left, &right, rig, left_frame);
-                self.render_with_starts(&right, right_frame, Some(&starts));
+                let options = RenderOptions::new().search_starts(&starts);
+                // Without a cancel flag nothing can cancel it.
+                let _ = self.render_with(&right, &options, right_frame);
             }
             false => self.render_into(&right, right_frame),
         }

@@ -5,6 +5,7 @@ use super::*;
 use crate::phantom::{self, PhantomOptions};
 use crate::{Geometry, Modality, ValueMap};
 use glam::{DMat3, DVec3, Vec3};
+use std::sync::Arc;
 use std::time::Instant;
 
 fn options(size: usize) -> PhantomOptions {
@@ -50,7 +51,7 @@ fn sphere_distance(eye: DVec3, dir: DVec3, centre: DVec3, radius: f64) -> f64 {
 fn sphere_depth_error(eye_offset: DVec3, refine_steps: u32) -> f64 {
     let (volume, shell) = phantom::sphere_shell(&options(48));
     let eye_vox = shell.centre_vox + eye_offset;
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let s = RenderSettings {
         refine_steps,
         ..settings(Mode::Iso)
@@ -97,7 +98,7 @@ fn tube_depth_from_inside_matches_the_cylinder() {
     let eye_vox = tube.centreline.point_at(4.0) + DVec3::new(2.0, -1.0, 0.0);
     let axis = tube.centreline.points()[0];
     let last_k = (volume.dims()[2] - 1) as f64;
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let prepared = renderer.prepare(&settings(Mode::Iso)).unwrap();
     let forward = DVec3::new(0.1, 0.05, 1.0).normalize();
     let camera = camera_at(renderer.volume(), eye_vox, forward, 90.0, 32);
@@ -145,7 +146,7 @@ fn homogeneous_block() -> Volume {
 
 #[test]
 fn dvr_of_a_homogeneous_slab_follows_beer_lambert_at_any_step() {
-    let renderer = Renderer::new(homogeneous_block());
+    let renderer = Arc::new(Renderer::new(homogeneous_block()));
     let alpha_per_mm = 0.05f32;
     let tf = TransferFunction::from_points(&[(0.0, alpha_per_mm)], &[(0.0, [1.0; 3])]).unwrap();
     let camera = Camera::look_at(
@@ -170,14 +171,20 @@ fn dvr_of_a_homogeneous_slab_follows_beer_lambert_at_any_step() {
                 let trace = prepared.trace_pixel(&camera, x, y);
                 let (t0, t1) = trace.range_mm.unwrap();
                 let expected = 1.0 - (1.0 - f64::from(alpha_per_mm)).powf(t1 - t0);
-                let alpha = f64::from(frame.alpha[x + 5 * y]);
+                let alpha = f64::from(frame.alpha(x, y));
                 assert!(
                     (alpha / expected - 1.0).abs() < 0.01,
                     "step {step_vox}: {alpha} vs {expected}"
                 );
             }
         }
-        images.push(frame.alpha);
+        images.push(
+            frame
+                .color
+                .iter()
+                .map(Premultiplied::alpha)
+                .collect::<Vec<_>>(),
+        );
     }
     for image in &images[1..] {
         for (a, b) in image.iter().zip(&images[0]) {
@@ -188,7 +195,7 @@ fn dvr_of_a_homogeneous_slab_follows_beer_lambert_at_any_step() {
 
 /// The colon phantom and a camera on its centreline at arc-length fraction `at`, looking along
 /// it.
-pub(super) fn colon_view(size: usize, at: f64, image: usize) -> (Renderer, Camera) {
+pub(super) fn colon_view(size: usize, at: f64, image: usize) -> (Arc<Renderer>, Camera) {
     let (volume, colon) = phantom::colon(&options(size));
     let s = colon.centreline.length_vox() * at;
     let eye = colon.centreline.point_at(s);
@@ -202,7 +209,7 @@ pub(super) fn colon_view(size: usize, at: f64, image: usize) -> (Renderer, Camer
         [image, image],
     )
     .unwrap();
-    (Renderer::new(volume), camera)
+    (Arc::new(Renderer::new(volume)), camera)
 }
 
 /// Asserts two lists are equal, naming the first differing element (not printing megabytes).
@@ -214,9 +221,19 @@ fn assert_same<T: PartialEq + std::fmt::Debug>(a: &[T], b: &[T], what: &str) {
 }
 
 pub(super) fn assert_same_image(a: &Frame, b: &Frame, what: &str) {
-    assert_same(&a.rgb, &b.rgb, &format!("{what}: colours"));
-    assert_same(&a.alpha, &b.alpha, &format!("{what}: opacities"));
+    let bits = |v: &[Premultiplied]| {
+        let bits = |c: &Premultiplied| c.rgb.map(f32::to_bits).to_vec();
+        v.iter()
+            .map(|c| (bits(c), c.transmittance.to_bits()))
+            .collect::<Vec<_>>()
+    };
+    assert_same(
+        &bits(&a.color),
+        &bits(&b.color),
+        &format!("{what}: colours"),
+    );
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(a.layers(), b.layers(), "{what}: layers");
     assert_same(
         &bits(&a.depth_mm),
         &bits(&b.depth_mm),
@@ -257,7 +274,7 @@ fn skipping_gives_the_same_image_with_several_times_fewer_samples() {
 #[test]
 fn grouped_rays_give_the_one_ray_pixels() {
     let (renderer, inside) = colon_view(120, 0.45, 40);
-    let bricked = Renderer::for_many_frames(renderer.volume().clone());
+    let bricked = Arc::new(Renderer::for_many_frames(renderer.volume().clone()));
     let g = renderer.volume().geometry();
     let outside = Camera::look_at(
         g.world_of(DVec3::new(-40.0, 50.0, 70.0)),
@@ -297,8 +314,8 @@ fn grouped_rays_give_the_one_ray_pixels() {
                 let what =
                     format!("{mode:?} {crossing:?} jitter {jitter} skip {skip_empty} ({x}, {y})");
                 let i = x + w * y;
-                assert_eq!(trace.rgb[..], frame.rgb[3 * i..3 * i + 3], "{what}");
-                assert_eq!(trace.alpha, frame.alpha[i], "{what}");
+                assert_eq!(trace.rgb, frame.pixel(x, y, s.background), "{what}");
+                assert_eq!(trace.alpha, frame.color[i].alpha(), "{what}");
                 let depth = frame.depth_mm[i];
                 assert_eq!(trace.depth_mm.to_bits(), depth.to_bits(), "{what}");
                 hits += usize::from(depth.is_finite());
@@ -318,7 +335,7 @@ fn grouped_rays_give_the_one_ray_pixels() {
 #[test]
 fn scalar_paths_give_the_simd_images() {
     let (renderer, camera) = colon_view(100, 0.6, 40);
-    let scalar = Renderer::new(renderer.volume().clone()).without_simd();
+    let scalar = Arc::new(Renderer::new(renderer.volume().clone()).without_simd());
     for mode in [
         Mode::Iso,
         Mode::Hybrid,
@@ -343,7 +360,7 @@ fn scalar_paths_give_the_simd_images() {
 #[test]
 fn bricked_voxels_give_the_same_image() {
     let (renderer, camera) = colon_view(100, 0.6, 40);
-    let bricked = Renderer::for_many_frames(renderer.volume().clone());
+    let bricked = Arc::new(Renderer::for_many_frames(renderer.volume().clone()));
     for mode in [Mode::Iso, Mode::Hybrid, Mode::Dvr, Mode::TwoIso, Mode::Mip] {
         let s = RenderSettings {
             mode,
@@ -361,7 +378,7 @@ fn bricked_voxels_give_the_same_image() {
 #[test]
 fn skipping_takes_several_times_fewer_samples_inside_a_cavity() {
     let (volume, shell) = phantom::sphere_shell(&options(128));
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let camera = camera_at(
         renderer.volume(),
         shell.centre_vox + DVec3::new(6.0, -4.0, 3.0),
@@ -410,9 +427,8 @@ fn hybrid_at_full_opacity_is_iso_and_at_zero_is_dvr_from_the_hit() {
     };
     let a = renderer.prepare(&hybrid_zero).unwrap().render(&camera);
     let b = renderer.prepare(&dvr).unwrap().render(&camera);
-    assert_same(&a.rgb, &b.rgb, "hybrid 0 % vs dvr: colours");
-    assert_same(&a.alpha, &b.alpha, "hybrid 0 % vs dvr: opacities");
-    assert!(a.alpha.iter().filter(|&&x| x > 0.5).count() > 32 * 32 / 2);
+    assert_same(&a.color, &b.color, "hybrid 0 % vs dvr: colours");
+    assert!(a.color.iter().filter(|c| c.alpha() > 0.5).count() > 32 * 32 / 2);
 }
 
 /// Also checks that compositing a batch at a time (the frame) gives exactly what one sample at
@@ -438,8 +454,8 @@ fn early_termination_stops_at_the_first_sample_past_the_threshold() {
                 assert!(before < 0.9);
             }
             let i = x + 12 * y;
-            assert_eq!(trace.alpha, frame.alpha[i]);
-            assert_eq!(trace.rgb[..], frame.rgb[3 * i..3 * i + 3]);
+            assert_eq!(trace.alpha, frame.color[i].alpha());
+            assert_eq!(trace.rgb, frame.pixel(x, y, s.background));
         }
     }
 }
@@ -448,7 +464,7 @@ fn early_termination_stops_at_the_first_sample_past_the_threshold() {
 fn two_iso_shows_the_stent_in_front_of_the_wall() {
     let (volume, vessel) = phantom::vessel(&options(64));
     let middle = vessel.axis.point_at(0.5 * vessel.axis.length_vox());
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let s = RenderSettings::preset("angioscopy").unwrap();
     assert_eq!(s.mode, Mode::TwoIso);
     let prepared = renderer.prepare(&s).unwrap();
@@ -475,7 +491,7 @@ fn two_iso_shows_the_stent_in_front_of_the_wall() {
                     radial < vessel.lumen_radius_vox,
                     "({x}, {y}): strut at {radial}"
                 );
-                stent.push(frame.pixel(x, y));
+                stent.push(frame.pixel(x, y, s.background));
             } else {
                 // The wall, not in front of the lumen's edge (next to a strut or a plaque the
                 // 130 HU surface is pushed into the wall by their boundary ramps).
@@ -484,7 +500,7 @@ fn two_iso_shows_the_stent_in_front_of_the_wall() {
                     radial > r - 0.3 && radial < outer,
                     "({x}, {y}): wall at {radial}"
                 );
-                wall.push(frame.pixel(x, y));
+                wall.push(frame.pixel(x, y, s.background));
             }
         }
     }
@@ -505,7 +521,7 @@ fn two_iso_shows_the_stent_in_front_of_the_wall() {
 fn mip_and_minip_match_a_brute_force_reference() {
     let (volume, vessel) = phantom::vessel(&options(32));
     let centre = vessel.axis.point_at(0.5 * vessel.axis.length_vox());
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let volume = renderer.volume();
     let extent = DVec3::from(volume.dims().map(|n| (n - 1) as f64));
     let camera = camera_at(
@@ -582,7 +598,7 @@ fn the_image_does_not_depend_on_the_thread_count() {
 #[test]
 fn awkward_cameras_give_no_nan_and_no_panic() {
     let (volume, _) = phantom::sphere_shell(&options(33));
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     let v = renderer.volume();
     let cameras = [
         // Exactly on a brick corner, looking along an axis (odd size: the centre ray is exact).
@@ -606,9 +622,9 @@ fn awkward_cameras_give_no_nan_and_no_panic() {
                 let camera = camera.with_near_mm(near).unwrap();
                 let frame = prepared.render(&camera);
                 assert!(frame
-                    .alpha
+                    .color
                     .iter()
-                    .all(|a| a.is_finite() && (0.0..=1.0001).contains(a)));
+                    .all(|c| c.alpha().is_finite() && (0.0..=1.0001).contains(&c.alpha())));
                 assert!(frame.depth_mm.iter().all(|d| d.is_nan() || *d >= 0.0));
             }
         }
@@ -616,7 +632,7 @@ fn awkward_cameras_give_no_nan_and_no_panic() {
     let away = renderer.prepare(&settings(Mode::Dvr)).unwrap();
     let frame = away.render(&cameras[4]);
     assert_eq!(frame.stats.rays, 0);
-    assert!(frame.rgb.iter().all(|&c| c == 0));
+    assert!(frame.to_rgb8([0.0; 3]).iter().all(|&c| c == 0));
 }
 
 #[test]
@@ -642,7 +658,9 @@ fn sheared_anisotropic_grids_shade_and_measure_in_millimetres() {
         }
     }
     let map = ValueMap::new(1.0, -1024.0).unwrap();
-    let renderer = Renderer::new(Volume::new(g, voxels, map, Modality::Ct).unwrap());
+    let renderer = Arc::new(Renderer::new(
+        Volume::new(g, voxels, map, Modality::Ct).unwrap(),
+    ));
     let prepared = renderer.prepare(&settings(Mode::Iso)).unwrap();
     let camera = Camera::look_at(
         centre,
@@ -659,8 +677,9 @@ fn sheared_anisotropic_grids_shade_and_measure_in_millimetres() {
     }
     // A headlight on a sphere seen from its centre: every normal faces the eye, so every pixel
     // is lit fully (ambient + diffuse + specular, clamped).
-    let lit = frame.pixel(8, 8);
-    for p in frame.rgb.chunks(3) {
+    let background = settings(Mode::Iso).background;
+    let lit = frame.pixel(8, 8, background);
+    for p in frame.to_rgb8(background).chunks(3) {
         assert!(
             p.iter().zip(lit).all(|(a, b)| a.abs_diff(b) <= 2),
             "{p:?} vs {lit:?}"
@@ -697,7 +716,7 @@ fn timing_fly_through_the_paper_size_colon() {
     let only = std::env::var("ENDOCAST_TIMING_MODES").unwrap_or_default();
     let (volume, colon) = phantom::colon(&options(size));
     let start = Instant::now();
-    let renderer = Renderer::new(volume);
+    let renderer = Arc::new(Renderer::new(volume));
     println!("brick grid: {:.1} ms", start.elapsed().as_secs_f64() * 1e3);
     let g = *renderer.volume().geometry();
     let line = &colon.centreline;

@@ -122,9 +122,9 @@ impl Image {
         Ok(Self { width, height, rgb })
     }
 
-    /// A copy of a rendered frame's colour.
-    pub fn from_frame(frame: &Frame) -> Result<Self, ViewError> {
-        Self::from_rgb(frame.width, frame.height, frame.rgb.clone())
+    /// A rendered frame's colour over `background` (display values, 0–1).
+    pub fn from_frame(frame: &Frame, background: [f32; 3]) -> Result<Self, ViewError> {
+        Self::from_rgb(frame.width, frame.height, frame.to_rgb8(background))
     }
 
     /// Width in pixels.

@@ -1,0 +1,117 @@
+//! The progressive driver of an interactive view: for one camera and settings it delivers a
+//! quarter-resolution frame, then a half, then the full one, then ever better stills
+//! (averages of jittered frames), and gives up as soon as the view changes.
+//!
+//! The front end bumps a shared *generation* counter whenever the camera or the settings
+//! change; the worker that owns the [`Prepared`] renderer reads the counter together with the
+//! view it renders and passes that value on. After every finished tile the driver compares the
+//! counter with it and, once they differ, sets the render's cancel flag: the tiles not yet
+//! started return at once, so the frame in flight is dropped within about one tile's time.
+//!
+//! ```
+//! use endocast_core::phantom::{self, PhantomOptions};
+//! use endocast_core::render::progressive::{progressive, ProgressiveOptions, Stage};
+//! use endocast_core::render::{Camera, Mode, RenderSettings, Renderer};
+//! use glam::DVec3;
+//! use std::sync::atomic::AtomicU64;
+//! use std::sync::Arc;
+//!
+//! let (volume, shell) = phantom::sphere_shell(&PhantomOptions { size: 32, ..Default::default() });
+//! let centre_mm = volume.geometry().world_of(shell.centre_vox);
+//! let mut settings = RenderSettings::default();
+//! (settings.mode, settings.iso_hu) = (Mode::Iso, -480.0);
+//! let prepared = Arc::new(Renderer::new(volume)).prepare(&settings).unwrap();
+//! let camera = Camera::look_at(centre_mm, centre_mm + DVec3::Z, DVec3::Y, 90.0, [32, 32]).unwrap();
+//! let generation = AtomicU64::new(0);
+//! let mut stages = Vec::new();
+//! let options = ProgressiveOptions { still_frames: 3, ..ProgressiveOptions::default() };
+//! progressive(&prepared, &camera, &generation, 0, &options, |stage, frame| {
+//!     assert_eq!([frame.width, frame.height], [32, 32]);
+//!     stages.push(stage);
+//! })
+//! .unwrap();
+//! assert_eq!(stages.last(), Some(&Stage::Still(3)));
+//! ```
+
+use super::frame::{Frame, Layers};
+use super::options::{Cancelled, Progress, Quality, RenderOptions};
+use super::still::Still;
+use super::{Camera, Prepared};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// A finished level the driver delivers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// A reduced-quality frame, upsampled to the full size.
+    Preview(Quality),
+    /// The full-quality frame, as [`Prepared::render`] makes it.
+    Full,
+    /// The average of this many jittered full-quality frames (2 or more; the first is the full
+    /// frame).
+    Still(usize),
+}
+
+/// What the driver renders.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProgressiveOptions {
+    /// The reduced levels before the full frame, in order (default quarter, then half).
+    pub previews: Vec<Quality>,
+    /// Frames averaged into the last still, the full frame included (default 8; 1 or 0: no
+    /// still after the full frame).
+    pub still_frames: usize,
+    /// Optional layers of every frame (default none; a still's are its full frame's).
+    pub layers: Layers,
+}
+
+impl Default for ProgressiveOptions {
+    fn default() -> Self {
+        Self {
+            previews: vec![Quality::Quarter, Quality::Half],
+            still_frames: 8,
+            layers: Layers::NONE,
+        }
+    }
+}
+
+/// Renders `camera`'s view with `prepared` level by level — the previews, the full frame, then
+/// stills of 2, 3, … `still_frames` frames — handing each finished one to `deliver`, as long as
+/// `generation` still holds `seen` (the value read with the view). Returns [`Cancelled`] as soon
+/// as it changes: before a level starts, or through the cancel flag of the level in flight.
+pub fn progressive(
+    prepared: &Prepared,
+    camera: &Camera,
+    generation: &AtomicU64,
+    seen: u64,
+    options: &ProgressiveOptions,
+    mut deliver: impl FnMut(Stage, &Frame),
+) -> Result<(), Cancelled> {
+    let cancel = AtomicBool::new(false);
+    let changed = || generation.load(Ordering::Acquire) != seen;
+    let watch = |_: Progress| {
+        if changed() {
+            cancel.store(true, Ordering::Relaxed);
+        }
+    };
+    let base = RenderOptions::new()
+        .layers(options.layers)
+        .cancel(&cancel)
+        .progress(&watch);
+    let check = || if changed() { Err(Cancelled) } else { Ok(()) };
+    let mut frame = Frame::default();
+    for &quality in &options.previews {
+        check()?;
+        prepared.render_with(camera, &base.quality(quality), &mut frame)?;
+        deliver(Stage::Preview(quality), &frame);
+    }
+    check()?;
+    prepared.render_with(camera, &base, &mut frame)?;
+    deliver(Stage::Full, &frame);
+    let mut still = Still::new();
+    still.add(&frame);
+    while still.frames() < options.still_frames {
+        check()?;
+        still.render_next(prepared, camera, &base)?;
+        deliver(Stage::Still(still.frames()), still.frame());
+    }
+    Ok(())
+}
