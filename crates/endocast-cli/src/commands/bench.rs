@@ -12,7 +12,7 @@ use endocast_core::camera::StereoRig;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::{
-    Camera, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, Renderer,
+    Camera, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, Renderer, StereoFrames,
 };
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::OpenOptions;
@@ -148,7 +148,7 @@ fn measure(
         .stereo
         .stereo
         .map(|_| (Measured::default(), Vec::new()));
-    let mut frames = [Frame::default(), Frame::default()];
+    let mut pair_frames = StereoFrames::default();
     for camera in cameras {
         // Nothing cancels it.
         let _ = prepared.render_with(camera, options, &mut frame);
@@ -165,12 +165,13 @@ fn measure(
             Err(error) => return (Err(error).context("invalid --stereo options"), None),
         };
         let start = Instant::now();
-        if let Err(error) = prepared.render_stereo_into(camera, &rig, &mut frames) {
+        if let Err(error) = prepared.render_stereo_into(camera, &rig, &mut pair_frames) {
             return (Err(error).context("invalid stereo camera"), None);
         }
         let pair_ms = start.elapsed().as_secs_f64() * 1e3;
         pair.ms.push(pair_ms);
-        pair.samples += frames[0].stats.samples + frames[1].stats.samples;
+        let [left, right] = &pair_frames.eyes;
+        pair.samples += left.stats.samples + right.stats.samples;
         ratios.push(pair_ms / one_ms);
     }
     (Ok(mono), pair)

@@ -5,7 +5,7 @@ use super::overview::Overview;
 use super::Shot;
 use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
-use crate::render::{Camera, Frame, Prepared, RenderSettings, RenderStats, Renderer};
+use crate::render::{Camera, Prepared, RenderSettings, RenderStats, Renderer, StereoFrames};
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
 use crate::views::stereo::{self, StereoOutput};
@@ -73,7 +73,7 @@ pub struct Flight {
     prepared: Option<Prepared>,
     /// The frames rendered into (the second for a stereo pair's right eye), their buffers
     /// reused from shot to shot.
-    frames: [Frame; 2],
+    frames: StereoFrames,
 }
 
 impl Flight {
@@ -86,7 +86,7 @@ impl Flight {
             dashboard: None,
             coverage: None,
             prepared: None,
-            frames: [Frame::default(), Frame::default()],
+            frames: StereoFrames::default(),
         }
     }
 
@@ -141,7 +141,7 @@ impl Flight {
         let (camera, eyes, stats) = self.render_shot(shot, settings)?;
         let endoscope = match (self.options.stereo, eyes) {
             (Some(stereo), Some([left, right])) => stereo::combine(&left, &right, stereo.output)?,
-            _ => Image::from_frame(&self.frames[0], settings.background)?,
+            _ => Image::from_frame(&self.frames.eyes[0], settings.background)?,
         };
         let image = match self.options.layout {
             Layout::Endoscope => endoscope,
@@ -161,7 +161,7 @@ impl Flight {
         let eyes = match eyes {
             Some(eyes) => eyes,
             None => {
-                let view = Image::from_frame(&self.frames[0], settings.background)?;
+                let view = Image::from_frame(&self.frames.eyes[0], settings.background)?;
                 [view.clone(), view]
             }
         };
@@ -185,7 +185,7 @@ impl Flight {
         let prepared = prepared(&mut self.prepared, &self.renderer, settings)?;
         let (seen_by, eyes) = match self.options.stereo {
             None => {
-                prepared.render_into(&camera, &mut self.frames[0]);
+                prepared.render_into(&camera, &mut self.frames.eyes[0]);
                 (camera, None)
             }
             Some(stereo) => {
@@ -193,7 +193,7 @@ impl Flight {
                     prepared.nearest_surface_mm(&camera)
                 })?;
                 prepared.render_stereo_into(&camera, &rig, &mut self.frames)?;
-                let [left, right] = &self.frames;
+                let [left, right] = &self.frames.eyes;
                 let background = settings.background;
                 let eyes = [
                     Image::from_frame(left, background)?,
@@ -202,12 +202,12 @@ impl Flight {
                 (rig.eyes(&camera)?[0], Some(eyes))
             }
         };
-        let mut stats = self.frames[0].stats;
+        let mut stats = self.frames.eyes[0].stats;
         if eyes.is_some() {
-            stats.add(&self.frames[1].stats);
+            stats.add(&self.frames.eyes[1].stats);
         }
         if let Some(coverage) = &mut self.coverage {
-            coverage.record(&seen_by, &self.frames[0])?;
+            coverage.record(&seen_by, &self.frames.eyes[0])?;
         }
         Ok((camera, eyes, stats))
     }

@@ -80,6 +80,7 @@ pub use options::{Cancelled, Progress, Quality, RenderOptions};
 pub use progressive::progressive;
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
 pub use settings::{Crossing, Mode, RenderSettings, SettingsError};
+pub use stereo::StereoFrames;
 pub use still::{Jitter, Still};
 pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
@@ -613,23 +614,19 @@ impl Prepared {
             let dims = self.renderer.volume.dims();
             let bricks = self.renderer.grid.bricks();
             let setup = RaySetup::new(camera, &self.voxel_from_world, dims, bricks);
+            let starts = late.map(|(_, starts)| starts);
             for x0 in xs.clone().step_by(4) {
+                let late_starts = starts.map(|s| s.lanes(x0, y, self.step_mm as f32));
                 // SAFETY: the CPU has AVX2 (checked above).
-                let lanes = unsafe { setup.rays4(x0, y) };
+                let lanes = unsafe { setup.rays4(x0, y, late_starts.as_ref()) };
                 for (x, lane) in (x0..xs.end).zip(lanes) {
                     let Some(lane) = lane else { continue };
                     let (step, offset) = (self.step_mm as f32, self.offset(x, y));
                     let mut march =
                         RayMarch::with_walk(lane.dda, &lane.ray, lane.range, step, offset);
-                    if let Some((integrator, starts)) = late {
-                        self.start_late(
-                            integrator,
-                            starts,
-                            [x, y],
-                            &lane.ray,
-                            lane.range,
-                            &mut march,
-                        );
+                    if let (Some((integrator, starts)), false) = (late, lane.late) {
+                        let (ray, range) = (&lane.ray, lane.range);
+                        self.start_late(integrator, starts, [x, y], ray, range, &mut march);
                     }
                     columns.push(x);
                     tasks.push(RayTask::new(march, lane.dir_world.as_vec3()));

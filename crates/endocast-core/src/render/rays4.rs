@@ -43,6 +43,22 @@ pub(crate) struct LaneRay {
     pub dir_world: DVec3,
     pub range: (f64, f64),
     pub dda: BrickDda,
+    /// Whether the walk starts at a late start (see [`LateStarts`]) rather than at `range.0`.
+    pub late: bool,
+}
+
+/// Late starts of four lanes' brick walks (a stereo pair's second eye, see `render::stereo`):
+/// per lane the start (mm; NaN for none) and the distance up to which samples must lie in the
+/// eye's clear ball for the start to hold without a check. Lanes whose check reaches beyond the
+/// ball keep their walk from `range.0` (the caller checks them one by one).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LateStarts {
+    pub check: [f32; 4],
+    pub start: [f32; 4],
+    /// Radius of the ball around the eye that holds no iso-active brick, voxels.
+    pub clear: f32,
+    /// Sample step, mm (the sample after `check` must lie in the ball too).
+    pub step: f32,
 }
 
 /// Four lanes' rays before clipping: voxel-space origins and directions, unit world directions,
@@ -83,12 +99,12 @@ impl RaySetup {
     /// The rays of pixels `x0 .. x0 + 4` of row `y` (`None` where a ray misses the volume or
     /// the camera forms none; lanes past the image's right edge are computed all the same).
     #[target_feature(enable = "avx2")]
-    pub fn rays4(&self, x0: usize, y: usize) -> [Option<LaneRay>; 4] {
+    pub fn rays4(&self, x0: usize, y: usize, late: Option<&LateStarts>) -> [Option<LaneRay>; 4] {
         let lanes = match &self.pinhole {
             Some(pinhole) => self.pinhole4(pinhole, x0, y),
             None => self.camera4(x0, y),
         };
-        self.finish(&lanes)
+        self.finish(&lanes, late)
     }
 
     /// A pinhole's four rays, operation for operation as `Camera::ray` and `VoxelRay::new`.
@@ -184,9 +200,14 @@ impl RaySetup {
 
     /// Clips the lanes' rays to the volume and starts their brick walks.
     #[target_feature(enable = "avx2")]
-    fn finish(&self, lanes: &Lanes4) -> [Option<LaneRay>; 4] {
+    fn finish(&self, lanes: &Lanes4, late: Option<&LateStarts>) -> [Option<LaneRay>; 4] {
         let (t0, t1, inside) = self.clip(lanes.origin, lanes.dir_vox, lanes.t_min);
-        let walk = self.walk_start(lanes.origin, lanes.dir_vox, t0);
+        let (t_walk, started) = match late {
+            Some(late) => late_walks(late, lanes.dir_vox, t0, t1),
+            None => (t0, [false; 4]),
+        };
+        let walk = self.walk_start(lanes.origin, lanes.dir_vox, t_walk);
+        let t_walk = doubles(t_walk);
         let (origin, dir, dir_vox, t0, t1, inside) = (
             lanes.origin.map(|v| doubles(v)),
             lanes.dir_world.map(|v| doubles(v)),
@@ -203,7 +224,8 @@ impl RaySetup {
                 },
                 dir_world: DVec3::new(dir[0][k], dir[1][k], dir[2][k]),
                 range: (t0[k], t1[k]),
-                dda: walk.lane(k, (t0[k], t1[k]), self.bricks),
+                dda: walk.lane(k, (t_walk[k], t1[k]), self.bricks),
+                late: started[k],
             })
         })
     }
@@ -310,6 +332,30 @@ impl RaySetup {
         }
         start
     }
+}
+
+/// Each lane's walk start: its late start where that lies past `t0` and the samples up to the
+/// check lie in the clear ball around the eye (every lane's origin), else `t0`.
+#[target_feature(enable = "avx2")]
+fn late_walks(
+    late: &LateStarts,
+    dir_vox: [__m256d; 3],
+    t0: __m256d,
+    t1: __m256d,
+) -> (__m256d, [bool; 4]) {
+    let (t0, t1, d) = (doubles(t0), doubles(t1), dir_vox.map(|v| doubles(v)));
+    let mut walk = t0;
+    let mut started = [false; 4];
+    for k in 0..4 {
+        let (check, start) = (f64::from(late.check[k]), f64::from(late.start[k]));
+        let voxels_per_mm = (d[0][k] * d[0][k] + d[1][k] * d[1][k] + d[2][k] * d[2][k]).sqrt();
+        let reach = voxels_per_mm * (check + f64::from(late.step));
+        // A hair inside the ball: the samples are taken in f32.
+        if start > t0[k] && reach < 0.999 * f64::from(late.clear) {
+            (walk[k], started[k]) = (start.min(t1[k]), true);
+        }
+    }
+    (_mm256_setr_pd(walk[0], walk[1], walk[2], walk[3]), started)
 }
 
 /// The per-lane start of the brick walks.

@@ -24,6 +24,8 @@
 //! of the isovalue, or a mode that composites in front of the surface (DVR, two-iso, MIP) —
 //! the eyes share only the prepared state.
 
+#[cfg(target_arch = "x86_64")]
+use super::rays4::LateStarts;
 use super::{Frame, Mode, Prepared, RenderOptions, BRICK_VOX};
 
 /// How many bricks around the eye [`Prepared::clear_radius_vox`] looks at.
@@ -31,6 +33,15 @@ const CLEAR_BRICKS: usize = 3;
 use crate::camera::{Camera, CameraError, Projection, StereoRig};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+
+/// A stereo pair's two frames, and the buffers the second eye's start-up reuses from pair to
+/// pair (fresh buffers cost page faults every frame).
+#[derive(Debug, Clone, Default)]
+pub struct StereoFrames {
+    /// The left and the right eye's frames.
+    pub eyes: [Frame; 2],
+    starts: SearchStarts,
+}
 
 /// Where each pixel's isosurface search of the second eye may start (see the module doc).
 #[derive(Debug, Clone, Default)]
@@ -42,9 +53,32 @@ pub(crate) struct SearchStarts {
     /// Per pixel: the distance along the ray (mm) up to which samples must be checked one by
     /// one, and the distance from which the search may start; NaN where it starts at the eye.
     starts: Vec<[f32; 2]>,
+    /// Working buffers: the left eye's depths along its view axis, and their three-row minima.
+    depths: Vec<f64>,
+    minima: Vec<f64>,
 }
 
 impl SearchStarts {
+    /// The late starts of pixels `x0 .. x0 + 4` of row `y` for the four-ray set-up, with the
+    /// sample step `step` (mm); columns past the image have none.
+    #[cfg(target_arch = "x86_64")]
+    pub fn lanes(&self, x0: usize, y: usize, step: f32) -> LateStarts {
+        let (mut check, mut start) = ([f32::NAN; 4], [f32::NAN; 4]);
+        for k in 0..4 {
+            if let Some(&[c, s]) = self.starts.get(x0 + k + self.width * y) {
+                if x0 + k < self.width {
+                    (check[k], start[k]) = (c, s);
+                }
+            }
+        }
+        LateStarts {
+            check,
+            start,
+            clear: self.clear.1,
+            step,
+        }
+    }
+
     /// The check distance and the start of pixel `(x, y)`, if it has a start past the eye.
     #[inline]
     pub fn at(&self, x: usize, y: usize) -> Option<(f32, f32)> {
@@ -54,40 +88,40 @@ impl SearchStarts {
 }
 
 impl Prepared {
-    /// Renders the left and right eyes of `camera` under `rig` into `frames` (their buffers
-    /// reused), the right eye's searches starting past the space the left eye showed empty
-    /// where that is exact (see the module doc). The images are those of two independent
-    /// renders of [`StereoRig::eyes`].
+    /// Renders the left and right eyes of `camera` under `rig` into `pair` (its frames and
+    /// working buffers reused), the right eye's searches starting past the space the left eye
+    /// showed empty where that is exact (see the module doc). The images are those of two
+    /// independent renders of [`StereoRig::eyes`].
     pub fn render_stereo_into(
         &self,
         camera: &Camera,
         rig: &StereoRig,
-        frames: &mut [Frame; 2],
+        pair: &mut StereoFrames,
     ) -> Result<(), CameraError> {
         let [left, right] = rig.eyes(camera)?;
-        let [left_frame, right_frame] = frames;
+        let [left_frame, right_frame] = &mut pair.eyes;
         self.render_into(&left, left_frame);
-        match self.shares_emptiness(&left, &right) {
-            true => {
-                let starts = self.search_starts(&left, &right, rig, left_frame);
-                let options = RenderOptions::new().search_starts(&starts);
-                // Without a cancel flag nothing can cancel it.
-                let _ = self.render_with(&right, &options, right_frame);
-            }
-            false => self.render_into(&right, right_frame),
+        if self.shares_emptiness(&left, &right) {
+            let starts = &mut pair.starts;
+            self.search_starts(&left, &right, rig, left_frame, starts);
+            let options = RenderOptions::new().search_starts(starts);
+            // Without a cancel flag nothing can cancel it.
+            let _ = self.render_with(&right, &options, right_frame);
+        } else {
+            self.render_into(&right, right_frame);
         }
         Ok(())
     }
 
-    /// [`Self::render_stereo_into`] into new frames.
+    /// [`Self::render_stereo_into`] into new frames: the left and the right eye's.
     pub fn render_stereo(
         &self,
         camera: &Camera,
         rig: &StereoRig,
     ) -> Result<[Frame; 2], CameraError> {
-        let mut frames = [Frame::default(), Frame::default()];
-        self.render_stereo_into(camera, rig, &mut frames)?;
-        Ok(frames)
+        let mut pair = StereoFrames::default();
+        self.render_stereo_into(camera, rig, &mut pair)?;
+        Ok(pair.eyes)
     }
 
     /// The distance along the view axis (mm) of the nearest surface `camera` sees — the 5th
@@ -174,20 +208,23 @@ impl Prepared {
         right: &Camera,
         rig: &StereoRig,
         left_frame: &Frame,
-    ) -> SearchStarts {
+        out: &mut SearchStarts,
+    ) {
         let [w, h] = right.size();
         let tan_half = (right.fov_deg().to_radians() / 2.0).tan();
         let k = rig.eye_separation_mm / tan_half * h as f64 / 2.0;
         let spacing = self.renderer.volume.geometry().spacing_mm().max_element();
         let margin = 0.5 * spacing + 2.0 * self.step_mm;
-        let forward_depth = pinhole_forward_depths(left, left_frame);
-        let column_min = column_minima(&forward_depth, [w, h]);
+        pinhole_forward_depths(left, left_frame, &mut out.depths);
+        column_minima(&out.depths, [w, h], &mut out.minima);
         let cosines = PinholeCosines::of(right);
-        let mut starts = vec![[f32::NAN; 2]; w * h];
-        starts.par_chunks_mut(w).enumerate().for_each_init(
+        out.starts.clear();
+        out.starts.resize(w * h, [f32::NAN; 2]);
+        let minima = &out.minima;
+        out.starts.par_chunks_mut(w).enumerate().for_each_init(
             || RowBounds::with_width(w),
             |bounds, (y, row)| {
-                bounds.fill(&column_min[y * w..][..w], k, margin);
+                bounds.fill(&minima[y * w..][..w], k, margin);
                 let mut walker = bounds.walker();
                 for (x, start) in row.iter_mut().enumerate() {
                     let q = x as f64 + 0.5 - k / rig.focus_mm;
@@ -204,12 +241,8 @@ impl Prepared {
         );
         let eye = right.shared_origin().unwrap_or_else(|| right.eye_mm());
         let eye = self.voxel_from_world.transform_point3(eye).as_vec3();
-        let clear = (eye, self.clear_radius_vox(eye));
-        SearchStarts {
-            clear,
-            width: w,
-            starts,
-        }
+        out.clear = (eye, self.clear_radius_vox(eye));
+        out.width = w;
     }
 }
 
@@ -240,19 +273,23 @@ impl PinholeCosines {
     }
 }
 
-/// A pinhole's hit depths along its view axis (mm); `+∞` where a ray hit nothing.
-fn pinhole_forward_depths(camera: &Camera, frame: &Frame) -> Vec<f64> {
+/// A pinhole's hit depths along its view axis (mm) into `out`; `+∞` where a ray hit nothing.
+fn pinhole_forward_depths(camera: &Camera, frame: &Frame, out: &mut Vec<f64>) {
     let [w, _] = camera.size();
     let cosines = PinholeCosines::of(camera);
-    frame
-        .depth_mm
-        .par_iter()
+    out.clear();
+    out.resize(frame.depth_mm.len(), 0.0);
+    out.par_chunks_mut(w)
+        .zip(frame.depth_mm.par_chunks(w))
         .enumerate()
-        .map(|(i, &d)| match d.is_finite() {
-            true => f64::from(d) * cosines.at(i % w, i / w),
-            false => f64::INFINITY,
-        })
-        .collect()
+        .for_each(|(y, (row, depths))| {
+            for (x, (z, &d)) in row.iter_mut().zip(depths).enumerate() {
+                *z = match d.is_finite() {
+                    true => f64::from(d) * cosines.at(x, y),
+                    false => f64::INFINITY,
+                };
+            }
+        });
 }
 
 /// Any camera's hit depths along its view axis (mm); `+∞` where a ray hit nothing.
@@ -269,9 +306,11 @@ fn forward_depths(camera: &Camera, frame: &Frame) -> Vec<f64> {
         .collect()
 }
 
-/// Per pixel, the smallest forward depth of its column of three rows (`y − 1 ..= y + 1`).
-fn column_minima(depths: &[f64], [w, h]: [usize; 2]) -> Vec<f64> {
-    let mut out = vec![f64::INFINITY; w * h];
+/// Per pixel, the smallest forward depth of its column of three rows (`y − 1 ..= y + 1`), into
+/// `out`.
+fn column_minima(depths: &[f64], [w, h]: [usize; 2], out: &mut Vec<f64>) {
+    out.clear();
+    out.resize(w * h, f64::INFINITY);
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for r in y.saturating_sub(1)..=(y + 1).min(h - 1) {
             for (m, d) in row.iter_mut().zip(&depths[r * w..][..w]) {
@@ -279,7 +318,6 @@ fn column_minima(depths: &[f64], [w, h]: [usize; 2]) -> Vec<f64> {
             }
         }
     });
-    out
 }
 
 /// One row of the left image as the right rays of that row see it (buffers reused from row to
