@@ -5,9 +5,9 @@
 //! done for eight rays by each instruction instead of one.
 //!
 //! A lane takes exactly the samples the one-ray walk
-//! ([`crate::render::march::Walk::SEARCH`]) takes: in each active brick, from the last sample before it to the first at or after its end
-//! (skipping those already taken), and tests each sample against the one before it on the grid
-//! when that one was taken. Its first crossing, values and all, is the one-ray search's, and
+//! ([`crate::render::march::Walk::SEARCH`]) takes: in each active brick, from the last sample
+//! before it to the first at or after its end (skipping those already taken), and tests each
+//! sample against the one before it on the grid when that one was taken. Its first crossing, values and all, is the one-ray search's, and
 //! the march is left where that search would leave it for what follows (the volume behind the
 //! surface): at the sample after the crossing, the brick it was found in pending.
 
@@ -33,8 +33,8 @@ type Mask = __m256i;
 
 /// The first crossings of `iso` of up to eight rays whose marches have not been walked yet, as
 /// [`crate::render::integrate::Integrator::search`] finds them one ray at a time.
-/// `directions[k]` says whether ray `k`'s crossing is rising, `active` holds the isovalue's brick bits (`None`: every
-/// brick is searched). Each march is left as that search leaves it.
+/// `directions[k]` says whether ray `k`'s crossing is rising, `active` holds the isovalue's
+/// brick bits (`None`: every brick is searched). Each march is left as that search leaves it.
 #[target_feature(enable = "avx2")]
 pub(super) fn search8(
     sampler: &Sampler<'_>,
