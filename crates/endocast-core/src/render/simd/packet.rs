@@ -7,9 +7,10 @@
 //! A lane takes exactly the samples the one-ray walk
 //! ([`crate::render::march::Walk::SEARCH`]) takes: in each active brick, from the last sample
 //! before it to the first at or after its end (skipping those already taken), and tests each
-//! sample against the one before it on the grid when that one was taken. Its first crossing, values and all, is the one-ray search's, and
-//! the march is left where that search would leave it for what follows (the volume behind the
-//! surface): at the sample after the crossing, the brick it was found in pending.
+//! sample against the one before it on the grid when that one was taken. Its first crossing,
+//! values and all, is the one-ray search's, and the march is left where that search would leave
+//! it for what follows (the volume behind the surface): at the sample after the crossing, the
+//! brick it was found in pending.
 
 use super::sample::trilinear;
 use crate::render::crossing::Bracket;
