@@ -449,7 +449,7 @@ impl Camera {
         let eye = self.eye_origin();
         match self.projection {
             Projection::Pinhole => {
-                // Operation for operation as the four-ray set-up (render/rays4.rs).
+                // Operation for operation as the four-ray set-up (render/simd/rays4.rs).
                 let mut sx = a * self.half * w / h;
                 let mut sy = b * self.half;
                 if s != 1.0 {

@@ -3,7 +3,8 @@
 //! per batch of samples (§3.3 of the paper: four steps, then the hit interpolated inside).
 
 use super::march::Batch;
-use super::sample::{Lanes, SampleGrid, Sampler};
+use super::sample::{SampleGrid, Sampler};
+use super::simd::sse::sides;
 
 /// Bisection steps per round of samples: the seven midpoints of three steps fill one batch (a
 /// fourth step is one more sample; fifteen midpoints in two batches measured slower).
@@ -95,41 +96,6 @@ pub(crate) fn first_crossing(
     (mask != 0).then(|| mask.trailing_zeros() as usize)
 }
 
-/// The lanes of `values` below `iso` and at or above it, as bit masks (lane k, bit k; ordered
-/// comparisons, so a NaN is in neither).
-#[inline(always)]
-fn sides(values: &Lanes, iso: f32) -> (u32, u32) {
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    // SAFETY: SSE is part of the x86-64 baseline every build targets.
-    unsafe {
-        use std::arch::x86_64::{
-            __m128, _mm_cmpge_ps, _mm_cmplt_ps, _mm_movemask_ps, _mm_set1_ps, _mm_setr_ps,
-        };
-        let v = values;
-        let (low, high) = (
-            _mm_setr_ps(v[0], v[1], v[2], v[3]),
-            _mm_setr_ps(v[4], v[5], v[6], v[7]),
-        );
-        let iso = _mm_set1_ps(iso);
-        let bits =
-            |low: __m128, high: __m128| (_mm_movemask_ps(low) | _mm_movemask_ps(high) << 4) as u32;
-        (
-            bits(_mm_cmplt_ps(low, iso), _mm_cmplt_ps(high, iso)),
-            bits(_mm_cmpge_ps(low, iso), _mm_cmpge_ps(high, iso)),
-        )
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let (mut below, mut above) = (0u32, 0u32);
-        for (k, &v) in values.iter().enumerate() {
-            below |= u32::from(v < iso) << k;
-            above |= u32::from(v >= iso) << k;
-        }
-        (below, above)
-    }
-}
-
 /// Whether the value goes from `before` to `after` across `iso` in the given direction.
 #[inline]
 pub(crate) fn crosses(before: f32, after: f32, iso: f32, rising: bool) -> bool {
@@ -144,6 +110,7 @@ pub(crate) fn crosses(before: f32, after: f32, iso: f32, rising: bool) -> bool {
 mod tests {
     use super::*;
     use crate::phantom::{self, PhantomOptions};
+    use crate::render::Lanes;
     use glam::Vec3;
 
     /// Step-by-step bisection, the reference the batched tree must equal.

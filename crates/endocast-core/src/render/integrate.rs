@@ -7,8 +7,6 @@
 use super::bricks::{Activity, BrickGrid};
 use super::crossing::{bisect, crosses, first_crossing, Bracket, BISECTION_LEVELS};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
-#[cfg(target_arch = "x86_64")]
-use super::packet;
 use super::ray_task::{PixelOut, RayTask};
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
@@ -128,20 +126,18 @@ impl Integrator<'_> {
         }
     }
 
-    /// [`Self::search`] for each ray of a group, eight at once on AVX2 ([`packet::search8`]).
-    #[allow(unsafe_code)]
+    /// [`Self::search`] for each ray of a group, eight at once on AVX2
+    /// ([`super::simd::Avx2::search8`]).
     fn search_group(&self, tasks: &mut [RayTask], iso: f32) {
         #[cfg(target_arch = "x86_64")]
-        if self.sampler.avx2() {
+        if let Some(avx2) = self.sampler.avx2() {
             let active = self.params.skip_empty.then(|| self.activity.iso.words());
             for chunk in tasks.chunks_mut(8) {
                 let mut rising = [false; 8];
                 for (r, task) in rising.iter_mut().zip(chunk.iter()) {
                     *r = self.rising(&task.march, iso);
                 }
-                // SAFETY: the sampler runs AVX2 batches only where the CPU has AVX2.
-                let brackets =
-                    unsafe { packet::search8(&self.sampler, active, iso, chunk, rising) };
+                let brackets = avx2.search8(&self.sampler, active, iso, chunk, rising);
                 for (task, bracket) in chunk.iter_mut().zip(brackets) {
                     task.bracket = bracket;
                 }
@@ -351,15 +347,13 @@ impl Integrator<'_> {
     }
 
     /// Every bisection step of each bracketed ray of a group: on AVX2 all steps of eight rays
-    /// in registers ([`packet::refine8`]), else a step at a time across eight rays.
-    #[allow(unsafe_code)]
+    /// in registers ([`super::simd::Avx2::refine8`]), else a step at a time across eight rays.
     fn bisect_group(&self, tasks: &mut [RayTask], iso: f32) {
         let steps = self.params.refine_steps;
         #[cfg(target_arch = "x86_64")]
-        if self.sampler.avx2() {
+        if let Some(avx2) = self.sampler.avx2() {
             for chunk in tasks.chunks_mut(8) {
-                // SAFETY: the sampler runs AVX2 batches only where the CPU has AVX2.
-                unsafe { packet::refine8(&self.sampler, iso, chunk, steps) };
+                avx2.refine8(&self.sampler, iso, chunk, steps);
             }
             return;
         }

@@ -49,15 +49,12 @@ mod frame;
 mod integrate;
 mod march;
 mod options;
-#[cfg(target_arch = "x86_64")]
-mod packet;
 pub mod progressive;
 pub mod quality;
 mod ray_task;
-#[cfg(target_arch = "x86_64")]
-mod rays4;
 mod sample;
 mod settings;
+mod simd;
 mod stereo;
 mod still;
 mod tiles;
@@ -90,7 +87,7 @@ use integrate::{Integrator, Params, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
 #[cfg(target_arch = "x86_64")]
-use rays4::RaySetup;
+use simd::rays4::RaySetup;
 use std::sync::Arc;
 use std::time::Instant;
 use stereo::SearchStarts;
@@ -599,7 +596,6 @@ impl Prepared {
 
     /// The rays of pixels `xs` of row `y` that meet the volume, and their columns: four at a
     /// time on AVX2 ([`RaySetup::rays4`], the same rays bit for bit), else one by one.
-    #[allow(unsafe_code)]
     fn row_tasks(
         &self,
         camera: &Camera,
@@ -610,15 +606,14 @@ impl Prepared {
         tasks: &mut Vec<RayTask>,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
+        if let Some(avx2) = simd::Avx2::detect() {
             let dims = self.renderer.volume.dims();
             let bricks = self.renderer.grid.bricks();
             let setup = RaySetup::new(camera, &self.voxel_from_world, dims, bricks);
             let starts = late.map(|(_, starts)| starts);
             for x0 in xs.clone().step_by(4) {
                 let late_starts = starts.map(|s| s.lanes(x0, y, self.step_mm as f32));
-                // SAFETY: the CPU has AVX2 (checked above).
-                let lanes = unsafe { setup.rays4(x0, y, late_starts.as_ref()) };
+                let lanes = avx2.rays4(&setup, x0, y, late_starts.as_ref());
                 for (x, lane) in (x0..xs.end).zip(lanes) {
                     let Some(lane) = lane else { continue };
                     let (step, offset) = (self.step_mm as f32, self.offset(x, y));

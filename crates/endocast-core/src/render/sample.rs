@@ -1,12 +1,11 @@
 //! The helpers every render mode shares: trilinear sampling in stored units, gradients mapped to
 //! world-space normals, Blinn-Phong shading with a headlight, and front-to-back compositing.
 
+use super::simd::Avx2;
 use crate::Volume;
-use glam::{DMat3, Mat3, Vec3, Vec3A, Vec4};
+use glam::{DMat3, Mat3, Vec3, Vec3A};
 
-#[cfg(target_arch = "x86_64")]
-pub(crate) mod avx2;
-mod bricked;
+pub(super) mod bricked;
 
 pub use bricked::BrickedVoxels;
 
@@ -57,18 +56,18 @@ pub type Lanes = [f32; 8];
 /// multiply-add), so both give bit-identical values.
 #[derive(Debug, Clone, Copy)]
 pub struct Sampler<'a> {
-    voxels: &'a [u16],
+    pub(super) voxels: &'a [u16],
     /// Largest position per axis (`n − 1`).
-    extent: Vec3,
+    pub(super) extent: Vec3,
     /// Largest base index per axis of the 2×2×2 cell (`n − 2`, or 0 for a single voxel).
-    max_base: [i32; 3],
+    pub(super) max_base: [i32; 3],
     /// Memory strides to the next voxel per axis; 0 along an axis of one voxel.
-    stride: [usize; 3],
+    pub(super) stride: [usize; 3],
     /// The voxels brick by brick, where the batches read them that way, and bricks per axis.
-    bricked: Option<(&'a [u16], [i32; 3])>,
-    /// Whether batches run on AVX2 (the CPU has it, x has two voxels or more for the paired
+    pub(super) bricked: Option<(&'a [u16], [i32; 3])>,
+    /// Where batches run on AVX2 (the CPU has it, x has two voxels or more for the paired
     /// gathers, and every index fits the gathers' `i32`).
-    avx2: bool,
+    avx2: Option<Avx2>,
 }
 
 impl<'a> Sampler<'a> {
@@ -85,7 +84,7 @@ impl<'a> Sampler<'a> {
             max_base,
             stride: [step(nx, 1), step(ny, nx), step(nz, nx * ny)],
             bricked: None,
-            avx2: nx >= 2 && i32::try_from(voxels.len()).is_ok() && avx2_available(),
+            avx2: Avx2::detect().filter(|_| nx >= 2 && i32::try_from(voxels.len()).is_ok()),
         }
     }
 
@@ -95,38 +94,33 @@ impl<'a> Sampler<'a> {
     /// the gathers' `i32` indices.
     pub fn with_bricks(volume: &'a Volume, bricked: &'a BrickedVoxels) -> Self {
         let plain = Self::new(volume);
-        if !bricked.fits(volume.dims()) || !avx2_available() {
+        let Some(avx2) = Avx2::detect().filter(|_| bricked.fits(volume.dims())) else {
             return plain;
-        }
+        };
         let bricks = bricked.bricks().map(|b| b as i32);
         Self {
             bricked: Some((bricked.voxels(), bricks)),
-            avx2: true,
+            avx2: Some(avx2),
             ..plain
         }
     }
 
-    /// Whether batches run on AVX2.
-    pub(crate) fn avx2(&self) -> bool {
+    /// The AVX2 token where batches run on AVX2.
+    pub(crate) fn avx2(&self) -> Option<Avx2> {
         self.avx2
     }
 
     /// The same sampler without the AVX2 batches (to compare both paths).
     pub fn scalar(self) -> Self {
-        Self {
-            avx2: false,
-            ..self
-        }
+        Self { avx2: None, ..self }
     }
 
     /// Samples `n .. n + count` (`count` ≤ 8) of `grid`; lanes from `count` on are unspecified.
     #[inline]
-    #[allow(unsafe_code)]
     pub fn grid8(&self, grid: &SampleGrid, n: i32, count: usize) -> Lanes {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only where the CPU reported AVX2 (`avx2_available`).
-            return unsafe { avx2::grid8(self, grid, n) };
+        if let Some(avx2) = self.avx2 {
+            return avx2.grid8(self, grid, n);
         }
         let mut out = [0.0; 8];
         for (lane, value) in (n..).zip(out.iter_mut().take(count)) {
@@ -137,24 +131,20 @@ impl<'a> Sampler<'a> {
 
     /// The values at eight positions given as their x, y and z lanes.
     #[inline]
-    #[allow(unsafe_code)]
     pub fn points8(&self, [x, y, z]: &[Lanes; 3]) -> Lanes {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: as in `grid8`.
-            return unsafe { avx2::points8(self, [x, y, z]) };
+        if let Some(avx2) = self.avx2 {
+            return avx2.points8(self, [x, y, z]);
         }
         std::array::from_fn(|k| self.value(Vec3::new(x[k], y[k], z[k])))
     }
 
     /// The values at `line.at(t[k])` for the eight distances `t`.
     #[inline]
-    #[allow(unsafe_code)]
     pub fn along8(&self, line: &SampleGrid, t: &Lanes) -> Lanes {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: as in `grid8`.
-            return unsafe { avx2::along8(self, line, t) };
+        if let Some(avx2) = self.avx2 {
+            return avx2.along8(self, line, t);
         }
         t.map(|t| self.value(line.at(t)))
     }
@@ -177,26 +167,6 @@ impl<'a> Sampler<'a> {
         let c = low + (high - low) * fx;
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
         lerp(lerp(c.x, c.y, fy), lerp(c.z, c.w, fy), fz)
-    }
-
-    /// The 2×2×2 cell whose lowest corner is voxel `index`: the four corners at x and the four
-    /// at x + 1, each ordered (y, z) = (0, 0), (1, 0), (0, 1), (1, 1).
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    fn corners(&self, index: usize) -> [Vec4; 2] {
-        let [sx, sy, sz] = self.stride;
-        // One bounds check for the whole cell (it panics like indexing would).
-        let cell = &self.voxels[index..=index + sx + sy + sz];
-        let at = |offset: usize| {
-            debug_assert!(offset < cell.len());
-            // SAFETY: every offset used below is a sum of a subset of {sx, sy, sz}, so it is at
-            // most sx + sy + sz = cell.len() − 1 (the slice above is that long, and the sum did
-            // not overflow or the slice would have been refused).
-            f32::from(unsafe { *cell.get_unchecked(offset) })
-        };
-        let low = Vec4::new(at(0), at(sy), at(sz), at(sz + sy));
-        let high = Vec4::new(at(sx), at(sy + sx), at(sz + sx), at(sz + sy + sx));
-        [low, high]
     }
 
     /// Gradient of the stored value by central differences one voxel apart, stored units per
@@ -237,18 +207,6 @@ impl<'a> Sampler<'a> {
         };
         let [dx, dy, dz] = [0, 1, 2].map(difference);
         std::array::from_fn(|k| Vec3::new(dx[k], dy[k], dz[k]) * 0.5)
-    }
-}
-
-/// Whether this CPU runs the AVX2 batches.
-fn avx2_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 

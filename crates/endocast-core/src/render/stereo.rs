@@ -25,14 +25,15 @@
 //! the eyes share only the prepared state.
 
 #[cfg(target_arch = "x86_64")]
-use super::rays4::LateStarts;
+use super::simd::rays4::LateStarts;
 use super::{Frame, Mode, Prepared, RenderOptions, BRICK_VOX};
 
-/// How many bricks around the eye [`Prepared::clear_radius_vox`] looks at.
-const CLEAR_BRICKS: usize = 3;
 use crate::camera::{Camera, CameraError, Projection, StereoRig};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+
+/// How many bricks around the eye [`Prepared::clear_radius_vox`] looks at.
+const CLEAR_BRICKS: usize = 3;
 
 /// A stereo pair's two frames, and the buffers the second eye's start-up reuses from pair to
 /// pair (fresh buffers cost page faults every frame).

@@ -6,6 +6,7 @@
 //! size and on any voxel spacing; [`TfTable`] corrects it for the actual step:
 //! α' = 1 − (1 − α)^(Δs / Δs₀).
 
+use super::simd::sse;
 use crate::ValueMap;
 use glam::Vec4;
 use thiserror::Error;
@@ -387,23 +388,9 @@ impl TfTable {
     /// [`Self::lookup`] of eight values at once: the same operations, the entry positions and
     /// weights computed for all lanes together.
     #[inline(always)]
-    #[allow(unsafe_code)]
     pub fn lookup8(&self, values: &[f32; 8]) -> [Vec4; 8] {
         let top = self.colors.len() - 1;
-        let (index, weight) = locate8(values, f32::from(self.first), top as f32);
-        std::array::from_fn(|k| {
-            let i = index[k] as usize;
-            debug_assert!(i <= top);
-            // SAFETY: `locate8` clamps i to [0, top], and top + 1 = entries.len() − 1 (the
-            // table ends with a copy of its last entry), so entries i and i + 1 exist.
-            let (lo, hi) = unsafe {
-                (
-                    *self.entries.get_unchecked(i),
-                    *self.entries.get_unchecked(i + 1),
-                )
-            };
-            lo + (hi - lo) * weight[k]
-        })
+        sse::lookup8(&self.entries, f32::from(self.first), top, values)
     }
 
     /// Plain colour at a continuous stored value (for maximum/minimum intensity projections).
@@ -416,41 +403,6 @@ impl TfTable {
         );
         [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * t)
     }
-}
-
-/// [`TfTable::locate`] of eight values for a table whose first entry is stored value `first`
-/// and last entry index `top`: entry indices clamped to `[0, top]` and weights. Four lanes at a
-/// time on SSE2 (part of every x86-64 CPU), with the scalar path's results: `maxps` and `minps`
-/// return their second operand for a NaN first one, as `f32::max` and `f32::min` ignore NaN.
-#[inline(always)]
-#[allow(unsafe_code)]
-fn locate8(values: &[f32; 8], first: f32, top: f32) -> ([i32; 8], [f32; 8]) {
-    let (mut index, mut weight) = ([0i32; 8], [0.0f32; 8]);
-    #[cfg(target_arch = "x86_64")]
-    for half in [0, 4] {
-        use std::arch::x86_64::{
-            _mm_cvtepi32_ps, _mm_cvttps_epi32, _mm_loadu_ps, _mm_max_ps, _mm_min_ps, _mm_set1_ps,
-            _mm_setzero_ps, _mm_storeu_ps, _mm_storeu_si128, _mm_sub_ps,
-        };
-        // SAFETY: SSE2 is part of the x86-64 baseline; each load and store touches the four
-        // elements `half .. half + 4` of an eight-element array.
-        unsafe {
-            let v = _mm_loadu_ps(values.as_ptr().add(half));
-            let x = _mm_max_ps(_mm_sub_ps(v, _mm_set1_ps(first)), _mm_setzero_ps());
-            // x.min(top) lies in [0, top]: truncation is exact and in range.
-            let i = _mm_cvttps_epi32(_mm_min_ps(x, _mm_set1_ps(top)));
-            let w = _mm_min_ps(_mm_sub_ps(x, _mm_cvtepi32_ps(i)), _mm_set1_ps(1.0));
-            _mm_storeu_si128(index.as_mut_ptr().add(half).cast(), i);
-            _mm_storeu_ps(weight.as_mut_ptr().add(half), w);
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    for k in 0..8 {
-        let x = (values[k] - first).max(0.0);
-        index[k] = x.min(top) as i32;
-        weight[k] = (x - index[k] as f32).min(1.0);
-    }
-    (index, weight)
 }
 
 /// Opacity for a step of `exponent` reference lengths.

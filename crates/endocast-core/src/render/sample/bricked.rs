@@ -7,15 +7,16 @@
 //! as much (iso 0.97, DVR 0.94), so 16³ at 1.2× memory.
 
 use super::super::bricks::bricks_along;
+use super::super::simd::Avx2;
 use crate::Volume;
 use rayon::prelude::*;
 
 /// Cells per brick edge (a power of two).
-pub(super) const VOX: usize = 16;
+pub(in crate::render) const VOX: usize = 16;
 /// Voxels per brick edge, with the apron.
-pub(super) const EDGE: usize = VOX + 1;
+pub(in crate::render) const EDGE: usize = VOX + 1;
 /// Voxels per brick.
-pub(super) const BRICK_LEN: usize = EDGE * EDGE * EDGE;
+pub(in crate::render) const BRICK_LEN: usize = EDGE * EDGE * EDGE;
 
 /// A volume's voxels brick by brick (x fastest inside a brick, bricks x fastest), each brick
 /// with a one-voxel apron on its upper faces (clamped to the volume).
@@ -37,9 +38,7 @@ impl BrickedVoxels {
             .iter()
             .try_fold(BRICK_LEN, |len, &b| len.checked_mul(b))
             .filter(|&len| i32::try_from(len).is_ok())?;
-        if !super::avx2_available() {
-            return None;
-        }
+        Avx2::detect()?;
         let source = volume.voxels();
         let mut voxels = vec![0u16; len];
         voxels

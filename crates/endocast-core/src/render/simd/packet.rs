@@ -4,19 +4,20 @@
 //! bookkeeping of the walk — brick steps, activity tests, sample ranges, crossing tests — is
 //! done for eight rays by each instruction instead of one.
 //!
-//! A lane takes exactly the samples the one-ray walk ([`super::march::Walk::SEARCH`]) takes:
-//! in each active brick, from the last sample before it to the first at or after its end
-//! (skipping those already taken), and tests each sample against the one before it on the grid
-//! when that one was taken. Its first crossing, values and all, is the one-ray search's, and
-//! the march is left where that search would leave it for what follows (the volume behind the
-//! surface): at the sample after the crossing, the brick it was found in pending.
+//! A lane takes exactly the samples the one-ray walk
+//! ([`crate::render::march::Walk::SEARCH`]) takes: in each active brick, from the last sample
+//! before it to the first at or after its end (skipping those already taken), and tests each
+//! sample against the one before it on the grid when that one was taken. Its first crossing,
+//! values and all, is the one-ray search's, and the march is left where that search would leave
+//! it for what follows (the volume behind the surface): at the sample after the crossing, the
+//! brick it was found in pending.
 
-use super::crossing::Bracket;
-use super::march::MarchStats;
-use super::ray_task::RayTask;
-use super::sample::avx2::trilinear;
-use super::sample::Sampler;
-use super::traverse::{BrickDda, Segment};
+use super::sample::trilinear;
+use crate::render::crossing::Bracket;
+use crate::render::march::MarchStats;
+use crate::render::ray_task::RayTask;
+use crate::render::sample::Sampler;
+use crate::render::traverse::{BrickDda, Segment};
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_andnot_si256,
     _mm256_blendv_epi8, _mm256_blendv_ps, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps,
@@ -32,18 +33,18 @@ use std::arch::x86_64::{
 type Mask = __m256i;
 
 /// The first crossings of `iso` of up to eight rays whose marches have not been walked yet, as
-/// [`super::integrate::Integrator::search`] finds them one ray at a time. `directions[k]` says
-/// whether ray `k`'s crossing is rising, `active` holds the isovalue's brick bits (`None`: every
-/// brick is searched). Each march is left as that search leaves it.
+/// [`crate::render::integrate::Integrator::search`] finds them one ray at a time.
+/// `directions[k]` says whether ray `k`'s crossing is rising, `active` holds the isovalue's
+/// brick bits (`None`: every brick is searched). Each march is left as that search leaves it.
 #[target_feature(enable = "avx2")]
-pub(crate) fn search8(
+pub(super) fn search8(
     sampler: &Sampler<'_>,
     active: Option<&[u64]>,
     iso: f32,
     tasks: &mut [RayTask],
     directions: [bool; 8],
 ) -> [Option<Bracket>; 8] {
-    debug_assert!(tasks.len() <= 8 && sampler.avx2());
+    debug_assert!(tasks.len() <= 8 && sampler.avx2().is_some());
     let mut dda = Dda::load(tasks);
     let grid = Grid::load(tasks);
     let mut lanes = Lanes::new(tasks.len());
@@ -94,10 +95,10 @@ pub(crate) fn search8(
 
 /// `steps` bisection steps of the brackets of up to eight rays (rays without one are left
 /// alone), all steps in registers: each midpoint computed, sampled and kept as
-/// [`super::integrate::Integrator::refine`] keeps a single ray's.
+/// [`crate::render::integrate::Integrator::refine`] keeps a single ray's.
 #[target_feature(enable = "avx2")]
-pub(crate) fn refine8(sampler: &Sampler<'_>, iso: f32, tasks: &mut [RayTask], steps: u32) {
-    debug_assert!(tasks.len() <= 8 && sampler.avx2());
+pub(super) fn refine8(sampler: &Sampler<'_>, iso: f32, tasks: &mut [RayTask], steps: u32) {
+    debug_assert!(tasks.len() <= 8 && sampler.avx2().is_some());
     let grid = Grid::load(tasks);
     let bracket = |f: fn(&Bracket) -> f32| lanes_f32(tasks, |t| t.bracket.as_ref().map_or(0.0, f));
     let (mut t0, mut v0) = (bracket(|b| b.before.0), bracket(|b| b.before.1));
@@ -155,7 +156,6 @@ struct Found {
 
 impl Found {
     /// No lane has found a crossing.
-    #[allow(unsafe_code)]
     fn new() -> Self {
         // SAFETY: every field is a vector of integers or floats, for which all bits zero is a
         // valid value (zero, or a lane mask with no lane on).
@@ -413,7 +413,6 @@ struct Lanes {
 impl Lanes {
     /// The state of `count` fresh lanes (the others never search).
     #[target_feature(enable = "avx2")]
-    #[allow(unsafe_code)]
     fn new(count: usize) -> Self {
         Self {
             live: mask(|k| k < count),
@@ -456,7 +455,6 @@ impl Lanes {
 /// The activity bits of `brick` in the lanes of `on` (a lane all ones where set).
 #[target_feature(enable = "avx2")]
 #[inline]
-#[allow(unsafe_code)]
 fn active_bits(words: &[u64], brick: __m256i, on: Mask) -> Mask {
     // As 32-bit words (x86 is little-endian): bit b is bit b % 32 of word b / 32. The index is
     // clamped to the words, so no lane reads outside them.
@@ -525,7 +523,6 @@ fn bits(m: Mask) -> u32 {
 
 /// `field` of each task, zero past the last.
 #[target_feature(enable = "avx2")]
-#[allow(unsafe_code)]
 fn lanes_f32(tasks: &[RayTask], field: impl Fn(&RayTask) -> f32) -> __m256 {
     let mut lanes = [0.0f32; 8];
     for (lane, task) in lanes.iter_mut().zip(tasks) {
@@ -548,7 +545,6 @@ fn lanes_i32(tasks: &[RayTask], field: impl Fn(&RayTask) -> i32) -> __m256i {
 /// Eight integers as lanes.
 #[target_feature(enable = "avx2")]
 #[inline]
-#[allow(unsafe_code)]
 fn lanes_i32_from(lanes: [i32; 8]) -> __m256i {
     // SAFETY: 32 bytes are read from an array of 32 bytes.
     unsafe { _mm256_loadu_si256(lanes.as_ptr().cast()) }
@@ -557,7 +553,6 @@ fn lanes_i32_from(lanes: [i32; 8]) -> __m256i {
 /// The lanes of `v`.
 #[target_feature(enable = "avx2")]
 #[inline]
-#[allow(unsafe_code)]
 fn floats(v: __m256) -> [f32; 8] {
     let mut lanes = [0.0f32; 8];
     // SAFETY: eight f32 are written to an array of eight.
@@ -568,7 +563,6 @@ fn floats(v: __m256) -> [f32; 8] {
 /// The lanes of `v`.
 #[target_feature(enable = "avx2")]
 #[inline]
-#[allow(unsafe_code)]
 fn ints(v: __m256i) -> [i32; 8] {
     let mut lanes = [0i32; 8];
     // SAFETY: 32 bytes are written to an array of 32 bytes.

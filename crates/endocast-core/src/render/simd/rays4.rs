@@ -6,9 +6,9 @@
 //! [`VoxelRay::clip`], [`BrickDda::new`]) operation for operation, in the same order and with
 //! the same comparisons, so it gives the same bits; only the per-ray bookkeeping is shared.
 
-use super::traverse::{BrickDda, VoxelRay};
-use super::BRICK_VOX;
 use crate::camera::{Camera, PinholeRays, Ray};
+use crate::render::traverse::{BrickDda, VoxelRay};
+use crate::render::BRICK_VOX;
 use glam::{DAffine3, DVec3};
 use std::arch::x86_64::{
     __m256d, _mm256_add_pd, _mm256_and_pd, _mm256_andnot_pd, _mm256_blendv_pd, _mm256_cmp_pd,
@@ -99,7 +99,12 @@ impl RaySetup {
     /// The rays of pixels `x0 .. x0 + 4` of row `y` (`None` where a ray misses the volume or
     /// the camera forms none; lanes past the image's right edge are computed all the same).
     #[target_feature(enable = "avx2")]
-    pub fn rays4(&self, x0: usize, y: usize, late: Option<&LateStarts>) -> [Option<LaneRay>; 4] {
+    pub(super) fn rays4(
+        &self,
+        x0: usize,
+        y: usize,
+        late: Option<&LateStarts>,
+    ) -> [Option<LaneRay>; 4] {
         let lanes = match &self.pinhole {
             Some(pinhole) => self.pinhole4(pinhole, x0, y),
             None => self.camera4(x0, y),
@@ -401,7 +406,6 @@ fn dot(a: [__m256d; 3], b: [__m256d; 3]) -> __m256d {
 
 /// `v as i32` per lane (truncation; out of range gives `i32::MIN`, which the callers clamp).
 #[target_feature(enable = "avx2")]
-#[allow(unsafe_code)]
 fn truncate(v: __m256d) -> [i32; 4] {
     let mut out = [0i32; 4];
     // SAFETY: 16 bytes are written to an array of 16 bytes.
@@ -411,7 +415,6 @@ fn truncate(v: __m256d) -> [i32; 4] {
 
 /// The lanes of `v`.
 #[target_feature(enable = "avx2")]
-#[allow(unsafe_code)]
 fn doubles(v: __m256d) -> [f64; 4] {
     let mut out = [0.0; 4];
     // SAFETY: four f64 are written to an array of four.

@@ -4,8 +4,8 @@
 //! operation for operation — clamp, truncate, the same lerps in the same order, no fused
 //! multiply-add — so the lanes equal the scalar values bit for bit.
 
-use super::bricked::{BRICK_LEN, EDGE, VOX};
-use super::{Lanes, SampleGrid, Sampler};
+use crate::render::sample::bricked::{BRICK_LEN, EDGE, VOX};
+use crate::render::sample::{Lanes, SampleGrid, Sampler};
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_cvtepi32_ps,
     _mm256_cvttps_epi32, _mm256_i32gather_epi32, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_epi32,
@@ -32,7 +32,6 @@ pub(super) fn grid8(sampler: &Sampler<'_>, grid: &SampleGrid, n: i32) -> Lanes {
 
 /// The values at `line.at(t[k])`.
 #[target_feature(enable = "avx2")]
-#[allow(unsafe_code)]
 pub(super) fn along8(sampler: &Sampler<'_>, line: &SampleGrid, t: &Lanes) -> Lanes {
     // SAFETY: `t` holds exactly eight f32; unaligned loads are allowed.
     at_distances(sampler, line, unsafe { _mm256_loadu_ps(t.as_ptr()) })
@@ -50,7 +49,6 @@ fn at_distances(sampler: &Sampler<'_>, line: &SampleGrid, t: __m256) -> Lanes {
 
 /// The values at eight positions given as their x, y and z lanes.
 #[target_feature(enable = "avx2")]
-#[allow(unsafe_code)]
 pub(super) fn points8(sampler: &Sampler<'_>, [x, y, z]: [&Lanes; 3]) -> Lanes {
     // SAFETY: each array holds exactly eight f32; unaligned loads are allowed.
     let load = |lanes: &Lanes| unsafe { _mm256_loadu_ps(lanes.as_ptr()) };
@@ -91,7 +89,6 @@ fn cell(p: __m256, extent: f32, max_base: i32) -> (__m256i, __m256) {
 /// clamped to the volume).
 #[target_feature(enable = "avx2")]
 #[inline]
-#[allow(unsafe_code)]
 pub(crate) fn trilinear(s: &Sampler<'_>, x: __m256, y: __m256, z: __m256) -> __m256 {
     let (bx, fx) = cell(x, s.extent.x, s.max_base[0]);
     let (by, fy) = cell(y, s.extent.y, s.max_base[1]);
@@ -161,7 +158,6 @@ fn bricked_base(bricks: [i32; 3], bx: __m256i, by: __m256i, bz: __m256i) -> (__m
 /// The lanes as an array.
 #[target_feature(enable = "avx2")]
 #[inline]
-#[allow(unsafe_code)]
 fn store(v: __m256) -> Lanes {
     let mut out = [0.0; 8];
     // SAFETY: `out` holds exactly eight f32; unaligned stores are allowed.
