@@ -1,0 +1,7 @@
+//! The viewer's tests, in one binary (one link step): the session driven as the window drives
+//! it, the case files, and the window itself on a headless egui context.
+
+mod case;
+mod common;
+mod flight;
+mod ui;
