@@ -9,6 +9,9 @@ use glam::{DQuat, DVec3};
 /// frame is kept.
 const PARALLEL_LIMIT: f64 = 0.999;
 
+/// How far from unit length and perpendicular a given frame may be to be kept as it is.
+const ORTHONORMAL_EPS: f64 = 1e-12;
+
 /// The endoscope's pose while flying: eye (world mm, LPS) and unit forward, up and right axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlyCamera {
@@ -40,6 +43,11 @@ impl FlyCamera {
     pub fn new(eye_mm: DVec3, forward: DVec3, up: DVec3) -> Option<Self> {
         if !eye_mm.is_finite() {
             return None;
+        }
+        let unit = |v: DVec3| (v.length() - 1.0).abs() < ORTHONORMAL_EPS;
+        if unit(forward) && unit(up) && forward.dot(up).abs() < ORTHONORMAL_EPS {
+            // Already a frame (a saved camera): kept bit for bit, so a case reopens exactly.
+            return Some(Self { eye_mm, forward, up });
         }
         let forward = forward.try_normalize()?;
         let up = up.try_normalize()?;

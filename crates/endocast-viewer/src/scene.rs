@@ -76,18 +76,22 @@ pub struct Navigation {
 impl Navigation {
     /// The lumen 6-connected to the voxel nearest `eye_mm` on `side` of `threshold`; `None`
     /// when the eye is outside the volume or in the wall. The camera's radius is two voxels (the
-    /// collider's bound holds against the wall to within about a voxel).
+    /// collider's bound holds against the wall to within about a voxel), or half the lumen's
+    /// widest radius in a lumen narrower than that.
     pub fn around(volume: &Volume, eye_mm: DVec3, threshold: f64, side: LumenSide) -> Option<Self> {
         let seed = seed_voxel(volume, eye_mm).ok()?;
         let lumen = Lumen::from_seed(volume, seed, threshold, side).ok()?;
         let field = DistanceField::new(&lumen, volume.geometry());
-        let radius_mm = 2.0 * field.min_spacing_mm();
+        let radius_mm = (2.0 * field.min_spacing_mm()).min(0.5 * field.max_mm());
         Some(Self { field, radius_mm })
     }
 
-    /// The collider of this lumen.
-    pub fn collider(&self) -> Option<Collider<'_>> {
-        Collider::new(&self.field, self.radius_mm).ok()
+    /// The collider for a camera at `eye_mm`: the camera's radius, shrunk to fit where the eye
+    /// already is nearer the wall than that (a jump, a reopened case), so it can always move
+    /// on; `None` outside the lumen.
+    pub fn collider_at(&self, eye_mm: DVec3) -> Option<Collider<'_>> {
+        let room = 0.9 * self.field.distance_mm(eye_mm);
+        Collider::new(&self.field, self.radius_mm.min(room)).ok()
     }
 
     /// Distance from `p_mm` to the wall, mm (0 outside the lumen).

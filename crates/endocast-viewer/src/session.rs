@@ -266,11 +266,12 @@ impl Session {
     /// Flies by `step` (sliding along the wall when collision is on); returns the distance
     /// travelled, mm.
     pub fn fly(&mut self, step: LocalMove) -> f64 {
+        let eye = self.camera.eye_mm();
         let collider = self
             .navigation
             .as_ref()
             .filter(|_| self.controls.collision)
-            .and_then(Navigation::collider);
+            .and_then(|n| n.collider_at(eye));
         self.camera.translate(step, collider.as_ref())
     }
 
