@@ -59,7 +59,10 @@ fn main() {
         session.set_camera(camera);
         let input = Instant::now();
         let generation = session.sync(true).expect("a new view");
-        let preview = session.worker().wait_for(generation, wait, |_| true).expect("a frame");
+        let preview = session
+            .worker()
+            .wait_for(generation, wait, |_| true)
+            .expect("a frame");
         first.push((input.elapsed(), preview.stage));
         // The camera stops: the same view, refined.
         session.sync(false);

@@ -176,7 +176,9 @@ impl Case {
 
     /// Reads `path`; the error names the file and the problem.
     pub fn read(path: &Path) -> Result<Self, CaseError> {
-        let size = std::fs::metadata(path).map_err(|e| CaseError::new(path, e))?.len();
+        let size = std::fs::metadata(path)
+            .map_err(|e| CaseError::new(path, e))?
+            .len();
         if size > MAX_BYTES {
             return Err(CaseError::new(path, format!("{size} bytes is too large")));
         }

@@ -47,7 +47,11 @@ impl FlyCamera {
         let unit = |v: DVec3| (v.length() - 1.0).abs() < ORTHONORMAL_EPS;
         if unit(forward) && unit(up) && forward.dot(up).abs() < ORTHONORMAL_EPS {
             // Already a frame (a saved camera): kept bit for bit, so a case reopens exactly.
-            return Some(Self { eye_mm, forward, up });
+            return Some(Self {
+                eye_mm,
+                forward,
+                up,
+            });
         }
         let forward = forward.try_normalize()?;
         let up = up.try_normalize()?;

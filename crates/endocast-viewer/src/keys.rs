@@ -16,7 +16,10 @@ pub const HELP: &[(&str, &str)] = &[
     ("Q / E", "roll left / right"),
     ("Shift", "three times faster"),
     ("drag in the view", "look around"),
-    ("click in the view", "turn toward that point (or mark it, in mark mode)"),
+    (
+        "click in the view",
+        "turn toward that point (or mark it, in mark mode)",
+    ),
     ("click in a slice", "jump there"),
     ("K", "record a key frame"),
     ("P / Space", "play / pause the key frames"),

@@ -15,6 +15,7 @@
 //! - [`app`]: the window (egui), which maps input to the session and draws what it has.
 //!
 //! ```no_run
+//! # #[cfg(feature = "window")] {
 //! use endocast_viewer::app::{run, ViewerOptions};
 //! use endocast_viewer::scene::ScanSource;
 //! use endocast_core::presets::Preset;
@@ -27,15 +28,21 @@
 //!     screenshot: None,
 //! })
 //! .unwrap();
+//! # }
 //! ```
 
+#[cfg(feature = "window")]
 pub mod app;
 pub mod case;
 pub mod controller;
+#[cfg(feature = "window")]
 pub mod keys;
+#[cfg(feature = "window")]
 mod panel;
 pub mod scene;
 pub mod session;
+#[cfg(feature = "window")]
 mod slices;
+#[cfg(feature = "window")]
 mod view;
 pub mod worker;

@@ -4,19 +4,27 @@
 use crate::app::{Action, Ready};
 use crate::keys::HELP;
 use crate::session::Session;
+use egui::{Color32, Sense, Stroke, Vec2};
 use endocast_core::camera::Projection;
 use endocast_core::presets;
 use endocast_core::render::Mode;
-use egui::{Color32, Sense, Stroke, Vec2};
 use std::path::Path;
 
 /// Draws the panel; returns what the application must do.
-pub(crate) fn controls_ui(ui: &mut egui::Ui, ready: &mut Ready, open_path: &mut String) -> Option<Action> {
+pub(crate) fn controls_ui(
+    ui: &mut egui::Ui,
+    ready: &mut Ready,
+    open_path: &mut String,
+) -> Option<Action> {
     let mut action = None;
     ui.heading("endocast");
     ui.label(ready.session.scene().source.label());
     ui.horizontal(|ui| {
-        ui.add(egui::TextEdit::singleline(open_path).hint_text("scan or case .json").desired_width(200.0));
+        ui.add(
+            egui::TextEdit::singleline(open_path)
+                .hint_text("scan or case .json")
+                .desired_width(200.0),
+        );
         if ui.button("Open").clicked() {
             action = Some(Action::Open);
         }
@@ -25,25 +33,34 @@ pub(crate) fn controls_ui(ui: &mut egui::Ui, ready: &mut Ready, open_path: &mut 
     view_controls_ui(ui, &mut ready.session);
     ui.separator();
     flight_controls_ui(ui, &mut ready.session);
-    egui::CollapsingHeader::new("Key frames").default_open(true).show(ui, |ui| {
-        if let Some(a) = key_frames_ui(ui, &mut ready.session) {
-            action = Some(a);
-        }
-    });
-    egui::CollapsingHeader::new("Marks and measurement").default_open(true).show(ui, |ui| {
-        marks_ui(ui, ready);
-    });
-    egui::CollapsingHeader::new("Case").default_open(true).show(ui, |ui| {
-        ui.label(format!("autosaved to {}", ready.autosave.path().display()));
-        ui.horizontal(|ui| {
-            if ui.button("Save case").clicked() {
-                action = Some(Action::SaveCase);
-            }
-            if ui.button("Screenshot").clicked() {
-                action = Some(Action::Message(screenshot(&ready.session, ready.autosave.path())));
+    egui::CollapsingHeader::new("Key frames")
+        .default_open(true)
+        .show(ui, |ui| {
+            if let Some(a) = key_frames_ui(ui, &mut ready.session) {
+                action = Some(a);
             }
         });
-    });
+    egui::CollapsingHeader::new("Marks and measurement")
+        .default_open(true)
+        .show(ui, |ui| {
+            marks_ui(ui, ready);
+        });
+    egui::CollapsingHeader::new("Case")
+        .default_open(true)
+        .show(ui, |ui| {
+            ui.label(format!("autosaved to {}", ready.autosave.path().display()));
+            ui.horizontal(|ui| {
+                if ui.button("Save case").clicked() {
+                    action = Some(Action::SaveCase);
+                }
+                if ui.button("Screenshot").clicked() {
+                    action = Some(Action::Message(screenshot(
+                        &ready.session,
+                        ready.autosave.path(),
+                    )));
+                }
+            });
+        });
     egui::CollapsingHeader::new("Keys").show(ui, |ui| {
         egui::Grid::new("keys").show(ui, |ui| {
             for (key, what) in HELP {
@@ -62,7 +79,8 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
         .selected_text(preset.name)
         .show_ui(ui, |ui| {
             for p in presets::iter() {
-                ui.selectable_value(&mut preset, p, p.name).on_hover_text(p.description);
+                ui.selectable_value(&mut preset, p, p.name)
+                    .on_hover_text(p.description);
             }
         });
     if !std::ptr::eq(preset, session.controls.preset) {
@@ -84,7 +102,11 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     egui::ComboBox::from_label("lens")
         .selected_text(c.projection.name())
         .show_ui(ui, |ui| {
-            for p in [Projection::Pinhole, Projection::Equidistant, Projection::Equisolid] {
+            for p in [
+                Projection::Pinhole,
+                Projection::Equidistant,
+                Projection::Equisolid,
+            ] {
                 ui.selectable_value(&mut c.projection, p, p.name());
             }
         });
@@ -97,16 +119,23 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
 
 /// The value histogram (log counts) with the isovalue marked; a click sets the isovalue.
 fn histogram_ui(ui: &mut egui::Ui, counts: &[u64], (lo, hi): (f64, f64), iso: &mut f64) {
-    let (response, painter) = ui.allocate_painter(Vec2::new(ui.available_width(), 56.0), Sense::click());
+    let (response, painter) =
+        ui.allocate_painter(Vec2::new(ui.available_width(), 56.0), Sense::click());
     let rect = response.rect;
     painter.rect_filled(rect, 2.0, Color32::from_gray(24));
-    let top = counts.iter().map(|&c| ((c + 1) as f64).ln()).fold(1.0, f64::max);
+    let top = counts
+        .iter()
+        .map(|&c| ((c + 1) as f64).ln())
+        .fold(1.0, f64::max);
     let w = rect.width() / counts.len() as f32;
     for (i, &c) in counts.iter().enumerate() {
         let h = (((c + 1) as f64).ln() / top) as f32 * rect.height();
         let x = rect.left() + i as f32 * w;
         painter.rect_filled(
-            egui::Rect::from_min_max(egui::pos2(x, rect.bottom() - h), egui::pos2(x + w, rect.bottom())),
+            egui::Rect::from_min_max(
+                egui::pos2(x, rect.bottom() - h),
+                egui::pos2(x + w, rect.bottom()),
+            ),
             0.0,
             Color32::from_gray(150),
         );
@@ -117,7 +146,10 @@ fn histogram_ui(ui: &mut egui::Ui, counts: &[u64], (lo, hi): (f64, f64), iso: &m
         [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
         Stroke::new(2.0, Color32::from_rgb(255, 120, 80)),
     );
-    if let Some(pos) = response.interact_pointer_pos().filter(|_| response.clicked()) {
+    if let Some(pos) = response
+        .interact_pointer_pos()
+        .filter(|_| response.clicked())
+    {
         *iso = lo + f64::from((pos.x - rect.left()) / rect.width()) * span;
     }
 }
@@ -125,7 +157,11 @@ fn histogram_ui(ui: &mut egui::Ui, counts: &[u64], (lo, hi): (f64, f64), iso: &m
 fn flight_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     let c = &mut session.controls;
     ui.checkbox(&mut c.collision, "collision (slide along the wall)");
-    ui.add(egui::Slider::new(&mut c.speed_mm_s, 0.5..=400.0).logarithmic(true).text("speed mm/s"));
+    ui.add(
+        egui::Slider::new(&mut c.speed_mm_s, 0.5..=400.0)
+            .logarithmic(true)
+            .text("speed mm/s"),
+    );
     let mut level = c.window.level_hu;
     let mut width = c.window.width_hu;
     ui.horizontal(|ui| {
@@ -150,7 +186,10 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
             }
         }
         let playing = session.playback().is_some_and(|p| p.playing);
-        if ui.button(if playing { "Pause" } else { "Play (P)" }).clicked() {
+        if ui
+            .button(if playing { "Pause" } else { "Play (P)" })
+            .clicked()
+        {
             if session.playback().is_some_and(|p| !p.finished()) {
                 session.toggle_pause();
             } else if let Err(e) = session.play() {
@@ -163,7 +202,10 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
     });
     if let Some(p) = session.playback() {
         let (mut s, len) = (p.s_mm, p.len_mm());
-        if ui.add(egui::Slider::new(&mut s, 0.0..=len).text("mm")).changed() {
+        if ui
+            .add(egui::Slider::new(&mut s, 0.0..=len).text("mm"))
+            .changed()
+        {
             session.scrub(s);
         }
     }
@@ -172,7 +214,10 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
     for (i, k) in session.key_frames().iter().enumerate() {
         ui.horizontal(|ui| {
             let e = k.eye_mm;
-            if ui.button(format!("{} ({:.0}, {:.0}, {:.0})", i + 1, e.x, e.y, e.z)).clicked() {
+            if ui
+                .button(format!("{} ({:.0}, {:.0}, {:.0})", i + 1, e.x, e.y, e.z))
+                .clicked()
+            {
                 go = Some(i);
             }
             if ui.small_button("✕").clicked() {
@@ -233,7 +278,12 @@ fn screenshot(session: &Session, case: &Path) -> String {
         .renderer
         .prepare(&session.controls.settings())
         .map_err(|e| e.to_string())
-        .and_then(|p| session.camera().map(|c| p.render(&c)).map_err(|e| e.to_string()));
+        .and_then(|p| {
+            session
+                .camera()
+                .map(|c| p.render(&c))
+                .map_err(|e| e.to_string())
+        });
     let written = frame.and_then(|f| {
         let rgb = f.to_rgb8(session.controls.settings().background);
         endocast_io::write_png_rgb8(&path, f.width as u32, f.height as u32, &rgb)

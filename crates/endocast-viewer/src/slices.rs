@@ -2,9 +2,9 @@
 //! orientation letters, in the slice window; a click jumps the camera there.
 
 use crate::session::Session;
+use egui::{Sense, TextureOptions, Vec2};
 use endocast_core::views::slices::{camera_slices, Slice, SliceOptions, Window};
 use glam::DVec3;
-use egui::{Sense, TextureOptions, Vec2};
 
 /// Edge of each slice image, pixels.
 const SLICE_PX: usize = 256;
@@ -29,9 +29,11 @@ impl SlicesView {
             .zip(&self.textures)
             .zip(["axial", "coronal", "sagittal"])
         {
-            let image = egui::Image::from_texture((texture.id(), Vec2::splat(edge)))
-                .sense(Sense::click());
-            let response = ui.add(image).on_hover_text(format!("{name}: click to jump here"));
+            let image =
+                egui::Image::from_texture((texture.id(), Vec2::splat(edge))).sense(Sense::click());
+            let response = ui
+                .add(image)
+                .on_hover_text(format!("{name}: click to jump here"));
             if response.clicked() {
                 if let Some(pos) = response.interact_pointer_pos() {
                     let scale = SLICE_PX as f64 / f64::from(response.rect.width());
@@ -70,7 +72,8 @@ impl SlicesView {
             .zip(["axial", "coronal", "sagittal"])
             .map(|(s, name)| {
                 let image = s.image();
-                let pixels = egui::ColorImage::from_rgb([image.width(), image.height()], image.rgb());
+                let pixels =
+                    egui::ColorImage::from_rgb([image.width(), image.height()], image.rgb());
                 ctx.load_texture(name, pixels, TextureOptions::LINEAR)
             })
             .collect();

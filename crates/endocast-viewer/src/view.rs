@@ -131,15 +131,22 @@ fn show_frame(ui: &egui::Ui, ready: &mut Ready, rect: Rect) {
         match &mut ready.view_texture {
             Some(t) => t.set(image, TextureOptions::LINEAR),
             None => {
-                ready.view_texture =
-                    Some(ui.ctx().load_texture("endoscope", image, TextureOptions::LINEAR));
+                ready.view_texture = Some(ui.ctx().load_texture(
+                    "endoscope",
+                    image,
+                    TextureOptions::LINEAR,
+                ));
             }
         }
     }
     if let Some(texture) = &ready.view_texture {
         let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
-        ui.painter()
-            .image(texture.id(), fit(rect, texture.aspect_ratio()), uv, Color32::WHITE);
+        ui.painter().image(
+            texture.id(),
+            fit(rect, texture.aspect_ratio()),
+            uv,
+            Color32::WHITE,
+        );
     }
     if let Some(error) = worker.error() {
         ui.painter().text(
@@ -168,9 +175,7 @@ fn draw_annotations(ui: &egui::Ui, session: &Session, rect: Rect, ppp: f64) {
         return;
     };
     let painter = ui.painter_at(rect);
-    let to_screen = |(x, y): (f64, f64)| {
-        rect.min + Vec2::new((x / ppp) as f32, (y / ppp) as f32)
-    };
+    let to_screen = |(x, y): (f64, f64)| rect.min + Vec2::new((x / ppp) as f32, (y / ppp) as f32);
     let mut last = Vec::new();
     for a in session.annotations() {
         if let Some(p) = camera.project(a.point_mm).map(to_screen) {

@@ -231,7 +231,11 @@ fn next_request(shared: &Shared) -> Option<Request> {
     }
 }
 
-fn render_request(shared: &Shared, prepared: &Prepared, request: &Request) -> Result<(), Cancelled> {
+fn render_request(
+    shared: &Shared,
+    prepared: &Prepared,
+    request: &Request,
+) -> Result<(), Cancelled> {
     let view = &request.view;
     let deliver = |stage: Stage, image: Image, depth_mm: &[f32], time: Duration| {
         let frame = Delivered {

@@ -40,9 +40,14 @@ fn a_saved_case_reopens_to_the_same_view_with_its_marks_and_key_frames() {
     settled(&mut session);
     assert!(session.annotate_pixel(30, 34, "lesion"));
     let shown = settled(&mut session);
-    Autosave::new(path.clone(), Duration::ZERO).tick(&session, true).unwrap();
+    Autosave::new(path.clone(), Duration::ZERO)
+        .tick(&session, true)
+        .unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
-    assert!(text.contains("\"lesion\"") && text.contains("endocast-case"), "{text}");
+    assert!(
+        text.contains("\"lesion\"") && text.contains("endocast-case"),
+        "{text}"
+    );
 
     let mut reopened = reopen(&path);
     assert_eq!(reopened.controls, session.controls);
@@ -50,7 +55,10 @@ fn a_saved_case_reopens_to_the_same_view_with_its_marks_and_key_frames() {
     assert_eq!(reopened.key_frames().len(), 1);
     let again = settled(&mut reopened);
     assert_eq!(again.camera, shown.camera);
-    assert!(again.image.rgb() == shown.image.rgb(), "the reopened view differs");
+    assert!(
+        again.image.rgb() == shown.image.rgb(),
+        "the reopened view differs"
+    );
 }
 
 #[test]
@@ -62,9 +70,21 @@ fn bad_case_files_are_refused_with_the_file_and_the_problem() {
     let text = std::fs::read_to_string(&good).unwrap();
     for (name, content, expect) in [
         ("garbage.json", "{not json".to_owned(), "garbage.json"),
-        ("format.json", text.replace("endocast-case", "other"), "format"),
-        ("preset.json", text.replace("colonoscopy", "gastroscopy"), "gastroscopy"),
-        ("key.json", text.replace("\"revision\"", "\"surprise\""), "surprise"),
+        (
+            "format.json",
+            text.replace("endocast-case", "other"),
+            "format",
+        ),
+        (
+            "preset.json",
+            text.replace("colonoscopy", "gastroscopy"),
+            "gastroscopy",
+        ),
+        (
+            "key.json",
+            text.replace("\"revision\"", "\"surprise\""),
+            "surprise",
+        ),
     ] {
         let path = dir.path().join(name);
         std::fs::write(&path, content).unwrap();
@@ -135,7 +155,11 @@ fn killing_during_autosave_loses_nothing_saved_before() {
         let confirmed = lines.join().unwrap();
         let last = *confirmed.last().expect("the child saved");
         let case = Case::read(&path).expect("the case file is whole after the kill");
-        assert!(case.revision >= last, "saved {last}, the file holds {}", case.revision);
+        assert!(
+            case.revision >= last,
+            "saved {last}, the file holds {}",
+            case.revision
+        );
         assert!(confirmed.len() > 3, "only {} saves", confirmed.len());
     }
 }

@@ -78,6 +78,10 @@ pub fn settled(session: &mut Session) -> Delivered {
 pub fn mean_difference(a: &Delivered, b: &Delivered) -> f64 {
     assert_eq!(a.image.width(), b.image.width());
     let (a, b) = (a.image.rgb(), b.image.rgb());
-    let sum: u64 = a.iter().zip(b).map(|(x, y)| u64::from(x.abs_diff(*y))).sum();
+    let sum: u64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| u64::from(x.abs_diff(*y)))
+        .sum();
     sum as f64 / a.len() as f64
 }

@@ -16,7 +16,10 @@ fn forward(mm: f64) -> LocalMove {
 fn flying_into_the_wall_stops_outside_it_and_the_frame_changes() {
     let (mut session, truth) = tube_session();
     let before = settled(&mut session);
-    let radius = session.navigation().expect("the eye is in the lumen").radius_mm();
+    let radius = session
+        .navigation()
+        .expect("the eye is in the lumen")
+        .radius_mm();
     // Into the wall, in small steps as the keys fly.
     for _ in 0..100 {
         session.fly(forward(1.0));
@@ -25,10 +28,20 @@ fn flying_into_the_wall_stops_outside_it_and_the_frame_changes() {
     let off = off_axis_mm(&truth, eye);
     // Stopped short of the wall by about the camera's radius (the field's bound is on voxel
     // centres, so within a voxel of it), yet well on its way.
-    assert!(off <= truth.radius_mm - radius + 1.0, "{off} mm off axis, wall at {}", truth.radius_mm);
-    assert!(off >= truth.radius_mm - radius - 1.5, "stopped early: {off} mm");
+    assert!(
+        off <= truth.radius_mm - radius + 1.0,
+        "{off} mm off axis, wall at {}",
+        truth.radius_mm
+    );
+    assert!(
+        off >= truth.radius_mm - radius - 1.5,
+        "stopped early: {off} mm"
+    );
     let after = settled(&mut session);
-    assert!(mean_difference(&before, &after) > 5.0, "the frame did not change");
+    assert!(
+        mean_difference(&before, &after) > 5.0,
+        "the frame did not change"
+    );
     // Without collision the same flight goes through the wall.
     session.controls.collision = false;
     session.fly(forward(10.0));
@@ -44,7 +57,11 @@ fn flying_along_the_tube_slides_along_the_wall() {
         session.fly(forward(0.5));
     }
     let d = session.fly_camera().eye_mm() - truth.centre_mm;
-    assert!(d.dot(truth.axis) > 10.0, "only {} mm along the tube", d.dot(truth.axis));
+    assert!(
+        d.dot(truth.axis) > 10.0,
+        "only {} mm along the tube",
+        d.dot(truth.axis)
+    );
     assert!(off_axis_mm(&truth, session.fly_camera().eye_mm()) < truth.radius_mm);
 }
 
@@ -54,7 +71,10 @@ fn changing_the_isovalue_changes_the_next_frame() {
     let before = settled(&mut session);
     session.controls.iso_hu = 100.0;
     let after = settled(&mut session);
-    assert!(mean_difference(&before, &after) > 1.0, "the isovalue did nothing");
+    assert!(
+        mean_difference(&before, &after) > 1.0,
+        "the isovalue did nothing"
+    );
     // A setting out of range is reported and the view stays.
     session.controls.iso_opacity = 2.0;
     session.sync(false);
@@ -62,7 +82,14 @@ fn changing_the_isovalue_changes_the_next_frame() {
     while session.worker().error().is_none() && std::time::Instant::now() < deadline {
         std::thread::sleep(Duration::from_millis(5));
     }
-    assert!(session.worker().error().is_some_and(|e| e.contains("opacity")), "{:?}", session.worker().error());
+    assert!(
+        session
+            .worker()
+            .error()
+            .is_some_and(|e| e.contains("opacity")),
+        "{:?}",
+        session.worker().error()
+    );
 }
 
 #[test]
@@ -77,7 +104,11 @@ fn moving_views_show_a_preview_first_and_new_input_supersedes_the_frame() {
         .worker()
         .wait_for(first, Duration::from_secs(30), |_| true)
         .unwrap();
-    assert!(matches!(preview.stage, Stage::Preview(_)), "{:?}", preview.stage);
+    assert!(
+        matches!(preview.stage, Stage::Preview(_)),
+        "{:?}",
+        preview.stage
+    );
     if waiting.is_none() {
         session.sync(true);
     }
@@ -113,7 +144,10 @@ fn stereo_shows_an_anaglyph_of_two_shifted_eyes() {
             .zip(stereo.image.rgb().chunks(3))
             .any(|(m, s)| m[c].abs_diff(s[c]) > 8)
     };
-    assert!(channel_differs(0) && channel_differs(1), "not two shifted eyes");
+    assert!(
+        channel_differs(0) && channel_differs(1),
+        "not two shifted eyes"
+    );
 }
 
 #[test]
@@ -145,7 +179,10 @@ fn two_key_frames_play_from_the_first_to_the_second() {
     assert!((session.fly_camera().eye_mm() - end.eye_mm()).length() < 1e-6);
     assert!((session.fly_camera().forward() - end.forward()).length() < 1e-6);
     assert!(session.playback().unwrap().finished());
-    assert!(mean_difference(&first, &last) > 1.0, "the flight shows the same picture");
+    assert!(
+        mean_difference(&first, &last) > 1.0,
+        "the flight shows the same picture"
+    );
     // Forward along the tube all the way, never back.
     assert!(along.windows(2).all(|w| w[1] >= w[0] - 1e-9), "{along:?}");
     // Along the tube the whole way.
@@ -165,8 +202,14 @@ fn marks_lie_on_the_wall_and_measure_between_them() {
     let [a, b] = [0, 1].map(|i| session.annotations()[i].point_mm);
     for p in [a, b] {
         let off = off_axis_mm(&truth, p);
-        assert!((off - truth.radius_mm).abs() < 1.0, "mark {off} mm off axis");
+        assert!(
+            (off - truth.radius_mm).abs() < 1.0,
+            "mark {off} mm off axis"
+        );
     }
     let mm = session.measurement_mm().unwrap();
-    assert!((mm - 2.0 * truth.radius_mm).abs() < 2.0, "{mm} mm across the tube");
+    assert!(
+        (mm - 2.0 * truth.radius_mm).abs() < 2.0,
+        "{mm} mm across the tube"
+    );
 }

@@ -1,9 +1,9 @@
 //! The window on a headless egui context: loading, flying with the keys, errors.
 
+use egui::{Event, Key, Modifiers, Pos2, RawInput, Rect, Vec2};
 use endocast_core::presets::Preset;
 use endocast_viewer::app::{ViewerApp, ViewerOptions};
 use endocast_viewer::scene::ScanSource;
-use egui::{Event, Key, Modifiers, Pos2, RawInput, Rect, Vec2};
 use std::time::{Duration, Instant};
 
 fn options(source: ScanSource) -> ViewerOptions {
@@ -68,14 +68,22 @@ fn the_window_opens_a_phantom_shows_frames_and_flies_with_the_keys() {
     let moved = app.session().unwrap().fly_camera().eye_mm() - start;
     assert!(moved.dot(forward) > 1.0, "W flew {moved:?}");
     // K records a key frame, H goes back to the start.
-    let _ = ctx.run(input(vec![key(Key::K, true), key(Key::K, false)]), |ctx| app.frame_ui(ctx));
+    let _ = ctx.run(input(vec![key(Key::K, true), key(Key::K, false)]), |ctx| {
+        app.frame_ui(ctx)
+    });
     assert_eq!(app.session().unwrap().key_frames().len(), 1);
-    let _ = ctx.run(input(vec![key(Key::H, true), key(Key::H, false)]), |ctx| app.frame_ui(ctx));
+    let _ = ctx.run(input(vec![key(Key::H, true), key(Key::H, false)]), |ctx| {
+        app.frame_ui(ctx)
+    });
     assert_eq!(app.session().unwrap().fly_camera().eye_mm(), start);
     // The frame shown follows: a frame of the current view arrives.
     let generation = app.session().unwrap().worker().generation();
     run_until(&ctx, &mut app, |a| {
-        a.session().unwrap().worker().latest().is_some_and(|f| f.generation >= generation)
+        a.session()
+            .unwrap()
+            .worker()
+            .latest()
+            .is_some_and(|f| f.generation >= generation)
     });
 }
 
@@ -89,7 +97,11 @@ fn a_scan_that_cannot_be_read_says_why_and_the_app_stays_usable() {
     let mut app = ViewerApp::new(ctx.clone(), options(source));
     run_until(&ctx, &mut app, |a| !a.is_loading());
     assert!(app.session().is_none());
-    assert!(app.message().contains("/nonexistent/chest.nii.gz"), "{}", app.message());
+    assert!(
+        app.message().contains("/nonexistent/chest.nii.gz"),
+        "{}",
+        app.message()
+    );
     // Another frame draws without a session.
     let _ = ctx.run(input(Vec::new()), |ctx| app.frame_ui(ctx));
 }
