@@ -38,6 +38,9 @@ enum Command {
     Presets(commands::presets::PresetsArgs),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
+    /// The interactive workstation: fly through a scan with the slices, the controls, key
+    /// frames, marks and cases (a window; `--screenshot` grabs it and quits).
+    View(Box<commands::view::ViewArgs>),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Presets(args) => commands::presets::run(&args),
         Command::Path(args) => commands::path::run(&args),
         Command::Fly(args) => commands::fly::run(&args),
+        Command::View(args) => commands::view::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
