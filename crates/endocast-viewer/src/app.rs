@@ -8,6 +8,7 @@ use crate::panel::controls_ui;
 use crate::scene::{ScanSource, Scene};
 use crate::session::Session;
 use crate::slices::SlicesView;
+use crate::state::{Action, Ready};
 use crate::view::view_ui;
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
@@ -41,21 +42,6 @@ struct Loading {
     what: String,
     started: Instant,
     result: Receiver<Result<(Session, Option<PathBuf>), String>>,
-}
-
-/// The open session and what the window keeps beside it.
-pub(crate) struct Ready {
-    pub session: Session,
-    pub slices: SlicesView,
-    pub autosave: Autosave,
-    pub view_texture: Option<egui::TextureHandle>,
-    pub shown: Option<(u64, Stage)>,
-    /// Clicks in the view place marks instead of turning the camera.
-    pub marking: bool,
-    /// The label of the next mark.
-    pub label: String,
-    /// The last time the camera was moved by input.
-    pub last_input: Option<Instant>,
 }
 
 /// The application.
@@ -285,16 +271,6 @@ impl ViewerApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
     }
-}
-
-/// What the control panel asks of the application.
-pub(crate) enum Action {
-    /// Open the path typed in the panel (a scan, or a case file `.json`).
-    Open,
-    /// Save the case now.
-    SaveCase,
-    /// Show a line in the status bar.
-    Message(String),
 }
 
 /// "Frame 12.3 ms · quarter → 41 ms after input · eye … · wall 4.1 mm".

@@ -44,5 +44,7 @@ pub mod session;
 #[cfg(feature = "window")]
 mod slices;
 #[cfg(feature = "window")]
+mod state;
+#[cfg(feature = "window")]
 mod view;
 pub mod worker;

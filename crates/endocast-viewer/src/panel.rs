@@ -1,9 +1,9 @@
 //! The control panel: the scan, the view's controls with clinical defaults per preset, the
 //! flight, the key frames, the marks and the case.
 
-use crate::app::{Action, Ready};
 use crate::keys::HELP;
 use crate::session::Session;
+use crate::state::{Action, Ready};
 use egui::{Color32, Sense, Stroke, Vec2};
 use endocast_core::camera::Projection;
 use endocast_core::presets;

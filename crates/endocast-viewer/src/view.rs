@@ -1,9 +1,9 @@
 //! The endoscopic view: shows the newest delivered frame, flies with the keys and the mouse,
 //! and sends every change of view to the render worker.
 
-use crate::app::Ready;
 use crate::keys::{held_motion, Commands};
 use crate::session::Session;
+use crate::state::Ready;
 use egui::{Color32, Pos2, Rect, Sense, Stroke, TextureOptions, Vec2};
 use std::time::Instant;
 
