@@ -5,8 +5,9 @@
 //! batch and bisecting its bracket are in [`super::crossing`].
 
 use super::bricks::{Activity, BrickGrid};
-use super::crossing::{bisect, crosses, first_crossing, Bracket, BISECTION_LEVELS};
+use super::crossing::{bisect, crosses, first_crossing, BISECTION_LEVELS};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
+use super::ray_task::Bracket;
 use super::ray_task::{PixelOut, RayTask};
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
@@ -137,7 +138,7 @@ impl Integrator<'_> {
                 for (r, task) in rising.iter_mut().zip(chunk.iter()) {
                     *r = self.rising(&task.march, iso);
                 }
-                let brackets = avx2.search8(&self.sampler, active, iso, chunk, rising);
+                let brackets = avx2.search8(self.sampler.voxel_grid(), active, iso, chunk, rising);
                 for (task, bracket) in chunk.iter_mut().zip(brackets) {
                     task.bracket = bracket;
                 }
@@ -353,7 +354,7 @@ impl Integrator<'_> {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = self.sampler.avx2() {
             for chunk in tasks.chunks_mut(8) {
-                avx2.refine8(&self.sampler, iso, chunk, steps);
+                avx2.refine8(self.sampler.voxel_grid(), iso, chunk, steps);
             }
             return;
         }

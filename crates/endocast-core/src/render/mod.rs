@@ -60,6 +60,7 @@ mod still;
 mod tiles;
 mod transfer;
 pub mod traverse;
+mod voxel_grid;
 
 #[cfg(test)]
 mod camera_tests;
