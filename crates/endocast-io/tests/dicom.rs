@@ -94,7 +94,10 @@ fn jpeg_ls_files_decode_to_the_pixels_charls_gave() {
         assert!(loaded.source.stored_type.contains("JPEG-LS"), "{name}");
         let sum = voxel_checksum(loaded.volume.voxels());
         assert_eq!(sum, CHARLS_CHECKSUM, "{name}");
-        assert!(loaded.volume.voxels() == reference.volume.voxels(), "{name}");
+        assert!(
+            loaded.volume.voxels() == reference.volume.voxels(),
+            "{name}"
+        );
     }
 }
 
