@@ -3,11 +3,11 @@
 
 #![allow(clippy::unwrap_used)] // helpers of tests: a failed unwrap is a failed test
 
-use crate::common::shared_data;
 use dicom_dictionary_std::tags;
 use dicom_object::OpenFileOptions;
 use endocast_core::Modality;
 use endocast_io::{dicom, Format, OpenOptions, ReadError};
+use endocast_testdata::shared_data;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
