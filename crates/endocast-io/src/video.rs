@@ -392,15 +392,15 @@ impl H264Sink {
             .map_err(|e| ReadError::io(path, std::io::Error::other(e)))?;
         let file = File::create(&self.target.temporary).map_err(|e| ReadError::io(path, e))?;
         let (w, h) = encoder.padded_size();
-        // Both edges are at most MP4_MAX_EDGE + 1, checked by the caller.
+        // Both edges are at most MP4_MAX_EDGE (even), checked by the caller.
         let muxer = mp4::Mp4Muxer::new(BufWriter::new(file), w as u16, h as u16, self.fps)
             .map_err(|e| ReadError::io(path, e))?;
         Ok((encoder, muxer))
     }
 }
 
-/// The longest frame edge written to MP4 (H.264 level 6.2 allows 8192 × 4320; the sample entry
-/// holds 16 bits).
+/// The longest frame edge written to MP4 (the sample entry holds 16 bits). The built-in
+/// encoder refuses more than 3840 × 2160 itself, with its own message.
 const MP4_MAX_EDGE: usize = 16384;
 
 impl FrameSink for H264Sink {

@@ -3,14 +3,15 @@
 //! colour space browsers assume, a key frame every two seconds, no skipped frames.
 
 use openh264::encoder::{
-    BitRate, Encoder, EncoderConfig, FrameRate, FrameType, IntraFramePeriod, RateControlMode,
+    Encoder, EncoderConfig, FrameRate, FrameType, IntraFramePeriod, QpRange, RateControlMode,
     VuiConfig,
 };
 use openh264::formats::{RgbSliceU8, YUVBuffer};
 use openh264::OpenH264API;
 
-/// Bits per pixel and frame the rate control aims at: smooth rendered scenes stay sharp.
-const BITS_PER_PIXEL: f64 = 0.2;
+/// The quantiser range, constant quality without rate control (which OpenH264 cannot keep
+/// without skipping frames): about libx264's default CRF 23.
+const QP: (u8, u8) = (20, 24);
 
 /// One encoded frame: its NAL units without start codes, and whether it is a key (IDR) frame.
 #[derive(Debug)]
@@ -33,11 +34,10 @@ impl H264Encoder {
     /// An encoder for `width × height` frames shown at `fps`.
     pub fn new(width: usize, height: usize, fps: f64) -> Result<Self, String> {
         let padded = (width + width % 2, height + height % 2);
-        let bits = (padded.0 * padded.1) as f64 * fps * BITS_PER_PIXEL;
         let config = EncoderConfig::new()
-            .bitrate(BitRate::from_bps(bits.clamp(100_000.0, 50e6) as u32))
             .max_frame_rate(FrameRate::from_hz(fps as f32))
-            .rate_control_mode(RateControlMode::Bitrate)
+            .rate_control_mode(RateControlMode::Off)
+            .qp(QpRange::new(QP.0, QP.1))
             .skip_frames(false)
             .intra_frame_period(IntraFramePeriod::from_num_frames(
                 (2.0 * fps).round().max(1.0) as u32,
