@@ -141,7 +141,7 @@ fn mp4_needs_no_ffmpeg_and_holds_every_frame() {
     let route = tube_path(dir.path(), &tube, "p.json");
     let fly = |out: &str, path_var: &Path| {
         let status = std::process::Command::new(env!("CARGO_BIN_EXE_endocast"))
-            .args(["fly", &tube, "--path", &route, "--iso", "-480"])
+            .args(["fly", &tube, "--path", &route, "--iso", "-480", "--json"])
             .args(["--size", "48x48", "--frame-step", "6", "-o", out])
             .env("PATH", path_var)
             .output()
@@ -151,17 +151,20 @@ fn mp4_needs_no_ffmpeg_and_holds_every_frame() {
             "{}",
             String::from_utf8_lossy(&status.stderr)
         );
+        let report: serde_json::Value = serde_json::from_slice(&status.stdout).unwrap();
+        report["frames"].as_u64().unwrap() as usize
     };
     // PATH holds nothing: no ffmpeg to fall back on.
     let empty = tempfile::tempdir().unwrap();
     let mp4 = dir.path().join("f.mp4");
-    fly(mp4.to_str().unwrap(), empty.path());
+    let reported = fly(mp4.to_str().unwrap(), empty.path());
     let bytes = std::fs::read(&mp4).unwrap();
     assert_eq!(&bytes[4..8], b"ftyp");
     let frames = dir.path().join("frames");
-    fly(frames.to_str().unwrap(), empty.path());
+    assert_eq!(fly(frames.to_str().unwrap(), empty.path()), reported);
     let pngs = std::fs::read_dir(&frames).unwrap().count();
     assert!(pngs > 1);
+    assert_eq!(pngs, reported, "--json reports the frames written");
     assert_eq!(
         mp4_frames(&bytes) as usize,
         pngs,

@@ -78,6 +78,9 @@ pub struct FlyArgs {
     /// (1 seen, 2 unseen wall voxels).
     #[arg(long)]
     coverage: bool,
+    /// Print the result (output, frames, length, speed, coverage) as JSON on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 /// The `--layout` choices.
@@ -159,18 +162,37 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     }
     progress.finish();
     let written = sinks.finish()?;
-    println!(
-        "{}: {} frames along {:.1} mm ({:.1} frames/s)",
-        written.display(),
-        shots.len(),
-        route.len_mm(),
-        progress.rate()
-    );
+    if !args.json {
+        println!(
+            "{}: {} frames along {:.1} mm ({:.1} frames/s)",
+            written.display(),
+            shots.len(),
+            route.len_mm(),
+            progress.rate()
+        );
+    }
+    let mut coverage = None;
     if let Some(forward) = flight.into_coverage() {
         let lumen = lumen.as_ref().context("coverage needs the lumen")?;
         let seen = fly_back(args, &renderer, &route, &options, &settings, forward)?;
         let geometry = renderer.volume().geometry();
-        fly_coverage::report(&args.output, geometry, lumen, &seen)?;
+        coverage = Some(fly_coverage::report(
+            &args.output,
+            geometry,
+            lumen,
+            &seen,
+            args.json,
+        )?);
+    }
+    if args.json {
+        let summary = serde_json::json!({
+            "output": written,
+            "frames": shots.len(),
+            "length_mm": route.len_mm(),
+            "frames_per_s": progress.rate(),
+            "coverage": coverage,
+        });
+        println!("{}", serde_json::to_string_pretty(&summary)?);
     }
     Ok(())
 }
