@@ -37,6 +37,10 @@ pub struct LookArgs {
     /// Jitter each pixel's samples by a deterministic per-pixel offset.
     #[arg(long)]
     jitter: bool,
+    /// Shade DVR samples with their gradient (Blinn-Phong; six extra samples per visible sample).
+    /// The hybrid mode never shades behind its surface.
+    #[arg(long)]
+    shade_dvr: bool,
     /// Skip empty bricks (the image is the same either way, only slower without).
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "true|false")]
     skip_empty: bool,
@@ -81,6 +85,7 @@ impl LookArgs {
             s.step_vox = finite("--step", step)?;
         }
         s.jitter = self.jitter;
+        s.shade_dvr |= self.shade_dvr;
         s.skip_empty = self.skip_empty;
         Ok(s)
     }

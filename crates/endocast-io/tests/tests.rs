@@ -2,11 +2,11 @@
 
 #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
-mod common;
 mod cross_format;
 mod dicom;
 mod image_out;
 mod metaimage;
+mod mp4;
 mod nifti;
 mod nrrd;
 mod stereo_real_scans;

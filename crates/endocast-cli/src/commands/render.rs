@@ -60,7 +60,7 @@ pub struct RenderArgs {
     /// Also write the depth image: float32 .npy, mm from the eye to the first hit, NaN where none.
     #[arg(long, value_name = "FILE.npy")]
     depth_out: Option<PathBuf>,
-    /// Print the frame's statistics as JSON.
+    /// Print the frame's statistics and the camera pose it used as JSON.
     #[arg(long)]
     json: bool,
     /// Trace one pixel and print every sample along its ray.
@@ -116,7 +116,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&stats_json(&frame, &settings))?
+            serde_json::to_string_pretty(&stats_json(&frame, &settings, &camera))?
         );
     } else {
         println!(
@@ -249,9 +249,22 @@ fn print_trace(prepared: &Prepared, camera: &Camera, x: usize, y: usize) -> Resu
     Ok(())
 }
 
-fn stats_json(frame: &Frame, settings: &RenderSettings) -> serde_json::Value {
+/// The frame's statistics and the camera that took it (world mm, LPS; `field`: degrees across
+/// the image height, or mm of view height for an orthographic lens).
+fn stats_json(frame: &Frame, settings: &RenderSettings, camera: &Camera) -> serde_json::Value {
     let s = &frame.stats;
+    let v = |v: DVec3| [v.x, v.y, v.z];
     json!({
+        "camera": {
+            "eye": v(camera.eye_mm()),
+            "look_direction": v(camera.forward()),
+            "up": v(camera.up()),
+            "field": camera.field(),
+            "projection": camera.projection().name(),
+            "near_mm": camera.near_mm(),
+            "distortion": camera.lens().distortion,
+            "vignetting": camera.lens().vignetting,
+        },
         "mode": settings.mode.name(),
         "width": frame.width,
         "height": frame.height,
