@@ -9,6 +9,7 @@ mod image_out;
 mod metaimage;
 mod nifti;
 mod nrrd;
+mod peel_real_scans;
 mod stereo_real_scans;
 mod test_volumes;
 mod transfer_json;

@@ -224,7 +224,7 @@ impl Derived {
         }
         let activity = Activity::classify(&renderer.grid, &isovalues, &table);
         let after = peel.then(|| {
-            let tf = &settings.peel.tf_after;
+            let tf = settings.peel.tf_after.as_ref().unwrap_or(&settings.tf);
             let after = TfTable::new(tf, map, volume.stored_range(), step_mm);
             let active = Activity::classify(&renderer.grid, &[], &after).tf;
             (after, active)

@@ -139,7 +139,7 @@ fn bone_tf(color: [f32; 3], alpha_per_mm: f32) -> TransferFunction {
 fn layered(keep: f32, unpeeled: Unpeeled, layer: PeelLayer) -> RenderSettings {
     let mut s = peel(layer, true);
     s.tf = bone_tf([1.0, 0.0, 0.0], 0.03);
-    s.peel.tf_after = bone_tf([0.0, 0.0, 1.0], 0.05);
+    s.peel.tf_after = Some(bone_tf([0.0, 0.0, 1.0], 0.05));
     (s.iso_opacity, s.iso_color) = (0.5, [0.0, 1.0, 0.0]);
     // No white highlight: red comes from the front alone.
     s.lighting.specular = 0.0;

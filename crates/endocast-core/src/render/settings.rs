@@ -123,8 +123,8 @@ pub struct PeelSettings {
     pub keep: f32,
     /// What rays without the wanted peel show. Default [`Unpeeled::Discard`].
     pub unpeeled: Unpeeled,
-    /// Transfer function behind the peel. Default the `ramp` preset, as [`RenderSettings::tf`].
-    pub tf_after: TransferFunction,
+    /// Transfer function behind the peel; `None` (the default) takes [`RenderSettings::tf`].
+    pub tf_after: Option<TransferFunction>,
 }
 
 impl Default for PeelSettings {
@@ -135,7 +135,7 @@ impl Default for PeelSettings {
             falling: false,
             keep: 0.0,
             unpeeled: Unpeeled::Discard,
-            tf_after: TransferFunction::ramp(-700.0, -300.0),
+            tf_after: None,
         }
     }
 }
