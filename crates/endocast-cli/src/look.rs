@@ -88,6 +88,9 @@ impl LookArgs {
         s.jitter = self.jitter;
         s.skip_empty = self.skip_empty;
         self.peel.apply(&mut s)?;
+        if let Some(spec) = self.peel.tf_after() {
+            s.peel.tf_after = Some(transfer_function(spec)?);
+        }
         Ok(s)
     }
 }

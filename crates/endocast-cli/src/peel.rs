@@ -1,6 +1,5 @@
 //! The depth-peeling options (`--mode peel`), shared by every command that renders.
 
-use crate::look::transfer_function;
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use endocast_core::render::{PeelLayer, RenderSettings, Unpeeled};
@@ -39,7 +38,12 @@ enum UnpeeledArg {
 }
 
 impl PeelArgs {
-    /// Applies the options given to `settings`.
+    /// The `--tf-after` given, a file or a preset name, for the caller to read.
+    pub fn tf_after(&self) -> Option<&str> {
+        self.tf_after.as_deref()
+    }
+
+    /// Applies the options given to `settings`, all but [`Self::tf_after`].
     pub fn apply(&self, settings: &mut RenderSettings) -> Result<()> {
         let peel = &mut settings.peel;
         if let Some(layer) = self.peel {
@@ -63,9 +67,6 @@ impl PeelArgs {
                 UnpeeledArg::Discard => Unpeeled::Discard,
                 UnpeeledArg::Context => Unpeeled::Context,
             };
-        }
-        if let Some(spec) = &self.tf_after {
-            peel.tf_after = Some(transfer_function(spec)?);
         }
         Ok(())
     }
