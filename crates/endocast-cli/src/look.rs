@@ -1,6 +1,7 @@
 //! The options that decide how a scan looks (preset, mode, isovalues, transfer function,
 //! sampling) and how many threads render it; shared by `render` and `bench`.
 
+use crate::peel::PeelArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::presets::{self, Preset};
@@ -15,7 +16,7 @@ pub struct LookArgs {
     /// override the preset.
     #[arg(long)]
     preset: Option<String>,
-    /// iso, dvr, hybrid, two-iso, mip or minip (default: the preset's, else hybrid).
+    /// iso, dvr, hybrid, two-iso, mip, minip or peel (default: the preset's, else hybrid).
     #[arg(long)]
     mode: Option<String>,
     /// Isovalue of the lumen wall, physical units (HU for CT).
@@ -44,6 +45,8 @@ pub struct LookArgs {
     /// Skip empty bricks (the image is the same either way, only slower without).
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "true|false")]
     skip_empty: bool,
+    #[command(flatten)]
+    peel: PeelArgs,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -63,7 +66,9 @@ impl LookArgs {
         };
         if let Some(mode) = &self.mode {
             s.mode = Mode::from_name(mode).with_context(|| {
-                format!("unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip or minip")
+                format!(
+                    "unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip, minip or peel"
+                )
             })?;
         }
         if let Some(iso) = self.iso {
@@ -87,6 +92,10 @@ impl LookArgs {
         s.jitter = self.jitter;
         s.shade_dvr |= self.shade_dvr;
         s.skip_empty = self.skip_empty;
+        self.peel.apply(&mut s)?;
+        if let Some(spec) = self.peel.tf_after() {
+            s.peel.tf_after = Some(transfer_function(spec)?);
+        }
         Ok(s)
     }
 }

@@ -6,6 +6,7 @@ mod look;
 mod lumen;
 mod optics;
 mod parse;
+mod peel;
 mod progress;
 
 use clap::{Parser, Subcommand};

@@ -158,6 +158,58 @@ fn bench_takes_size_and_prints_json_lines_on_stdout() {
 }
 
 #[test]
+fn peels_of_the_joint_phantom_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = dir.path().join("joint.nii.gz");
+    let v = volume.to_str().unwrap();
+    assert!(endocast(&["phantom", "joint", "-o", v, "--size", "64"])
+        .status
+        .success());
+    // The eye on the axis 10 mm below the first joint space (its lower surface 1.25 mm below
+    // the centre, the second joint space 12.8 mm higher), looking up across both.
+    let depth = dir.path().join("depth.npy");
+    let png = dir.path().join("peel.png");
+    for (peel, expected) in [("1", 8.75), ("2", 21.55), ("last", 21.55)] {
+        let out = endocast(&[
+            "render",
+            v,
+            "-o",
+            png.to_str().unwrap(),
+            "--mode",
+            "peel",
+            "--peel",
+            peel,
+            "--peel-threshold",
+            "650",
+            "--peel-falling",
+            "--eye",
+            "0,0,-10",
+            "--look-at",
+            "0,0,1",
+            "--up",
+            "0,1,0",
+            "--size",
+            "3x3",
+            "--fov",
+            "10",
+            "--depth-out",
+            depth.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (_, values) = read_npy(&depth);
+        assert!(
+            (values[4] - expected).abs() < 0.1,
+            "peel {peel}: {}",
+            values[4]
+        );
+    }
+}
+
+#[test]
 fn bad_render_options_are_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let volume = dir.path().join("v.nii");
@@ -185,6 +237,11 @@ fn bad_render_options_are_clear_errors() {
         (vec!["--iso-opacity", "1.5"], "iso-opacity"),
         (vec!["--size", "0x10"], "size"),
         (vec!["--threads", "0"], "threads"),
+        (vec!["--peel", "0"], "--peel"),
+        (vec!["--peel-keep", "1.5"], "peel-keep"),
+        (vec!["--unpeeled", "maybe"], "maybe"),
+        (vec!["--tf-after", "/no/such/after.json"], "after.json"),
+        (vec!["--peel-threshold", "inf"], "peel-threshold"),
     ] {
         let mut args = vec!["render", v, "-o", o];
         args.extend(extra.iter().copied());

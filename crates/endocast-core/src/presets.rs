@@ -19,7 +19,7 @@
 
 use crate::camera::Projection;
 use crate::navigate::LumenSide;
-use crate::render::{Mode, RenderSettings, TransferFunction};
+use crate::render::{Mode, PeelLayer, PeelSettings, RenderSettings, TransferFunction};
 use crate::views::slices::Window;
 
 /// Vertical field of view of a pinhole endoscope, degrees: the default of every preset and of
@@ -35,6 +35,19 @@ pub struct Surface {
     pub opacity: f32,
     /// Colour before shading, 0–1 (sRGB); `None` keeps [`RenderSettings`]' default.
     pub color: Option<[f32; 3]>,
+}
+
+/// The depth peeling of a [`Mode::Peel`] preset (see [`PeelSettings`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PresetPeel {
+    /// Peel threshold, physical units.
+    pub threshold: f64,
+    /// Whether crossings into the darker material count (else into the brighter).
+    pub falling: bool,
+    /// The peel shown.
+    pub layer: PeelLayer,
+    /// Name of the transfer function behind the peel (see [`TransferFunction::preset`]).
+    pub tf_after: &'static str,
 }
 
 /// The lumen a preset flies through: region growing keeps the voxels on `side` of `threshold`.
@@ -68,6 +81,8 @@ pub struct Preset {
     pub iso_color: Option<[f32; 3]>,
     /// The second isosurface of [`Mode::TwoIso`], where the preset has one.
     pub iso2: Option<Surface>,
+    /// The peel of [`Mode::Peel`], where the preset has one.
+    pub peel: Option<PresetPeel>,
     /// The lumen a flight navigates; `None` for the benchmark presets, which are no procedure.
     pub lumen: Option<PresetLumen>,
     /// Window of the slice views, physical units.
@@ -92,6 +107,7 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
@@ -109,6 +125,7 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         // −900, not −500: at −500 the thin bronchial wall leaks into the lung (−820…−950 HU).
         lumen: Some(PresetLumen {
             threshold: -900.0,
@@ -136,6 +153,7 @@ pub const ALL: &[Preset] = &[
             opacity: 1.0,
             color: None,
         }),
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: 130.0,
             side: LumenSide::Above,
@@ -157,6 +175,7 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
@@ -178,6 +197,7 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: 75.0,
             side: LumenSide::Below,
@@ -191,6 +211,42 @@ pub const ALL: &[Preset] = &[
         fov_deg: DEFAULT_FOV_DEG,
     },
     Preset {
+        name: "arthroscopy",
+        description:
+            "T1 MRI joint: from inside one bone, the opposing bone's surface past the joint \
+                      space (peel back into tissue above 30)",
+        mode: Mode::Peel,
+        tf: "arthroscopy",
+        // The peel draws the opposing bone as an opaque surface.
+        iso: 30.0,
+        iso_opacity: 1.0,
+        iso_color: Some([0.93, 0.88, 0.78]),
+        iso2: None,
+        // Measured on shared/data/knee-mri (T1, no contrast). Around the femorotibial joint
+        // two-class Otsu splits the dark joint space, cortex and menisci (mean 24) from marrow
+        // (48) at 36, but 36 lies inside the femoral marrow's texture (median 41, quartile 34),
+        // which would peel; 30 lies midway between the dark class and the tibial marrow's 10th
+        // percentile (35). From inside one bone the first crossing back above it is the other.
+        peel: Some(PresetPeel {
+            threshold: 30.0,
+            falling: false,
+            layer: PeelLayer::Nth(1),
+            tf_after: "arthroscopy",
+        }),
+        // The bones' marrow is the "lumen" the eye starts in.
+        lumen: Some(PresetLumen {
+            threshold: 30.0,
+            side: LumenSide::Above,
+        }),
+        // T1 intensity units: joint space black, marrow light grey.
+        window: Window {
+            level_hu: 50.0,
+            width_hu: 100.0,
+        },
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+    },
+    Preset {
         name: "ramp",
         description: "benchmark: the paper's Table 1 alpha ramp (-700 to -300 HU), wall 50 %",
         mode: Mode::Hybrid,
@@ -199,6 +255,7 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.5,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: None,
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
@@ -213,6 +270,7 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.5,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: None,
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
@@ -264,6 +322,15 @@ impl Preset {
         if let Some(color) = self.iso_color {
             s.iso_color = color;
         }
+        if let Some(peel) = self.peel {
+            s.peel = PeelSettings {
+                threshold_hu: Some(peel.threshold),
+                falling: peel.falling,
+                layer: peel.layer,
+                tf_after: TransferFunction::preset(peel.tf_after),
+                ..PeelSettings::default()
+            };
+        }
         if let Some(upper) = self.iso2 {
             s.iso2_hu = upper.iso;
             s.iso2_opacity = upper.opacity;
@@ -289,10 +356,10 @@ mod tests {
             assert!(!preset.description.is_empty() && !preset.description.contains('\n'));
         }
         assert_eq!(Preset::find("gastroscopy"), None);
-        assert_eq!(iter().count(), 7);
+        assert_eq!(iter().count(), 8);
         assert_eq!(
             lumen_names(),
-            "colonoscopy, bronchoscopy, angioscopy, sinus, ventricles"
+            "colonoscopy, bronchoscopy, angioscopy, sinus, ventricles, arthroscopy"
         );
     }
 
@@ -304,6 +371,11 @@ mod tests {
             assert_eq!(s.tf, TransferFunction::preset(preset.tf).unwrap());
             assert!(preset.window.width_hu > 0.0);
             assert_eq!(preset.iso2.is_some(), preset.mode == Mode::TwoIso);
+            assert_eq!(preset.peel.is_some(), preset.mode == Mode::Peel);
+            if let Some(peel) = preset.peel {
+                assert!(TransferFunction::preset(peel.tf_after).is_some());
+                assert_eq!(s.peel_threshold_hu(), peel.threshold);
+            }
             assert!((10.0..=170.0).contains(&preset.fov_deg));
         }
     }

@@ -9,6 +9,7 @@ mod metaimage;
 mod mp4;
 mod nifti;
 mod nrrd;
+mod peel_real_scans;
 mod stereo_real_scans;
 mod test_volumes;
 mod transfer_json;

@@ -1,7 +1,8 @@
 //! `endocast bench`: frames per second along a fixed fly path. Without a scan it runs the
 //! protocol of Scharsach et al.'s Tables 1 and 2 on the colon phantom (512×512×478 at the default
 //! size): iso-only, then the hybrid mode at isosurface opacity 100 / 80 / 50 / 0 % with a simple
-//! ramp and a complex transfer function; with a scan and `--path` it measures one setting.
+//! ramp and a complex transfer function, then depth peeling; with a scan and `--path` it measures
+//! one setting.
 
 use crate::look::{find_preset, in_pool, LookArgs};
 use crate::optics::{LensArgs, StereoArgs};
@@ -12,7 +13,8 @@ use endocast_core::camera::StereoRig;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::{
-    Camera, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, Renderer, StereoFrames,
+    Camera, Frame, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings, Renderer,
+    StereoFrames,
 };
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::OpenOptions;
@@ -233,7 +235,33 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
             });
         }
     }
+    cells.extend(peel_cells(&base));
     Ok((Renderer::for_many_frames(volume), poses, cells))
+}
+
+/// Depth peeling on the colon (issue 19) at the wall's isovalue: the first peel is the wall the
+/// iso-only cell shows; the second and the last are the next loops of the colon behind it, the
+/// front discarded (a search alone) or kept at 30 % through the transfer function of the options
+/// (the ramp by default).
+fn peel_cells(base: &RenderSettings) -> Vec<Cell> {
+    [
+        ("peel 1", PeelLayer::Nth(1), 0.0),
+        ("peel 2", PeelLayer::Nth(2), 0.0),
+        ("peel last", PeelLayer::Last, 0.0),
+        ("peel 2, 30 % of the front kept", PeelLayer::Nth(2), 0.3),
+    ]
+    .into_iter()
+    .map(|(name, layer, keep)| {
+        let mut s = base.clone();
+        s.mode = Mode::Peel;
+        s.peel.threshold_hu = None;
+        (s.peel.layer, s.peel.keep) = (layer, keep);
+        Cell {
+            name: name.into(),
+            settings: s,
+        }
+    })
+    .collect()
 }
 
 /// A scan, the path the user gave, and the one setting the options describe.

@@ -2,9 +2,13 @@
 //! pieces — [`Integrator::search`] and [`Integrator::refine`] (the isosurface hit of §3.3),
 //! [`Integrator::surface`] (gradient, normal, Blinn-Phong), [`Integrator::composite`]
 //! (front-to-back DVR with early termination) — over a [`RayMarch`]. Finding a crossing in a
-//! batch and bisecting its bracket are in [`super::crossing`].
+//! batch and bisecting its bracket are in [`super::crossing`]; depth peeling is in [`peel`].
 
-use super::bricks::{Activity, BrickGrid};
+mod peel;
+
+pub(crate) use peel::PeelParams;
+
+use super::bricks::{Activity, BitSet, BrickGrid};
 use super::crossing::{bisect, crosses, first_crossing, BISECTION_LEVELS};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
 use super::ray_task::Bracket;
@@ -54,6 +58,15 @@ pub(crate) struct Params {
     pub refine_steps: u32,
     pub shade_dvr: bool,
     pub skip_empty: bool,
+    pub peel: PeelParams,
+}
+
+/// A transfer function as a walk reads it: its lookup table and the bricks in which it is not
+/// transparent.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Classified<'a> {
+    pub table: &'a TfTable,
+    pub active: &'a BitSet,
 }
 
 /// The per-frame context of the integrators.
@@ -62,6 +75,8 @@ pub(crate) struct Integrator<'a> {
     pub grid: &'a BrickGrid,
     pub activity: &'a Activity,
     pub table: &'a TfTable,
+    /// The transfer function behind a peel ([`Mode::Peel`]; the same as `table` otherwise).
+    pub after: Classified<'a>,
     pub shader: Shader,
     pub params: Params,
     /// The eye (voxel space) and the crossing side of the lower isovalue for rays starting
@@ -83,6 +98,15 @@ impl Integrator<'_> {
             Mode::TwoIso => self.two_iso(march, dir_world, probe),
             Mode::Mip => self.extreme(march, probe, |a, b| a > b),
             Mode::Minip => self.extreme(march, probe, |a, b| a < b),
+            Mode::Peel => self.peel(march, dir_world, probe),
+        }
+    }
+
+    /// The transfer function of every mode but the part of a peel behind its surface.
+    fn before(&self) -> Classified<'_> {
+        Classified {
+            table: self.table,
+            active: &self.activity.tf,
         }
     }
 
@@ -95,7 +119,13 @@ impl Integrator<'_> {
     /// Whether brick `b` can hold a visible DVR sample.
     #[inline]
     fn tf_active(&self, b: u32) -> bool {
-        !self.params.skip_empty || self.activity.tf.get(b as usize)
+        self.active_in(&self.activity.tf, b)
+    }
+
+    /// Whether brick `b` is set in `active` (every brick is without empty-space skipping).
+    #[inline]
+    fn active_in(&self, active: &BitSet, b: u32) -> bool {
+        !self.params.skip_empty || active.get(b as usize)
     }
 
     /// Renders a group of rays, each as [`Self::run`] would. Iso and hybrid go phase by phase
@@ -418,17 +448,18 @@ impl Integrator<'_> {
             .shade(color, self.shader.normal(gradient), dir_world)
     }
 
-    /// Composites one DVR sample through the transfer function, shaded on request.
+    /// Composites one DVR sample through the transfer function `table`, shaded on request.
     #[inline(always)]
     fn add_sample(
         &self,
+        table: &TfTable,
         acc: &mut Accum,
         line: SampleGrid,
         s: Sample,
         dir_world: Vec3,
         shade: bool,
     ) {
-        let entry = self.table.lookup(s.value);
+        let entry = table.lookup(s.value);
         let alpha = entry.w;
         let mut rgb = Vec3A::from_vec4(entry);
         if shade {
@@ -452,6 +483,18 @@ impl Integrator<'_> {
         shade: bool,
         probe: &mut P,
     ) {
+        self.composite_with(self.before(), march, out, (dir_world, shade), probe);
+    }
+
+    /// [`Self::composite`] through the transfer function `tf`.
+    fn composite_with<P: Probe>(
+        &self,
+        tf: Classified<'_>,
+        march: &mut RayMarch,
+        out: &mut PixelOut,
+        (dir_world, shade): (Vec3, bool),
+        probe: &mut P,
+    ) {
         let stop = self.params.early_termination;
         if out.accum.alpha() >= stop {
             out.terminated = true;
@@ -461,50 +504,20 @@ impl Integrator<'_> {
         let mut acc = out.accum;
         let line = march.grid();
         let mode = Walk::COMPOSITE;
-        let active = |b| self.tf_active(b);
+        let active = |b| self.active_in(tf.active, b);
         let terminated = if shade || P::TRACES {
             march.walk(&self.sampler, mode, active, |s: Sample| {
-                self.add_sample(&mut acc, line, s, dir_world, shade);
+                self.add_sample(tf.table, &mut acc, line, s, dir_world, shade);
                 probe.sample(s.t, s.value, acc.alpha());
                 until_opaque(acc.alpha(), stop)
             })
         } else {
             march.walk_batches(&self.sampler, mode, active, |batch| {
-                self.composite_batch(&mut acc, &batch, stop)
+                composite_batch(tf.table, &mut acc, &batch, stop)
             })
         };
         out.accum = acc;
         out.terminated = terminated;
-    }
-
-    /// Unshaded compositing of a whole batch, with the same operations in the same order as
-    /// one sample at a time, but without a test per sample: the opacity only grows, so the
-    /// batch is redone one by one only when it ends at or past `stop`, to stop at the exact
-    /// sample.
-    #[inline(always)]
-    fn composite_batch(&self, acc: &mut Accum, batch: &Batch, stop: f32) -> Option<Stopped> {
-        let entries = self.table.lookup8(&batch.values);
-        let entries = &entries[..batch.count];
-        let mut whole = *acc;
-        for entry in entries {
-            whole.under(Vec3A::from_vec4(*entry), entry.w);
-        }
-        if whole.alpha() < stop {
-            *acc = whole;
-            return None;
-        }
-        let mut taken = 0;
-        for entry in entries {
-            acc.under(Vec3A::from_vec4(*entry), entry.w);
-            taken += 1;
-            if acc.alpha() >= stop {
-                break;
-            }
-        }
-        Some(Stopped {
-            taken,
-            next: batch.first + taken as i32,
-        })
     }
 
     /// Two surfaces and DVR outside both: every sample is tested for a crossing of either
@@ -530,7 +543,8 @@ impl Integrator<'_> {
                     self.add_crossed_surfaces(acc, depth, (line, dir_world), previous, after);
                 }
                 if s.value < lower.iso || s.value > upper.iso {
-                    self.add_sample(acc, line, s, dir_world, self.params.shade_dvr);
+                    let shade = self.params.shade_dvr;
+                    self.add_sample(self.table, acc, line, s, dir_world, shade);
                 }
                 previous = (s.t, s.value);
                 probe.sample(s.t, s.value, acc.alpha());
@@ -620,6 +634,35 @@ impl Integrator<'_> {
         }
         out
     }
+}
+
+/// Unshaded compositing of a whole batch through `table`, with the same operations in the same
+/// order as one sample at a time, but without a test per sample: the opacity only grows, so the
+/// batch is redone one by one only when it ends at or past `stop`, to stop at the exact sample.
+#[inline(always)]
+fn composite_batch(table: &TfTable, acc: &mut Accum, batch: &Batch, stop: f32) -> Option<Stopped> {
+    let entries = table.lookup8(&batch.values);
+    let entries = &entries[..batch.count];
+    let mut whole = *acc;
+    for entry in entries {
+        whole.under(Vec3A::from_vec4(*entry), entry.w);
+    }
+    if whole.alpha() < stop {
+        *acc = whole;
+        return None;
+    }
+    let mut taken = 0;
+    for entry in entries {
+        acc.under(Vec3A::from_vec4(*entry), entry.w);
+        taken += 1;
+        if acc.alpha() >= stop {
+            break;
+        }
+    }
+    Some(Stopped {
+        taken,
+        next: batch.first + taken as i32,
+    })
 }
 
 /// Stop the march once the accumulated opacity reaches the early-termination threshold.

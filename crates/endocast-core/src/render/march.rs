@@ -89,6 +89,12 @@ impl Walk {
         join: true,
         long: true,
     };
+    /// Compositing in front of a peel: crossings tested too, and resumed after each one.
+    pub const PEEL: Self = Self {
+        padded: true,
+        join: true,
+        long: false,
+    };
     /// MIP/MinIP: bricks judged one by one against the extreme so far.
     pub const EXTREME: Self = Self {
         padded: false,

@@ -67,6 +67,8 @@ mod camera_tests;
 #[cfg(test)]
 mod interactive_tests;
 #[cfg(test)]
+mod peel_tests;
+#[cfg(test)]
 mod tests;
 
 pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
@@ -77,14 +79,16 @@ pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
 pub use options::{Cancelled, Progress, Quality, RenderOptions};
 pub use progressive::progressive;
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
-pub use settings::{Crossing, Mode, RenderSettings, SettingsError};
+pub use settings::{
+    Crossing, Mode, PeelLayer, PeelSettings, RenderSettings, SettingsError, Unpeeled,
+};
 pub use stereo::StereoFrames;
 pub use still::{Jitter, Still};
 pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
 use frame::to_u8;
 use glam::{DAffine3, DVec3, Vec3};
-use integrate::{Integrator, Params, Probe, Surface};
+use integrate::{Classified, Integrator, Params, PeelParams, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
 #[cfg(target_arch = "x86_64")]
@@ -185,6 +189,8 @@ struct Derived {
     settings: RenderSettings,
     table: TfTable,
     activity: Activity,
+    /// The transfer function behind a peel and its active bricks ([`Mode::Peel`] only).
+    after: Option<(TfTable, BitSet)>,
     params: Params,
     shader: Shader,
     step_mm: f64,
@@ -205,12 +211,25 @@ impl Derived {
         } else {
             (settings.iso2_hu, settings.iso_hu)
         };
-        let mut isovalues = vec![stored(settings.iso_hu)];
+        let peel = settings.mode == Mode::Peel;
+        // A peel's surface is its threshold's.
+        let wall_hu = if peel {
+            settings.peel_threshold_hu()
+        } else {
+            settings.iso_hu
+        };
+        let mut isovalues = vec![stored(wall_hu)];
         if settings.mode == Mode::TwoIso {
             table.make_transparent_between(stored(lower_hu), stored(upper_hu));
             isovalues.push(stored(settings.iso2_hu));
         }
         let activity = Activity::classify(&renderer.grid, &isovalues, &table);
+        let after = peel.then(|| {
+            let tf = settings.peel.tf_after.as_ref().unwrap_or(&settings.tf);
+            let after = TfTable::new(tf, map, volume.stored_range(), step_mm);
+            let active = Activity::classify(&renderer.grid, &[], &after).tf;
+            (after, active)
+        });
         let surface = |iso_hu: f64, opacity: f32, color: [f32; 3]| Surface {
             iso: stored(iso_hu),
             opacity,
@@ -218,19 +237,31 @@ impl Derived {
         };
         let params = Params {
             mode: settings.mode,
-            lower: surface(settings.iso_hu, settings.iso_opacity, settings.iso_color),
+            lower: surface(wall_hu, settings.iso_opacity, settings.iso_color),
             upper: surface(settings.iso2_hu, settings.iso2_opacity, settings.iso2_color),
             crossing: settings.crossing,
             early_termination: settings.early_termination,
             refine_steps: settings.refine_steps,
             shade_dvr: settings.shade_dvr,
             skip_empty: settings.skip_empty,
+            peel: PeelParams {
+                nth: match settings.peel.layer {
+                    PeelLayer::Nth(n) => Some(n),
+                    PeelLayer::Last => None,
+                },
+                // Into the brighter material is up the stored values unless the map turns
+                // their order around.
+                rising: settings.peel.falling == (map.scale() < 0.0),
+                keep: settings.peel.keep,
+                context: settings.peel.unpeeled == Unpeeled::Context,
+            },
         };
         let shader = Shader::new(geometry.world_from_voxel().matrix3, settings.lighting);
         Ok(Self {
             settings: settings.clone(),
             table,
             activity,
+            after,
             params,
             shader,
             step_mm,
@@ -247,6 +278,7 @@ pub struct Prepared {
     settings: RenderSettings,
     table: TfTable,
     activity: Activity,
+    after: Option<(TfTable, BitSet)>,
     params: Params,
     shader: Shader,
     step_mm: f64,
@@ -314,6 +346,7 @@ impl Prepared {
             settings: d.settings,
             table: d.table,
             activity: d.activity,
+            after: d.after,
             params: d.params,
             shader: d.shader,
             step_mm: d.step_mm,
@@ -328,6 +361,7 @@ impl Prepared {
         self.settings = d.settings;
         self.table = d.table;
         self.activity = d.activity;
+        self.after = d.after;
         self.params = d.params;
         self.shader = d.shader;
         self.step_mm = d.step_mm;
@@ -361,11 +395,16 @@ impl Prepared {
 
     /// The integrators for frames of `camera`.
     fn integrator(&self, camera: &Camera) -> Integrator<'_> {
+        let (table, active) = match &self.after {
+            Some((table, active)) => (table, active),
+            None => (&self.table, &self.activity.tf),
+        };
         let mut integrator = Integrator {
             sampler: self.renderer.sampler(),
             grid: &self.renderer.grid,
             activity: &self.activity,
             table: &self.table,
+            after: Classified { table, active },
             shader: self.shader,
             params: self.params,
             eye_side: None,
