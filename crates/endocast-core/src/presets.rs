@@ -45,6 +45,25 @@ pub struct PresetLumen {
     pub threshold: f64,
     /// Whether the lumen is darker (air, CSF on T1) or brighter (contrast) than the wall.
     pub side: LumenSide,
+    /// What fills the lumen, in one word for messages ("air", "contrast", "CSF").
+    pub tissue: &'static str,
+}
+
+/// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
+/// scan's own units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reference {
+    /// Hounsfield units: air −1000, water 0; CT scans shift them by their offset.
+    Hounsfield,
+    /// The intensities of a T1 brain MRI (the shared `chris_t1`), anchored at its CSF and
+    /// white-matter levels: a scan's own CSF and tissue levels stretch them (and reverse them
+    /// where CSF is bright).
+    T1Brain {
+        /// Ventricular CSF on the reference scale.
+        csf: f64,
+        /// White matter on the reference scale.
+        tissue: f64,
+    },
 }
 
 /// One procedure's defaults. Built only in [`ALL`]; find one with [`Preset::find`].
@@ -76,6 +95,8 @@ pub struct Preset {
     pub projection: Projection,
     /// The endoscope's field of view, degrees (vertical for a pinhole).
     pub fov_deg: f64,
+    /// The scale the values above are written on.
+    pub reference: Reference,
 }
 
 /// The window for CT with an air-filled lumen: air black, soft tissue light grey, bone white.
@@ -95,10 +116,12 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
+            tissue: "gas",
         }),
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "bronchoscopy",
@@ -113,6 +136,7 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: -900.0,
             side: LumenSide::Below,
+            tissue: "air",
         }),
         // The lung window.
         window: Window {
@@ -121,6 +145,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "angioscopy",
@@ -139,6 +164,7 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: 130.0,
             side: LumenSide::Above,
+            tissue: "contrast",
         }),
         // A vessel window: contrast light grey, calcium and metal white, fat dark.
         window: Window {
@@ -147,6 +173,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "sinus",
@@ -160,6 +187,7 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
+            tissue: "air",
         }),
         // The bone window: air black, thin sinus walls distinct from soft tissue.
         window: Window {
@@ -168,6 +196,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "ventricles",
@@ -181,6 +210,7 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: 75.0,
             side: LumenSide::Below,
+            tissue: "CSF",
         }),
         // T1 intensity units (chris_t1: CSF 25–40, white matter 106–130): 0 black, 160 white.
         window: Window {
@@ -189,6 +219,10 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::T1Brain {
+            csf: 32.0,
+            tissue: 118.0,
+        },
     },
     Preset {
         name: "ramp",
@@ -203,6 +237,7 @@ pub const ALL: &[Preset] = &[
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "complex",
@@ -217,6 +252,7 @@ pub const ALL: &[Preset] = &[
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
 ];
 
