@@ -47,6 +47,19 @@ pub struct PresetLumen {
     pub side: LumenSide,
     /// What fills the lumen, in one word for messages ("air", "contrast", "CSF").
     pub tissue: &'static str,
+    /// Which component of the lumen the procedure means.
+    pub structure: Structure,
+}
+
+/// Which connected component of a lumen a procedure means, when no point is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Structure {
+    /// The largest; for a dark lumen, the largest that does not touch the volume's border (the
+    /// air around the patient does).
+    Largest,
+    /// The largest that reaches into a box at the object's centre and does not touch the
+    /// border: the lateral ventricles, not the CSF around the brain nor a lesion.
+    Central,
 }
 
 /// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
@@ -117,6 +130,7 @@ pub const ALL: &[Preset] = &[
             threshold: -500.0,
             side: LumenSide::Below,
             tissue: "gas",
+            structure: Structure::Largest,
         }),
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
@@ -137,6 +151,7 @@ pub const ALL: &[Preset] = &[
             threshold: -900.0,
             side: LumenSide::Below,
             tissue: "air",
+            structure: Structure::Largest,
         }),
         // The lung window.
         window: Window {
@@ -165,6 +180,7 @@ pub const ALL: &[Preset] = &[
             threshold: 130.0,
             side: LumenSide::Above,
             tissue: "contrast",
+            structure: Structure::Largest,
         }),
         // A vessel window: contrast light grey, calcium and metal white, fat dark.
         window: Window {
@@ -188,6 +204,7 @@ pub const ALL: &[Preset] = &[
             threshold: -500.0,
             side: LumenSide::Below,
             tissue: "air",
+            structure: Structure::Largest,
         }),
         // The bone window: air black, thin sinus walls distinct from soft tissue.
         window: Window {
@@ -211,6 +228,7 @@ pub const ALL: &[Preset] = &[
             threshold: 75.0,
             side: LumenSide::Below,
             tissue: "CSF",
+            structure: Structure::Central,
         }),
         // T1 intensity units (chris_t1: CSF 25–40, white matter 106–130): 0 black, 160 white.
         window: Window {
@@ -219,9 +237,11 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        // The CSF and tissue class medians `tissue::measure_csf` finds on chris_t1 (partial
+        // volume lifts CSF from its 25–40 core): that scan keeps the table's values.
         reference: Reference::T1Brain {
-            csf: 32.0,
-            tissue: 118.0,
+            csf: 43.0,
+            tissue: 119.0,
         },
     },
     Preset {

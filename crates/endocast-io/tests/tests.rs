@@ -9,6 +9,7 @@ mod image_out;
 mod metaimage;
 mod nifti;
 mod nrrd;
+mod scans_understood;
 mod stereo_real_scans;
 mod test_volumes;
 mod transfer_json;

@@ -12,7 +12,7 @@ use endocast_core::navigate::{default_view, DefaultView, FramingReason};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
-use endocast_core::tissue::ScanValues;
+use endocast_core::tissue::{self, ScanValues};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
 use endocast_core::Volume;
@@ -197,7 +197,11 @@ fn default_pose(
     settings: &RenderSettings,
     fov_deg: f64,
 ) -> Pose {
-    let choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
+    let mut choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
+    if let Some(choice) = choice.as_mut() {
+        choice.within =
+            preset.and_then(|p| tissue::central_structure(p, volume, &ScanValues::measure(volume)));
+    }
     let view = default_view(volume, choice.as_ref(), fov_deg);
     match &view {
         DefaultView::InsideLumen {
@@ -205,7 +209,7 @@ fn default_pose(
             threshold,
             side,
         } => eprintln!(
-            "camera inside the largest lumen {side} {threshold}: --eye {} --look-at {} --up {}",
+            "camera inside the lumen {side} {threshold:.1}: --eye {} --look-at {} --up {}",
             triple(pose.eye_mm),
             triple(pose.look_at_mm),
             triple(pose.up)

@@ -166,6 +166,40 @@ impl Lumen {
             .transpose()
     }
 
+    /// The largest component that reaches into the inclusive voxel box `lo..=hi` and does not
+    /// touch the volume's border: the lateral ventricles from a box at the brain's centre,
+    /// whatever dark CSF, skull or background lies around the brain. `Ok(None)` when every
+    /// lumen voxel of the box belongs to a component that touches the border.
+    pub fn largest_through_box(
+        volume: &Volume,
+        threshold: f64,
+        side: LumenSide,
+        (lo, hi): ([usize; 3], [usize; 3]),
+    ) -> Result<Option<Self>, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let dims = volume.dims();
+        let hi = [0, 1, 2].map(|a| hi[a].min(dims[a] - 1));
+        let test = ValueTest::new(volume.value_map(), threshold, side);
+        let mut visited = BitGrid::new(dims);
+        let mut best: Option<Component> = None;
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let v = [i, j, k];
+                    if visited.get(v) || !test.holds(volume.voxels()[volume.index(i, j, k)]) {
+                        continue;
+                    }
+                    let c = fill(volume, &test, v, &mut visited);
+                    if !c.touches_border(dims) && best.is_none_or(|b| c.count > b.count) {
+                        best = Some(c);
+                    }
+                }
+            }
+        }
+        best.map(|c| Self::from_seed(volume, c.seed, threshold, side))
+            .transpose()
+    }
+
     /// Copies the component's bits out of the volume-wide visited set into its bounding box.
     fn from_visited(
         visited: &BitGrid,

@@ -36,5 +36,5 @@ pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
 pub use plan::{plan_path, seed_voxel, smooth_centreline, PlannedPath};
-pub use preset::{preset_lumen, LumenChoice, LumenChoiceError};
-pub use viewpoint::{default_view, default_viewpoint, DefaultView, FramingReason};
+pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
+pub use viewpoint::{default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason};

@@ -4,6 +4,8 @@
 
 use super::histogram::Histogram;
 use super::ScanValues;
+use crate::navigate::Central;
+use crate::presets::{Preset, Structure};
 use crate::Volume;
 
 /// Half the central box's size, as a fraction of the object's extent along each axis (between
@@ -75,9 +77,22 @@ pub fn measure_csf(volume: &Volume, scan: &ScanValues) -> Option<CsfContrast> {
     })
 }
 
+/// The central structure `preset` (in the scan's units) means on `volume`: the box at the
+/// object's centre and the CSF level; `None` for presets that mean the largest lumen, and for
+/// a scan without a clear CSF/tissue contrast at its centre.
+pub fn central_structure(preset: &Preset, volume: &Volume, scan: &ScanValues) -> Option<Central> {
+    if preset.lumen?.structure != Structure::Central {
+        return None;
+    }
+    Some(Central {
+        region: central_box(volume, scan)?,
+        floor: measure_csf(volume, scan)?.csf,
+    })
+}
+
 /// The inclusive voxel box around the middle of the object (voxels above the background
-/// threshold), [`BOX_HALF`] of its extent each way.
-fn central_box(volume: &Volume, scan: &ScanValues) -> Option<([usize; 3], [usize; 3])> {
+/// threshold), [`BOX_HALF`] of its extent each way; `None` for a volume without object.
+pub fn central_box(volume: &Volume, scan: &ScanValues) -> Option<([usize; 3], [usize; 3])> {
     let dims = volume.dims();
     let map = volume.value_map();
     let object: Vec<bool> = (0..=u16::MAX)

@@ -20,7 +20,7 @@ mod brain;
 mod histogram;
 mod resolve;
 
-pub use brain::{measure_csf, CsfContrast};
+pub use brain::{central_box, central_structure, measure_csf, CsfContrast};
 pub use resolve::{default_settings, resolve, Resolved};
 
 use crate::{Modality, Volume};

@@ -28,7 +28,7 @@ fn synthetic(dims: [usize; 3], value: impl Fn([usize; 3]) -> u16) -> Volume {
 }
 
 /// A "head": background 0, a ball of tissue at 118 with two CSF "ventricles" (30) near the
-/// centre, the T1 reference's levels. `t2` swaps CSF and tissue to 200 and 90.
+/// centre. `t2` swaps CSF and tissue to 200 and 90.
 fn brain(t2: bool) -> Volume {
     let (csf, tissue) = if t2 { (200, 90) } else { (30, 118) };
     synthetic([48, 48, 48], |[i, j, k]| {
