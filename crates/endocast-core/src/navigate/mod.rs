@@ -30,7 +30,9 @@ mod side;
 mod test_util;
 mod viewpoint;
 
-pub use centreline::{centreline, CentrelinePath, PathEnd, SNAP_RADIUS_MM};
+pub use centreline::{
+    centreline, snap_radius_mm, CentrelinePath, PathEnd, SNAP_RADIUS_MM, SNAP_RADIUS_VOXELS,
+};
 pub use collision::Collider;
 pub use distance::DistanceField;
 pub use error::NavError;
