@@ -60,6 +60,9 @@ pub enum Structure {
     /// The largest that reaches into a box at the object's centre and does not touch the
     /// border: the lateral ventricles, not the CSF around the brain nor a lesion.
     Central,
+    /// The airway tree grown from the trachea's round section in the top axial slices, its
+    /// threshold lowered until it stops leaking into the lung.
+    Trachea,
 }
 
 /// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
@@ -151,7 +154,7 @@ pub const ALL: &[Preset] = &[
             threshold: -900.0,
             side: LumenSide::Below,
             tissue: "air",
-            structure: Structure::Largest,
+            structure: Structure::Trachea,
         }),
         // The lung window.
         window: Window {

@@ -28,6 +28,7 @@ mod preset;
 mod side;
 #[cfg(test)]
 mod test_util;
+mod trachea;
 mod viewpoint;
 
 pub use centreline::{
@@ -39,4 +40,5 @@ pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
 pub use plan::{plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
+pub use trachea::find_trachea;
 pub use viewpoint::{default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason};

@@ -4,8 +4,10 @@
 use super::distance::DistanceField;
 use super::lumen::{Lumen, LumenSide};
 use super::preset::{Central, LumenChoice, LumenChoiceError};
+use super::trachea::find_trachea;
 use crate::camera::framing_pose;
 use crate::pose::Pose;
+use crate::presets::Structure;
 use crate::Volume;
 use glam::{DMat3, DVec3};
 
@@ -122,9 +124,16 @@ pub fn default_view(volume: &Volume, lumen: Option<&LumenChoice<'_>>, fov_deg: f
         Ok(lumen) => lumen,
         Err(error) => return framing(FramingReason::Choice(error)),
     };
-    let found = match choice.within {
-        Some(central) => central_lumen(volume, threshold, side, &central),
-        None => default_viewpoint(volume, threshold, side).map(|pose| (pose, threshold)),
+    let structure = choice.preset.and_then(|p| p.lumen).map(|l| l.structure);
+    let largest = || default_viewpoint(volume, threshold, side).map(|pose| (pose, threshold));
+    let found = match (choice.within, structure) {
+        (Some(central), _) => central_lumen(volume, threshold, side, &central),
+        (None, Some(Structure::Trachea)) if side == LumenSide::Below => {
+            find_trachea(volume, threshold)
+                .map(|(tree, t)| (viewpoint_in(volume, &tree), t))
+                .or_else(largest)
+        }
+        _ => largest(),
     };
     match found {
         Some((pose, threshold)) => DefaultView::InsideLumen {
