@@ -202,14 +202,17 @@ fn default_pose(
         choice.within =
             preset.and_then(|p| tissue::central_structure(p, volume, &ScanValues::measure(volume)));
     }
+    let clock = std::time::Instant::now();
     let view = default_view(volume, choice.as_ref(), fov_deg);
+    let found_ms = clock.elapsed().as_secs_f64() * 1e3;
     match &view {
         DefaultView::InsideLumen {
             pose,
             threshold,
             side,
         } => eprintln!(
-            "camera inside the lumen {side} {threshold:.1}: --eye {} --look-at {} --up {}",
+            "camera inside the lumen {side} {threshold:.1} (found in {found_ms:.0} ms): --eye {} \
+             --look-at {} --up {}",
             triple(pose.eye_mm),
             triple(pose.look_at_mm),
             triple(pose.up)
