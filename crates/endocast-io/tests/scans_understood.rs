@@ -62,7 +62,7 @@ fn t2_like(t1: &Volume) -> Volume {
         .map(|&v| if v < 10 { v } else { 255 - v.min(245) })
         .collect();
     Volume::new(
-        t1.geometry().clone(),
+        *t1.geometry(),
         voxels,
         ValueMap::new(1.0, 0.0).unwrap(),
         t1.modality().clone(),

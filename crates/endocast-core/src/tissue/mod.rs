@@ -170,7 +170,7 @@ impl ScanValues {
 impl fmt::Display for ScanValues {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.kind {
-            ValueKind::Hounsfield { offset } if offset == 0.0 => write!(f, "CT in HU"),
+            ValueKind::Hounsfield { offset: 0.0 } => write!(f, "CT in HU"),
             ValueKind::Hounsfield { offset } => write!(f, "CT stored as HU + {offset}"),
             ValueKind::Intensity => write!(
                 f,

@@ -89,7 +89,7 @@ fn hu_plus_1024_is_recognised_and_presets_shift_by_it() {
     );
     // A scan that says it is MR is never read as HU.
     let mr = Volume::new(
-        shifted.geometry().clone(),
+        *shifted.geometry(),
         shifted.voxels().to_vec(),
         shifted.value_map(),
         Modality::Mr,
