@@ -6,6 +6,8 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, RenderSettings, TransferFunction};
+use endocast_core::tissue::{self, ScanValues};
+use endocast_core::Volume;
 use std::path::Path;
 
 /// How a scan is rendered.
@@ -58,12 +60,41 @@ impl LookArgs {
         self.preset.as_deref().map(find_preset).transpose()
     }
 
-    /// The preset (or defaults), overridden by every option given.
+    /// The preset (or defaults), overridden by every option given; values as the table gives
+    /// them (HU), whatever the scan (see [`LookArgs::on_scan`]).
     pub fn settings(&self) -> Result<RenderSettings> {
-        let mut s = match self.preset()? {
+        let base = match self.preset()? {
             Some(preset) => preset.settings(),
             None => RenderSettings::default(),
         };
+        self.overridden(base)
+    }
+
+    /// The look on `volume`: the preset (or the default view) carried to the scan's own units
+    /// ([`tissue::resolve`], [`tissue::default_settings`]), then every option given, which
+    /// wins (`--iso` is in the scan's units). Also says in one line what was resolved.
+    pub fn on_scan(&self, volume: &Volume) -> Result<ScanLook> {
+        let scan = ScanValues::measure(volume);
+        let (base, preset, summary) = match self.preset()? {
+            Some(preset) => {
+                let resolved = tissue::resolve(preset, volume, &scan);
+                (resolved.settings(), Some(resolved.preset), resolved.summary)
+            }
+            None => {
+                let s = tissue::default_settings(&scan);
+                let summary = format!("wall at {:.1} ({scan})", s.iso_hu);
+                (s, None, summary)
+            }
+        };
+        Ok(ScanLook {
+            settings: self.overridden(base)?,
+            preset,
+            summary,
+            scan,
+        })
+    }
+
+    fn overridden(&self, mut s: RenderSettings) -> Result<RenderSettings> {
         if let Some(mode) = &self.mode {
             s.mode = Mode::from_name(mode).with_context(|| {
                 format!(
@@ -98,6 +129,19 @@ impl LookArgs {
         }
         Ok(s)
     }
+}
+
+/// How a scan looks, its values understood.
+#[derive(Debug, Clone)]
+pub struct ScanLook {
+    /// The settings, options applied.
+    pub settings: RenderSettings,
+    /// The preset in the scan's units, if one was named.
+    pub preset: Option<Preset>,
+    /// What was resolved, in one line.
+    pub summary: String,
+    /// What the histogram says.
+    pub scan: ScanValues,
 }
 
 /// The preset called `name`, or an error listing the known ones.

@@ -4,6 +4,7 @@
 
 mod bad_input;
 mod common;
+mod default_views;
 mod info_shared_data;
 mod navigation;
 mod phantom_convert;

@@ -58,6 +58,44 @@ pub struct PresetLumen {
     pub threshold: f64,
     /// Whether the lumen is darker (air, CSF on T1) or brighter (contrast) than the wall.
     pub side: LumenSide,
+    /// What fills the lumen, in one word for messages ("air", "contrast", "CSF").
+    pub tissue: &'static str,
+    /// Which component of the lumen the procedure means.
+    pub structure: Structure,
+}
+
+/// Which connected component of a lumen a procedure means, when no point is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Structure {
+    /// The largest; for a dark lumen, the largest that does not touch the volume's border (the
+    /// air around the patient does).
+    Largest,
+    /// The largest that reaches into a box at the object's centre and does not touch the
+    /// border: the lateral ventricles, not the CSF around the brain nor a lesion.
+    Central,
+    /// The airway tree grown from the trachea's round section in the top axial slices, its
+    /// threshold lowered until it stops leaking into the lung.
+    Trachea,
+}
+
+/// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
+/// scan's own units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reference {
+    /// Hounsfield units: air −1000, water 0; CT scans shift them by their offset.
+    Hounsfield,
+    /// The intensities of a T1 brain MRI (the shared `chris_t1`), anchored at its CSF and
+    /// white-matter levels: a scan's own CSF and tissue levels stretch them (and reverse them
+    /// where CSF is bright).
+    T1Brain {
+        /// Ventricular CSF on the reference scale.
+        csf: f64,
+        /// White matter on the reference scale.
+        tissue: f64,
+    },
+    /// The intensities of the scan the preset was tuned on, used as they are (no tissue level
+    /// anchors them yet).
+    AsGiven,
 }
 
 /// One procedure's defaults. Built only in [`ALL`]; find one with [`Preset::find`].
@@ -91,6 +129,8 @@ pub struct Preset {
     pub projection: Projection,
     /// The endoscope's field of view, degrees (vertical for a pinhole).
     pub fov_deg: f64,
+    /// The scale the values above are written on.
+    pub reference: Reference,
 }
 
 /// The window for CT with an air-filled lumen: air black, soft tissue light grey, bone white.
@@ -111,10 +151,13 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
+            tissue: "gas",
+            structure: Structure::Largest,
         }),
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "bronchoscopy",
@@ -130,6 +173,8 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: -900.0,
             side: LumenSide::Below,
+            tissue: "air",
+            structure: Structure::Trachea,
         }),
         // The lung window.
         window: Window {
@@ -138,6 +183,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "angioscopy",
@@ -157,6 +203,8 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: 130.0,
             side: LumenSide::Above,
+            tissue: "contrast",
+            structure: Structure::Largest,
         }),
         // A vessel window: contrast light grey, calcium and metal white, fat dark.
         window: Window {
@@ -165,6 +213,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "sinus",
@@ -179,6 +228,8 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
+            tissue: "air",
+            structure: Structure::Largest,
         }),
         // The bone window: air black, thin sinus walls distinct from soft tissue.
         window: Window {
@@ -187,6 +238,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "ventricles",
@@ -201,6 +253,8 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: 75.0,
             side: LumenSide::Below,
+            tissue: "CSF",
+            structure: Structure::Central,
         }),
         // T1 intensity units (chris_t1: CSF 25–40, white matter 106–130): 0 black, 160 white.
         window: Window {
@@ -209,6 +263,12 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        // The CSF and tissue class medians `tissue::measure_csf` finds on chris_t1 (partial
+        // volume lifts CSF from its 25–40 core): that scan keeps the table's values.
+        reference: Reference::T1Brain {
+            csf: 43.0,
+            tissue: 119.0,
+        },
     },
     Preset {
         name: "arthroscopy",
@@ -237,6 +297,8 @@ pub const ALL: &[Preset] = &[
         lumen: Some(PresetLumen {
             threshold: 30.0,
             side: LumenSide::Above,
+            tissue: "marrow",
+            structure: Structure::Largest,
         }),
         // T1 intensity units: joint space black, marrow light grey.
         window: Window {
@@ -245,6 +307,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::AsGiven,
     },
     Preset {
         name: "ramp",
@@ -260,6 +323,7 @@ pub const ALL: &[Preset] = &[
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "complex",
@@ -275,6 +339,7 @@ pub const ALL: &[Preset] = &[
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
 ];
 

@@ -2,11 +2,11 @@
 //! is the femur's surface across the joint space, and from inside the stented aorta of the CTA
 //! it is what lies behind the wall, in both cases beyond the surface an endoscope would see.
 
-use crate::common::shared_data;
 use endocast_core::camera::Optics;
 use endocast_core::presets::Preset;
 use endocast_core::render::{Frame, Mode, RenderSettings, Renderer};
 use endocast_io::OpenOptions;
+use endocast_testdata::shared_data;
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -14,13 +14,7 @@ const SIZE: usize = 64;
 
 /// The scan `data`, or `None` outside CI when it is absent.
 fn open(data: &str) -> Option<Arc<Renderer>> {
-    let Some(path) = shared_data(data) else {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "{data} is absent"
-        );
-        return None;
-    };
+    let path = shared_data(data)?;
     let volume = endocast_io::open(&path, &OpenOptions::default())
         .unwrap()
         .volume;

@@ -10,6 +10,7 @@ mod mp4;
 mod nifti;
 mod nrrd;
 mod peel_real_scans;
+mod scans_understood;
 mod stereo_real_scans;
 mod test_volumes;
 mod transfer_json;

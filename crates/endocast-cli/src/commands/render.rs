@@ -12,6 +12,7 @@ use endocast_core::navigate::{default_view, DefaultView, FramingReason};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
+use endocast_core::tissue::{self, ScanValues};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
 use endocast_core::Volume;
@@ -70,12 +71,13 @@ pub struct RenderArgs {
 
 /// Runs `endocast render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let settings = args.look.settings()?;
-    let preset = args.look.preset()?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
+    let look = args.look.on_scan(&loaded.volume)?;
+    eprintln!("{}", look.summary);
+    let (settings, preset) = (look.settings, look.preset.as_ref());
     let camera = camera(args, preset, &loaded.volume, &settings)?;
     let renderer = Arc::new(Renderer::new(loaded.volume));
     let prepared = renderer
@@ -108,6 +110,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             frame
         }
     };
+    warn_if_empty(&frame, &settings, &look.scan);
     let [w, h] = [frame.width as u32, frame.height as u32];
     if let Some(depth) = &args.depth_out {
         endocast_io::image_out::write_npy_f32(depth, w, h, &frame.depth_mm)
@@ -194,15 +197,22 @@ fn default_pose(
     settings: &RenderSettings,
     fov_deg: f64,
 ) -> Pose {
-    let choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
+    let mut choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
+    if let Some(choice) = choice.as_mut() {
+        choice.within =
+            preset.and_then(|p| tissue::central_structure(p, volume, &ScanValues::measure(volume)));
+    }
+    let clock = std::time::Instant::now();
     let view = default_view(volume, choice.as_ref(), fov_deg);
+    let found_ms = clock.elapsed().as_secs_f64() * 1e3;
     match &view {
         DefaultView::InsideLumen {
             pose,
             threshold,
             side,
         } => eprintln!(
-            "camera inside the largest lumen {side} {threshold}: --eye {} --look-at {} --up {}",
+            "camera inside the lumen {side} {threshold:.1} (found in {found_ms:.0} ms): --eye {} \
+             --look-at {} --up {}",
             triple(pose.eye_mm),
             triple(pose.look_at_mm),
             triple(pose.up)
@@ -218,6 +228,21 @@ fn default_pose(
         },
     }
     view.pose()
+}
+
+/// Warns, saying why and what to try, when nothing in the image was hit or drawn.
+fn warn_if_empty(frame: &Frame, settings: &RenderSettings, scan: &ScanValues) {
+    let drawn = frame.color.iter().any(|p| p.transmittance < 0.99);
+    if frame.stats.iso_hits > 0 || drawn {
+        return;
+    }
+    let (lo, hi) = scan.range;
+    eprintln!(
+        "warning: the image is empty: no ray met the wall at {:.1} or anything the transfer \
+         function shows (values {lo:.1} to {hi:.1}, {scan}); try --iso {:.1} (background/object \
+         boundary) without --eye, or another --preset",
+        settings.iso_hu, scan.object_threshold
+    );
 }
 
 /// `x,y,z` with two decimals, as `--eye` takes it.
