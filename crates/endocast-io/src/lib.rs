@@ -18,6 +18,7 @@
 //! ```
 
 pub mod atomic;
+mod compressed;
 pub mod dicom;
 mod encode;
 pub mod error;

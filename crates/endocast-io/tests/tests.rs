@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
 mod common;
+mod corruption;
 mod cross_format;
 mod dicom;
 mod image_out;

@@ -142,7 +142,9 @@ pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
         Ok(false) => return Scanned::NotDicom,
         Err(e) => return Scanned::Unreadable(e),
     }
-    if let Err(e) = lengths::check_element_lengths(path) {
+    // A deflated data set holds at most the largest volume's 16-bit samples and its header.
+    let max_inflated = limits.max_voxels.saturating_mul(2).saturating_add(1 << 26);
+    if let Err(e) = lengths::check_element_lengths(path, max_inflated) {
         return Scanned::Unreadable(e);
     }
     let object = match OpenFileOptions::new()
