@@ -5,6 +5,7 @@
 mod bad_input;
 mod common;
 mod info_shared_data;
+mod integrity;
 mod navigation;
 mod phantom_convert;
 mod presets;

@@ -8,6 +8,7 @@
 
 use super::scan::{chain, open_error, PixelLayout};
 use crate::error::{ReadError, Result};
+use crate::guard;
 use dicom_core::value::DicomValueType;
 use dicom_core::{DicomValue, PrimitiveValue};
 use dicom_dictionary_std::tags;
@@ -249,8 +250,8 @@ pub(super) fn decode_file(
     frames: Vec<(u32, &mut [u16])>,
     map: &SampleMap,
 ) -> Result<Vec<FrameStats>> {
-    let object = OpenFileOptions::new()
-        .open_file(path)
+    let object = guard::quietly(|| OpenFileOptions::new().open_file(path))
+        .map_err(|panicked| ReadError::format(path, panicked.to_string()))?
         .map_err(|e| open_error(path, &e))?;
     let pixel_data = object
         .get(tags::PIXEL_DATA)
@@ -284,20 +285,15 @@ pub(super) fn decode_file(
     }
 }
 
-/// Decodes one compressed frame. Third-party decoders have been seen to panic on corrupt data
-/// (dicom-rs 0.10's RLE decoder indexes past its buffer), so a panic there is caught and becomes
-/// an error about the file instead of taking the program down.
+/// Decodes one compressed frame; a panic in the decoder becomes an error (see [`guard`]).
 fn decode_frame_guarded(
     object: &DefaultDicomObject,
     frame: u32,
 ) -> std::result::Result<DecodedPixelData<'_>, String> {
-    let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        object.decode_pixel_data_frame(frame)
-    }));
-    match attempt {
+    match guard::quietly(|| object.decode_pixel_data_frame(frame)) {
         Ok(Ok(decoded)) => Ok(decoded),
         Ok(Err(e)) => Err(chain(&e)),
-        Err(_) => Err("the decoder failed on corrupt data".into()),
+        Err(panicked) => Err(panicked.to_string()),
     }
 }
 

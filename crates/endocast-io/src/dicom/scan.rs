@@ -3,6 +3,7 @@
 
 use super::lengths;
 use crate::error::{ReadError, Result};
+use crate::guard;
 use crate::limits::Limits;
 use crate::samples::Rescale;
 use dicom_core::Tag;
@@ -147,12 +148,15 @@ pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
     if let Err(e) = lengths::check_element_lengths(path, max_inflated) {
         return Scanned::Unreadable(e);
     }
-    let object = match OpenFileOptions::new()
-        .read_until(tags::PIXEL_DATA)
-        .open_file(path)
-    {
-        Ok(object) => object,
-        Err(e) => return Scanned::Unreadable(open_error(path, &e)),
+    let opened = guard::quietly(|| {
+        OpenFileOptions::new()
+            .read_until(tags::PIXEL_DATA)
+            .open_file(path)
+    });
+    let object = match opened {
+        Ok(Ok(object)) => object,
+        Ok(Err(e)) => return Scanned::Unreadable(open_error(path, &e)),
+        Err(panicked) => return Scanned::Unreadable(ReadError::format(path, panicked.to_string())),
     };
     match image_file(path, &object, &object.meta().transfer_syntax, limits) {
         Ok(Some(image)) => Scanned::Image(image),
