@@ -21,7 +21,11 @@ fuzz_target!(|data: &[u8]| {
         spacing_mm: [layout[3], layout[4], layout[5]].map(|s| f64::from(s) / 16.0),
         element: ElementType::from_name(TYPES[usize::from(layout[6]) % TYPES.len()])
             .expect("a known type"),
-        endian: if layout[7] % 2 == 0 { Endian::Little } else { Endian::Big },
+        endian: if layout[7] % 2 == 0 {
+            Endian::Little
+        } else {
+            Endian::Big
+        },
         header_bytes: u64::from(u16::from_le_bytes([layout[8], layout[9]])),
     };
     let orientation = ORIENTATIONS[usize::from(layout[10]) % ORIENTATIONS.len()];
