@@ -42,6 +42,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    remove_temporary_files_on_signals();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
@@ -56,8 +57,26 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            // Messages may quote file names and headers: no control character gets through.
+            eprintln!("error: {}", endocast_io::escape(&format!("{error:#}")));
             ExitCode::FAILURE
         }
     }
+}
+
+/// On SIGINT or SIGTERM, removes the temporary files of the outputs being written (a film in
+/// progress, a PNG being written) and exits with status 128 + the signal's number, as a
+/// shell reports a command killed by it.
+fn remove_temporary_files_on_signals() {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+        return; // the default handlers stay: interrupted, temporary files may remain
+    };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            endocast_io::atomic::remove_temporary_files();
+            eprintln!("\ninterrupted: temporary files removed");
+            std::process::exit(128 + signal);
+        }
+    });
 }

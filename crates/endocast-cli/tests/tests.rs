@@ -6,6 +6,7 @@ mod bad_input;
 mod common;
 mod default_views;
 mod info_shared_data;
+mod integrity;
 mod navigation;
 mod phantom_convert;
 mod presets;

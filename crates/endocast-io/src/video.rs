@@ -19,6 +19,7 @@
 //! # Ok::<(), endocast_io::ReadError>(())
 //! ```
 
+use crate::atomic::Pending;
 use crate::error::{ReadError, Result};
 use crate::image_out::write_png_rgb8;
 use endocast_core::views::Image;
@@ -180,6 +181,10 @@ struct TempTarget {
     target: PathBuf,
     temporary: PathBuf,
     committed: bool,
+    /// Lists the temporary file for a signal handler (see [`remove_temporary_files`]).
+    ///
+    /// [`remove_temporary_files`]: crate::atomic::remove_temporary_files
+    _listed: Pending,
 }
 
 impl TempTarget {
@@ -194,6 +199,7 @@ impl TempTarget {
         ));
         Ok(Self {
             target: target.to_path_buf(),
+            _listed: Pending::new(&temporary),
             temporary,
             committed: false,
         })

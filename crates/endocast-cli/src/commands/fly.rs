@@ -105,6 +105,11 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         );
     }
     let stereo = flight_stereo(args)?;
+    // Per frame: one render per eye and, for a dashboard, its composite image.
+    let eyes = if stereo.is_some() { 2 } else { 1 };
+    let dashboard = u64::from(args.layout == LayoutArg::Dashboard);
+    args.input
+        .check_frames(&args.output, args.size, eyes + dashboard)?;
     let route = read_route(&args.route).context("cannot read the path")?;
     let shots = route
         .shots(args.frame_step, args.look_ahead)

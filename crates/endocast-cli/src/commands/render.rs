@@ -16,6 +16,7 @@ use endocast_core::tissue::{self, ScanValues};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
 use endocast_core::Volume;
+use endocast_io::ImageFormat;
 use glam::DVec3;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -26,7 +27,7 @@ use std::sync::Arc;
 pub struct RenderArgs {
     #[command(flatten)]
     input: InputArgs,
-    /// Output PNG (8-bit sRGB).
+    /// Output image: .png (8-bit sRGB) or .jpg.
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
@@ -71,6 +72,9 @@ pub struct RenderArgs {
 
 /// Runs `endocast render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    ImageFormat::for_path(&args.output).context("cannot write the image")?;
+    let eyes = if args.stereo.stereo.is_some() { 2 } else { 1 };
+    args.input.check_frames(&args.output, args.size, eyes)?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
@@ -105,7 +109,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
             let [w, h] = [frame.width as u32, frame.height as u32];
             let rgb = frame.to_rgb8(settings.background);
-            endocast_io::image_out::write_png_rgb8(&args.output, w, h, &rgb)
+            endocast_io::write_image_rgb8(&args.output, w, h, &rgb)
                 .context("cannot write the image")?;
             frame
         }
@@ -178,7 +182,7 @@ fn write_stereo(
     let (left, right) = (left?, right?);
     let write = |path: &Path, image: &Image| {
         let [w, h] = [image.width() as u32, image.height() as u32];
-        endocast_io::image_out::write_png_rgb8(path, w, h, image.rgb())
+        endocast_io::write_image_rgb8(path, w, h, image.rgb())
             .with_context(|| format!("cannot write {}", path.display()))
     };
     if output == StereoOutput::Pair {

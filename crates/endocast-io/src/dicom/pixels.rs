@@ -9,6 +9,7 @@
 use super::jpegls;
 use super::scan::{chain, open_error, PixelLayout};
 use crate::error::{ReadError, Result};
+use crate::guard;
 use dicom_core::value::DicomValueType;
 use dicom_core::{DicomValue, PrimitiveValue};
 use dicom_dictionary_std::tags;
@@ -255,8 +256,8 @@ pub(super) fn decode_file(
     frames: Vec<(u32, &mut [u16])>,
     map: &SampleMap,
 ) -> Result<Vec<FrameStats>> {
-    let object = OpenFileOptions::new()
-        .open_file(path)
+    let object = guard::quietly(|| OpenFileOptions::new().open_file(path))
+        .map_err(|panicked| ReadError::format(path, panicked.to_string()))?
         .map_err(|e| open_error(path, &e))?;
     let pixel_data = object
         .get(tags::PIXEL_DATA)
@@ -343,11 +344,10 @@ fn jpeg_ls_frame(
 }
 
 /// Runs a third-party decoder. Decoders have been seen to panic on corrupt data (dicom-rs
-/// 0.10's RLE decoder indexes past its buffer), so a panic there is caught and becomes an error
-/// about the file instead of taking the program down.
+/// 0.10's RLE decoder indexes past its buffer), so a panic there is caught, quietly (see
+/// [`guard`]), and becomes an error about the file instead of taking the program down.
 fn guarded<T>(decode: impl FnOnce() -> T) -> std::result::Result<T, String> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode))
-        .map_err(|_| "the decoder failed on corrupt data".to_string())
+    guard::quietly(decode).map_err(|panicked| panicked.to_string())
 }
 
 /// Converts frame `frame` of uncompressed pixel data. dicom-rs has already put 16-bit words
