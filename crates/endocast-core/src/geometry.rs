@@ -86,6 +86,27 @@ impl Geometry {
         })
     }
 
+    /// The geometry whose [`Self::world_from_voxel`] is `world_from_voxel` (LPS mm from voxel
+    /// index): spacing from the lengths of its columns, direction from the unit columns, origin
+    /// from its translation. Fails as [`Self::new`] does (a zero or non-finite column, dependent
+    /// axes).
+    pub fn from_world_from_voxel(
+        dims: [usize; 3],
+        world_from_voxel: DAffine3,
+    ) -> Result<Self, GeometryError> {
+        let m = world_from_voxel.matrix3;
+        let spacing = DVec3::new(m.x_axis.length(), m.y_axis.length(), m.z_axis.length());
+        if !spacing.is_finite() || spacing.min_element() <= 0.0 {
+            return Err(GeometryError::BadSpacing(spacing.to_array()));
+        }
+        let direction = DMat3::from_cols(
+            m.x_axis / spacing.x,
+            m.y_axis / spacing.y,
+            m.z_axis / spacing.z,
+        );
+        Self::new(dims, spacing, world_from_voxel.translation, direction)
+    }
+
     /// An axis-aligned LPS geometry (identity direction) with the given spacing and origin.
     pub fn axis_aligned(
         dims: [usize; 3],

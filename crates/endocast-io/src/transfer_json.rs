@@ -14,6 +14,7 @@
 //! interpolation belong to the renderer's transfer function.
 
 use crate::error::{ReadError, Result};
+use endocast_core::render::TransferFunction;
 use serde_json::Value;
 use std::path::Path;
 
@@ -33,6 +34,23 @@ pub struct TfPoints {
 pub fn read_transfer_json(path: &Path) -> Result<TfPoints> {
     let text = crate::text::read_text(path, MAX_BYTES, "a transfer function file")?;
     parse_transfer_json(path, &text)
+}
+
+/// The transfer function `spec` names: a JSON file (when that path exists or ends in `.json`)
+/// or else a preset by name ([`TransferFunction::PRESETS`]); how `--tf` and the Python
+/// bindings read it.
+pub fn transfer_function(spec: &str) -> Result<TransferFunction> {
+    let path = Path::new(spec);
+    if path.exists() || spec.ends_with(".json") {
+        let points = read_transfer_json(path)?;
+        return TransferFunction::from_points(&points.opacity, &points.color)
+            .map_err(|e| ReadError::format(path, format!("not a usable transfer function: {e}")));
+    }
+    TransferFunction::preset(spec).ok_or_else(|| {
+        let presets = TransferFunction::PRESETS.join(", ");
+        let what = format!("transfer function: neither a file nor a preset ({presets})");
+        ReadError::unsupported(path, what)
+    })
 }
 
 /// Parses the text of a transfer-function file; `path` only names it in errors.
