@@ -10,6 +10,7 @@
 
 mod errors;
 mod fly;
+mod image;
 mod kwargs;
 mod look;
 mod navigate;
@@ -29,5 +30,6 @@ fn _endocast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(navigate::path, m)?)?;
     m.add_function(wrap_pyfunction!(fly::fly, m)?)?;
     m.add_function(wrap_pyfunction!(look::preset_names, m)?)?;
+    m.add_function(wrap_pyfunction!(image::save_png, m)?)?;
     Ok(())
 }

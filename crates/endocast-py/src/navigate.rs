@@ -16,6 +16,9 @@ use pyo3::types::PyDict;
 /// A point in LPS mm, as (x, y, z).
 type Point = (f64, f64, f64);
 
+/// A path's points (N, 3) and radii (N,).
+type PathArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// The centred path through the lumen from `start` (LPS mm; or `start_voxel`, an index) to
 /// `end` (or `end_voxel`; neither: the farthest lumen point), as `endocast path` plans it and
 /// writes it: points every `step` mm (default 2) and the last, as an (N, 3) array in LPS mm,
@@ -28,7 +31,7 @@ pub fn path<'py>(
     start: Option<[f64; 3]>,
     end: Option<[f64; 3]>,
     options: Option<&Bound<'py, PyDict>>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<PathArrays<'py>> {
     let kw = Kwargs::new(py, "path", options)?;
     let volume = volume.get().volume();
     let start_voxel = kw.take::<[f64; 3]>("start_voxel")?;

@@ -52,6 +52,7 @@ impl Volume {
 /// or `series`), NIfTI, NRRD, MetaImage.
 #[pyfunction]
 #[pyo3(signature = (path, series = None, *, max_voxels = None, orientation = None))]
+#[allow(clippy::needless_pass_by_value)] // PyO3 hands arguments over by value.
 pub fn open(
     py: Python<'_>,
     path: PathBuf,

@@ -170,3 +170,11 @@ def test_two_threads_render_at_once(volume):
     print(f"one render {alone * 1e3:.0f} ms, two threads {both * 1e3:.0f} ms "
           f"({both / alone:.2f}x), overlap {overlap * 1e3:.0f} ms")
     assert overlap > 0.5 * min(a1 - a0, b1 - b0)
+
+
+def test_save_png_writes_what_it_is_given(tmp_path):
+    image = np.arange(4 * 5 * 3, dtype=np.uint8).reshape(4, 5, 3)
+    endocast.save_png(tmp_path / "x.png", image)
+    np.testing.assert_array_equal(read_png_rgb(tmp_path / "x.png"), image)
+    with pytest.raises(endocast.EndocastError, match="channels"):
+        endocast.save_png(tmp_path / "y.png", np.zeros((2, 2, 2), np.uint8))

@@ -20,6 +20,7 @@ from ._endocast import (
     path,
     presets,
     render,
+    save_png,
 )
 
 __all__ = [
@@ -31,4 +32,5 @@ __all__ = [
     "path",
     "presets",
     "render",
+    "save_png",
 ]

@@ -156,3 +156,5 @@ def fly(
 ) -> pathlib.Path: ...
 def presets() -> list[str]:
     """The preset names."""
+def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:
+    """Write an RGB or RGBA uint8 image (height, width, 3 or 4) as an 8-bit PNG."""
