@@ -253,6 +253,21 @@ mod tests {
     use super::*;
 
     #[test]
+    fn an_affine_gives_back_its_geometry() {
+        let spacing = DVec3::new(0.5, 1.0, 2.5);
+        let origin = DVec3::new(-10.0, 3.0, 7.0);
+        let tilted = DMat3::from_rotation_z(0.3) * DMat3::from_rotation_x(-0.2);
+        let g = Geometry::new([4, 5, 6], spacing, origin, tilted).unwrap();
+        let back = Geometry::from_world_from_voxel([4, 5, 6], g.world_from_voxel()).unwrap();
+        assert!(back.spacing_mm().abs_diff_eq(spacing, 1e-12));
+        assert!(back.origin_mm().abs_diff_eq(origin, 1e-12));
+        assert!(back.direction().abs_diff_eq(tilted, 1e-12));
+        let flat = DAffine3::from_scale(DVec3::new(1.0, 0.0, 1.0));
+        let error = Geometry::from_world_from_voxel([2, 2, 2], flat).unwrap_err();
+        assert!(matches!(error, GeometryError::BadSpacing(_)));
+    }
+
+    #[test]
     fn affine_round_trip_with_shear() {
         let tilt = 18.5_f64.to_radians();
         let dir = DMat3::from_cols(DVec3::X, DVec3::new(0.0, tilt.cos(), -tilt.sin()), DVec3::Z);

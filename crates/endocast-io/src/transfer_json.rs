@@ -142,6 +142,17 @@ fn point<const N: usize>(entry: &Value) -> std::result::Result<(f64, [f32; N]), 
 mod tests {
     use super::*;
 
+    #[test]
+    fn a_spec_is_a_file_or_a_preset() {
+        assert!(transfer_function("colonoscopy").is_ok());
+        let unknown = transfer_function("gastroscopy").unwrap_err().to_string();
+        assert!(unknown.contains("neither a file nor a preset"), "{unknown}");
+        let missing = transfer_function("no/such/tf.json")
+            .unwrap_err()
+            .to_string();
+        assert!(missing.contains("no/such/tf.json"), "{missing}");
+    }
+
     fn parse(text: &str) -> Result<TfPoints> {
         parse_transfer_json(Path::new("tf.json"), text)
     }
