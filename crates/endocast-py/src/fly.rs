@@ -56,7 +56,7 @@ pub fn fly<'py>(
         py.detach(|| {
             let settings = looks.for_shot(&shots[n]).map_err(to_py)?;
             let (image, _) = look
-                .in_pool(|| flight.frame(n, &shots[n], &settings))?
+                .in_pool(|| flight.frame(n, &shots[n], &settings))
                 .map_err(to_py)?;
             PyResult::Ok(image)
         })

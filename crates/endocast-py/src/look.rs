@@ -19,8 +19,9 @@ pub struct Look {
     pub preset: Option<&'static Preset>,
     /// The settings in force.
     pub settings: RenderSettings,
-    /// Worker threads (`None`: all cores).
-    pub threads: Option<usize>,
+    /// The workers of the `threads` option (`None`: rayon's global pool, all cores); made
+    /// once, so that a flight's frames share it.
+    pool: Option<rayon::ThreadPool>,
 }
 
 impl Look {
@@ -63,26 +64,28 @@ impl Look {
             s.background = background;
         }
         s.validate().map_err(to_py)?;
-        let threads = kw.take::<usize>("threads")?;
-        if threads == Some(0) {
-            return Err(error("threads must be at least 1"));
-        }
+        let pool = match kw.take::<usize>("threads")? {
+            None => None,
+            Some(0) => return Err(error("threads must be at least 1")),
+            Some(n) => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(to_py)?,
+            ),
+        };
         Ok(Self {
             preset,
             settings: s,
-            threads,
+            pool,
         })
     }
 
-    /// Runs `work` on `threads` workers (all cores when `None`).
-    pub fn in_pool<T: Send>(&self, work: impl FnOnce() -> T + Send) -> PyResult<T> {
-        match self.threads {
-            None => Ok(work()),
-            Some(n) => Ok(rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(to_py)?
-                .install(work)),
+    /// Runs `work` on the `threads` workers (all cores without the option).
+    pub fn in_pool<T: Send>(&self, work: impl FnOnce() -> T + Send) -> T {
+        match &self.pool {
+            None => work(),
+            Some(pool) => pool.install(work),
         }
     }
 }

@@ -53,10 +53,10 @@ pub fn render<'py>(
         let prepared = renderer.prepare(&look.settings).map_err(to_py)?;
         match &stereo {
             None => {
-                let frame = look.in_pool(|| prepared.render(&camera))?;
+                let frame = look.in_pool(|| prepared.render(&camera));
                 Ok(single(&frame, look.settings.background))
             }
-            Some(stereo) => look.in_pool(|| render_stereo(&prepared, &camera, stereo))?,
+            Some(stereo) => look.in_pool(|| render_stereo(&prepared, &camera, stereo)),
         }
     })?;
     let (rgba_dims, depth_dims) = (rgba_dims(&view), depth_dims(&view));

@@ -145,15 +145,39 @@ def fly(
     volume: Volume,
     route: Union[_Path, npt.ArrayLike],
     out: None = None,
-    **options: object,
-) -> npt.NDArray[np.uint8]: ...
+    *,
+    preset: Optional[str] = None,
+    mode: Optional[_Mode] = None,
+    iso: Optional[float] = None,
+    iso2: Optional[float] = None,
+    iso_opacity: Optional[float] = None,
+    tf: Optional[str] = None,
+    step: Optional[float] = None,
+    jitter: bool = False,
+    skip_empty: bool = True,
+    shade_dvr: Optional[bool] = None,
+    background: Optional[_Vec3] = None,
+    fov: Optional[float] = None,
+    near: float = 0.0,
+    lens: Optional[_Lens] = None,
+    distortion: Optional[Tuple[float, float]] = None,
+    vignetting: float = 0.0,
+    size: Tuple[int, int] = (384, 384),
+    frame_step: float = 1.0,
+    look_ahead: float = 10.0,
+    fps: float = 25.0,
+    threads: Optional[int] = None,
+) -> npt.NDArray[np.uint8]:
+    """Fly along ``route`` (an (N, 3) array of LPS points or a path file) as ``endocast fly``
+    films the endoscopic view: without ``out`` the frames, RGB uint8 (frames, height, width, 3)."""
 @overload
 def fly(
     volume: Volume,
     route: Union[_Path, npt.ArrayLike],
     out: _Path,
     **options: object,
-) -> pathlib.Path: ...
+) -> pathlib.Path:
+    """The same flight written to ``out`` (.gif, .mp4 or a folder of PNGs); returns its path."""
 def presets() -> list[str]:
     """The preset names."""
 def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:
