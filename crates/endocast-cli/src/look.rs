@@ -8,7 +8,6 @@ use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, RenderSettings, TransferFunction};
 use endocast_core::tissue::{self, ScanValues};
 use endocast_core::Volume;
-use std::path::Path;
 
 /// How a scan is rendered.
 #[derive(Args, Debug, Clone)]
@@ -163,19 +162,7 @@ fn finite(name: &str, value: f64) -> Result<f64> {
 
 /// A transfer function from a JSON file, or a preset by name.
 pub fn transfer_function(spec: &str) -> Result<TransferFunction> {
-    let path = Path::new(spec);
-    if path.exists() || spec.ends_with(".json") {
-        let points = endocast_io::transfer_json::read_transfer_json(path)
-            .context("cannot read the transfer function")?;
-        return TransferFunction::from_points(&points.opacity, &points.color)
-            .with_context(|| format!("{}: not a usable transfer function", path.display()));
-    }
-    TransferFunction::preset(spec).with_context(|| {
-        format!(
-            "--tf {spec:?} is neither a file nor a preset ({})",
-            TransferFunction::PRESETS.join(", ")
-        )
-    })
+    endocast_io::transfer_json::transfer_function(spec).context("cannot use the transfer function")
 }
 
 /// Runs `work` on a pool of `threads` workers (all cores when `None`).

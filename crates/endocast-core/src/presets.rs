@@ -26,6 +26,36 @@ use crate::views::slices::Window;
 /// commands run without one.
 pub const DEFAULT_FOV_DEG: f64 = 90.0;
 
+/// The field of a fisheye lens when neither the caller nor the preset gives one, degrees: a
+/// wide endoscope's.
+pub const FISHEYE_DEFAULT_FOV_DEG: f64 = 170.0;
+
+/// The projection and field of a view under `preset` (if any), for the `projection` and
+/// `field` a caller asked for (if any): the projection defaults to the preset's, else a
+/// pinhole; the field to the preset's field of view — a fisheye's
+/// [`FISHEYE_DEFAULT_FOV_DEG`] when the preset's own lens is no fisheye — or, orthographic,
+/// `default_height_mm`. The field is not checked against the projection's range here (the
+/// camera does that).
+pub fn lens_defaults(
+    preset: Option<&Preset>,
+    projection: Option<Projection>,
+    field: Option<f64>,
+    default_height_mm: f64,
+) -> (Projection, f64) {
+    let projection = projection
+        .or(preset.map(|p| p.projection))
+        .unwrap_or(Projection::Pinhole);
+    let field = match (field, projection) {
+        (Some(field), _) => field,
+        (None, Projection::Orthographic) => default_height_mm,
+        (None, p) if p.is_fisheye() && preset.is_none_or(|p| !p.projection.is_fisheye()) => {
+            FISHEYE_DEFAULT_FOV_DEG
+        }
+        (None, _) => preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg),
+    };
+    (projection, field)
+}
+
 /// A second isosurface ([`Mode::TwoIso`]'s upper one: stent, calcification).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Surface {

@@ -7,7 +7,7 @@ use crate::lumen::LumenArgs;
 use crate::parse::parse_vec3;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::navigate::{default_view, plan_path, DefaultView, PathEnd, PlannedPath};
+use endocast_core::navigate::{default_view, plan_path, DefaultView, PathEnd};
 use endocast_core::path::SmoothOptions;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::tissue::{self, ScanValues};
@@ -91,7 +91,10 @@ pub fn run(args: &PathArgs) -> Result<()> {
     let (lumen, field, planned) = plan_path(volume, threshold, side, start, end, &options)
         .with_context(|| format!("no path in the lumen {side} {threshold}"))?;
     let seconds = clock.elapsed().as_secs_f64();
-    let points = resample(&planned, args.step)?;
+    let points = planned
+        .path
+        .points_every(args.step)
+        .with_context(|| format!("--step {}", args.step))?;
     write(&args.output, &points)?;
     let summary = json!({
         "output": args.output,
@@ -165,20 +168,6 @@ fn point(
         (None, Some(v)) => Some(volume.geometry().world_of(DVec3::from(v))),
         (None, None) => None,
     })
-}
-
-/// The smooth path's points every `step_mm` (and its last point).
-fn resample(planned: &PlannedPath, step_mm: f64) -> Result<Vec<DVec3>> {
-    let path = &planned.path;
-    if !(step_mm.is_finite() && step_mm > 0.0) {
-        bail!("--step must be a positive number of mm, not {step_mm}");
-    }
-    let count = (path.len_mm() / step_mm).ceil() as usize;
-    let mut points: Vec<DVec3> = (0..count)
-        .map(|n| path.point_at(n as f64 * step_mm))
-        .collect();
-    points.push(path.point_at(path.len_mm()));
-    Ok(points)
 }
 
 /// Writes the points as Slicer Markups (`.mrk.json`) or as our path JSON.
