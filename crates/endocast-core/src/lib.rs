@@ -23,6 +23,7 @@ pub mod phantom;
 pub mod pose;
 pub mod presets;
 pub mod render;
+pub mod scene;
 pub mod views;
 pub mod volume;
 
