@@ -17,6 +17,7 @@ pub mod camera;
 pub mod coverage;
 pub mod flight;
 pub mod geometry;
+pub mod isosurface;
 pub mod navigate;
 pub mod path;
 pub mod phantom;

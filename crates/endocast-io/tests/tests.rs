@@ -6,6 +6,7 @@ mod common;
 mod cross_format;
 mod dicom;
 mod image_out;
+mod mesh;
 mod metaimage;
 mod nifti;
 mod nrrd;
