@@ -86,11 +86,9 @@ fn ascii(path: &Path, bytes: &[u8]) -> Result<Parts> {
                 check_count(path, "vertices", vertices.len() as u64)?;
             }
             Some("outer") => in_loop = 0,
-            Some("endloop") => {
-                if in_loop != 3 {
-                    let message = format!("a facet with {in_loop} vertices (STL needs 3)");
-                    return Err(ReadError::format(path, at(&message)));
-                }
+            Some("endloop") if in_loop != 3 => {
+                let message = format!("a facet with {in_loop} vertices (STL needs 3)");
+                return Err(ReadError::format(path, at(&message)));
             }
             _ => {}
         }
