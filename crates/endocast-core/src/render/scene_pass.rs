@@ -121,6 +121,7 @@ impl Prepared {
         let dir = task.dir_world;
         let (t_start, t_end) = task.march.span();
         let out = &mut task.out;
+        let opaque_surface = self.params.lower.opacity >= self.params.early_termination;
         match self.params.mode {
             Mode::Iso => {
                 let depth = out.depth_mm;
@@ -129,6 +130,15 @@ impl Prepared {
                 *out = around(integrator, out, hits, in_front, dir);
             }
             Mode::Mip | Mode::Minip => *out = around(integrator, out, hits, hits.len(), dir),
+            // Hybrid draws nothing in front of its surface: hits there, and any hit when the
+            // surface is opaque, join around it.
+            Mode::Hybrid
+                if !out.depth_mm.is_nan()
+                    && (opaque_surface || hits.iter().all(|h| h.t_mm < out.depth_mm)) =>
+            {
+                let in_front = hits.partition_point(|h| h.t_mm < out.depth_mm);
+                *out = around(integrator, out, hits, in_front, dir);
+            }
             _ if hits.iter().all(|h| h.t_mm <= t_start || h.t_mm >= t_end) => {
                 let in_front = hits.partition_point(|h| h.t_mm <= t_start);
                 *out = around(integrator, out, hits, in_front, dir);

@@ -253,10 +253,10 @@ impl Endoscope {
     }
 
     /// The instruments placed for a camera at `eye` with unit `forward`, `right` and `up`: axes
-    /// parallel to the view direction, one diameter from it, 30° to the left of straight down
-    /// (the second one 30° to the right), from the lens plane to the tip.
+    /// parallel to the view direction, 1.25 diameters from it, 45° to the left of straight
+    /// down (the second one 45° to the right), from the lens plane to the tip.
     pub fn instruments(&self, eye: DVec3, [forward, right, up]: [DVec3; 3]) -> Vec<Capsule> {
-        let (sin, cos) = 30f64.to_radians().sin_cos();
+        let (sin, cos) = 45f64.to_radians().sin_cos();
         let sides: &[f64] = if self.second_instrument {
             &[-1.0, 1.0]
         } else {
@@ -265,7 +265,7 @@ impl Endoscope {
         sides
             .iter()
             .map(|side| {
-                let offset = (right * (side * sin) - up * cos) * self.diameter_mm;
+                let offset = (right * (side * sin) - up * cos) * (1.25 * self.diameter_mm);
                 Capsule {
                     a: eye + offset,
                     b: eye + offset + forward * self.length_mm,
