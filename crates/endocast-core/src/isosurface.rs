@@ -28,8 +28,10 @@ const TETRAHEDRA: [[u8; 4]; 6] = [
 /// Regula falsi steps on a diagonal edge at most (converges to float precision in far fewer).
 const ROOT_STEPS: usize = 40;
 
-/// The isosurface at `iso` (physical units) around the lumen `lumen`: the boundary between its
-/// voxels and the rest, in world mm.
+/// The surface of `lumen` at its threshold: the boundary between its voxels and the rest, in
+/// world mm (watertight where the lumen does not reach the volume's border). Vertices between
+/// a lumen voxel and a diagonal neighbour on the lumen's side outside it (another component)
+/// have no crossing and sit at the edge's midpoint.
 pub fn lumen_surface(volume: &Volume, lumen: &Lumen) -> Result<TriangleMesh, MeshError> {
     extract(volume, lumen.threshold(), &|v, _| lumen.contains(v))
 }
