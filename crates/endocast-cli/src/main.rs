@@ -8,6 +8,7 @@ mod optics;
 mod parse;
 mod peel;
 mod progress;
+mod scene_args;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -37,6 +38,8 @@ enum Command {
     Fly(Box<commands::fly::FlyArgs>),
     /// List the procedure presets: mode, transfer function, isovalues, lumen, slice window, lens.
     Presets(commands::presets::PresetsArgs),
+    /// The lumen's wall (an isosurface) as a triangle mesh: STL, OBJ or PLY in world mm.
+    Mesh(Box<commands::mesh::MeshArgs>),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
 }
@@ -53,6 +56,7 @@ fn main() -> ExitCode {
         Command::Presets(args) => commands::presets::run(&args),
         Command::Path(args) => commands::path::run(&args),
         Command::Fly(args) => commands::fly::run(&args),
+        Command::Mesh(args) => commands::mesh::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -12,3 +12,4 @@ mod phantom_convert;
 mod presets;
 mod real_scans;
 mod render;
+mod scene;

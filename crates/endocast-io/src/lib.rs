@@ -28,6 +28,7 @@ pub mod image_out;
 pub mod limits;
 mod loaded;
 pub mod markups;
+pub mod mesh;
 pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;

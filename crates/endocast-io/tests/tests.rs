@@ -6,6 +6,7 @@ mod corruption;
 mod cross_format;
 mod dicom;
 mod image_out;
+mod mesh;
 mod metaimage;
 mod mp4;
 mod nifti;

@@ -7,6 +7,7 @@
 use crate::look::{find_preset, in_pool, LookArgs};
 use crate::optics::{LensArgs, StereoArgs};
 use crate::parse::parse_size;
+use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::StereoRig;
@@ -62,6 +63,9 @@ pub struct BenchArgs {
     /// Print one JSON line per measured setting instead of the table.
     #[arg(long)]
     json: bool,
+    /// Geometry drawn in every frame (the cost of meshes, a grid, the endoscope).
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Also append one JSON line per measured setting to this file.
     #[arg(long, value_name = "FILE")]
     json_file: Option<PathBuf>,
@@ -92,6 +96,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .lens
         .optics(preset, args.fov, 0.0, (hi - lo).length())?;
     let renderer = Arc::new(renderer);
+    let scene = args.scene.scene()?;
     let options = RenderOptions::new().quality(args.quality);
     let cameras: Vec<Camera> = poses
         .iter()
@@ -117,9 +122,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "| setting | min fps | avg fps | max fps | median ms | Msamples/s |\n|---|---|---|---|---|---|",
     );
     for cell in &cells {
-        let prepared = renderer
+        let mut prepared = renderer
             .prepare(&cell.settings)
             .context("invalid settings")?;
+        prepared.set_scene(scene.clone());
         let (mono, pair) = in_pool(args.look.threads, || {
             measure(args, &prepared, &options, &cameras)
         })?;

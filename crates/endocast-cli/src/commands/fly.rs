@@ -9,6 +9,7 @@ use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::parse_size;
 use crate::progress::Progress;
+use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use endocast_core::coverage::Coverage;
@@ -57,6 +58,8 @@ pub struct FlyArgs {
     fov_deg: Option<f64>,
     #[command(flatten)]
     lens: LensArgs,
+    #[command(flatten)]
+    scene: SceneArgs,
     #[command(flatten)]
     stereo: StereoArgs,
     /// Endoscope image size, pixels.
@@ -147,6 +150,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         window,
     };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
+    flight.set_scene(args.scene.scene()?);
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {

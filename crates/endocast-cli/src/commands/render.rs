@@ -5,6 +5,7 @@ use crate::look::{in_pool, LookArgs};
 use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
+use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::default_up;
@@ -38,6 +39,8 @@ pub struct RenderArgs {
     lens: LensArgs,
     #[command(flatten)]
     stereo: StereoArgs,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Eye position, world mm (LPS, as `endocast info` reports). Without it, an endoscopic
     /// preset looks along the largest lumen from its most central point; otherwise the view
     /// frames the whole volume from the front.
@@ -84,9 +87,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let (settings, preset) = (look.settings, look.preset.as_ref());
     let camera = camera(args, preset, &loaded.volume, &settings)?;
     let renderer = Arc::new(Renderer::new(loaded.volume));
-    let prepared = renderer
+    let mut prepared = renderer
         .prepare(&settings)
         .context("invalid render settings")?;
+    prepared.set_scene(args.scene.scene()?);
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
     }

@@ -222,7 +222,7 @@ impl Integrator<'_> {
     }
 
     /// Composites the lower isosurface, shaded at the hit `out.depth_mm`, onto `out`.
-    fn lit_surface(&self, march: &RayMarch, dir_world: Vec3, out: &mut PixelOut) {
+    pub(super) fn lit_surface(&self, march: &RayMarch, dir_world: Vec3, out: &mut PixelOut) {
         let surface = self.params.lower;
         let lit = self.surface(march.grid().at(out.depth_mm), surface.color, dir_world);
         out.accum.under_surface(lit, surface.opacity);
@@ -261,7 +261,12 @@ impl Integrator<'_> {
 
     /// The first crossing of `iso` in iso-active bricks; the march is left so that the next walk
     /// starts with the first sample past the crossing.
-    fn search<P: Probe>(&self, march: &mut RayMarch, iso: f32, probe: &mut P) -> Option<Bracket> {
+    pub(super) fn search<P: Probe>(
+        &self,
+        march: &mut RayMarch,
+        iso: f32,
+        probe: &mut P,
+    ) -> Option<Bracket> {
         let rising = self.rising(march, iso);
         self.search_from(march, (iso, rising), (0.0, 0.0), probe)
     }
@@ -349,7 +354,7 @@ impl Integrator<'_> {
     /// Bisection of the bracket `(t, value)` before and after a crossing (the two samples the
     /// march took, so their values are not fetched again), then linear interpolation inside the
     /// final bracket (no refinement: the sample after the crossing).
-    fn refine(&self, line: SampleGrid, iso: f32, bracket: Bracket) -> f32 {
+    pub(super) fn refine(&self, line: SampleGrid, iso: f32, bracket: Bracket) -> f32 {
         let Bracket {
             mut before,
             mut after,
@@ -475,7 +480,7 @@ impl Integrator<'_> {
     }
 
     /// Front-to-back DVR in TF-active bricks onto `out`, until early termination.
-    fn composite<P: Probe>(
+    pub(super) fn composite<P: Probe>(
         &self,
         march: &mut RayMarch,
         out: &mut PixelOut,
@@ -524,10 +529,25 @@ impl Integrator<'_> {
     /// isovalue since the previous one (surfaces composited in depth order), then composited by
     /// the transfer function if it lies outside the band between the isovalues.
     fn two_iso(&self, march: &mut RayMarch, dir_world: Vec3, probe: &mut impl Probe) -> PixelOut {
+        let mut out = PixelOut::default();
+        self.two_iso_part(march, dir_world, &mut out, &mut (0.0, 0.0), probe);
+        out
+    }
+
+    /// [`Self::two_iso`] over one part of a ray onto `out`, `previous` (`(t, value)`) the last
+    /// sample of the part before (ignored where the march's first sample is fresh); left at the
+    /// part's last sample.
+    pub(super) fn two_iso_part(
+        &self,
+        march: &mut RayMarch,
+        dir_world: Vec3,
+        out: &mut PixelOut,
+        previous: &mut (f32, f32),
+        probe: &mut impl Probe,
+    ) {
         let (lower, upper) = (self.params.lower, self.params.upper);
         let stop = self.params.early_termination;
-        let mut out = PixelOut::default();
-        let mut previous = (0.0f32, 0.0f32);
+        let mut last = *previous;
         let line = march.grid();
         let acc = &mut out.accum;
         let depth = &mut out.depth_mm;
@@ -537,22 +557,22 @@ impl Integrator<'_> {
             |b| self.iso_active(b) || self.tf_active(b),
             |s: Sample| {
                 // The test every sample takes stays small; the rare crossing is handled aside.
-                let crossed = |iso: f32| (previous.1 < iso) != (s.value < iso);
+                let crossed = |iso: f32| (last.1 < iso) != (s.value < iso);
                 if !s.fresh && (crossed(lower.iso) || crossed(upper.iso)) {
                     let after = (s.t, s.value);
-                    self.add_crossed_surfaces(acc, depth, (line, dir_world), previous, after);
+                    self.add_crossed_surfaces(acc, depth, (line, dir_world), last, after);
                 }
                 if s.value < lower.iso || s.value > upper.iso {
                     let shade = self.params.shade_dvr;
                     self.add_sample(self.table, acc, line, s, dir_world, shade);
                 }
-                previous = (s.t, s.value);
+                last = (s.t, s.value);
                 probe.sample(s.t, s.value, acc.alpha());
                 until_opaque(acc.alpha(), stop)
             },
         );
+        *previous = last;
         out.terminated = terminated;
-        out
     }
 
     /// Two-iso: the surfaces crossed between samples `before` and `after` (`(t, value)`),

@@ -53,6 +53,7 @@ pub mod progressive;
 pub mod quality;
 mod ray_task;
 mod sample;
+mod scene_pass;
 mod settings;
 mod simd;
 mod stereo;
@@ -68,6 +69,8 @@ mod camera_tests;
 mod interactive_tests;
 #[cfg(test)]
 mod peel_tests;
+#[cfg(test)]
+mod scene_tests;
 #[cfg(test)]
 mod tests;
 
@@ -91,6 +94,7 @@ use glam::{DAffine3, DVec3, Vec3};
 use integrate::{Classified, Integrator, Params, PeelParams, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
+use scene_pass::SceneRow;
 #[cfg(target_arch = "x86_64")]
 use simd::rays4::RaySetup;
 use std::sync::Arc;
@@ -99,6 +103,7 @@ use stereo::SearchStarts;
 use tiles::{Control, Extra, Pixel, Tile, TileRect, Tiling, TILE};
 use traverse::{BrickDda, VoxelRay};
 
+use crate::scene::{PlacedScene, Scene};
 use crate::Volume;
 
 /// A volume ready for rendering: the volume and its brick grid (built once), and for sessions
@@ -283,6 +288,8 @@ pub struct Prepared {
     shader: Shader,
     step_mm: f64,
     voxel_from_world: DAffine3,
+    /// Geometry drawn with the volume ([`Self::set_scene`]).
+    scene: Option<Arc<Scene>>,
 }
 
 /// A pixel's ray in the world and in voxel space, and its part inside the volume (mm).
@@ -351,6 +358,7 @@ impl Prepared {
             shader: d.shader,
             step_mm: d.step_mm,
             voxel_from_world,
+            scene: None,
         })
     }
 
@@ -467,7 +475,9 @@ impl Prepared {
             assert_eq!(max.len(), w * h, "one maximum distance per pixel");
         }
         let integrator = self.integrator(camera);
-        let tile = |rect| self.tile(&integrator, camera, options, rect);
+        let scene = self.scene.as_ref().filter(|s| !s.is_empty());
+        let placed = scene.map(|s| s.placed(camera));
+        let tile = |rect| self.tile(&integrator, camera, options, placed.as_ref(), rect);
         let control = Control {
             cancel: options.cancel,
             progress: options.progress,
@@ -481,6 +491,7 @@ impl Prepared {
         integrator: &Integrator<'_>,
         camera: &Camera,
         options: &RenderOptions<'_>,
+        scene: Option<&PlacedScene<'_>>,
         rect: TileRect,
     ) -> Tile {
         let pixels = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
@@ -496,6 +507,7 @@ impl Prepared {
         let width = camera.size()[0];
         let missed = self.pixel_of(&PixelOut::default());
         let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
+        let mut others = Vec::new();
         for y in rect.y0..rect.y1 {
             columns.clear();
             tasks.clear();
@@ -511,6 +523,27 @@ impl Prepared {
             integrator.run_group(&mut tasks);
             let row = tile.pixels.len();
             tile.pixels.resize(row + rect.x1 - rect.x0, missed);
+            if let Some(scene) = scene {
+                let scene_row = SceneRow {
+                    scene,
+                    camera,
+                    options,
+                    y,
+                };
+                others.clear();
+                let xs = rect.x0..rect.x1;
+                self.add_scene(
+                    integrator,
+                    &scene_row,
+                    xs,
+                    (&columns, &mut tasks),
+                    &mut others,
+                );
+                for (x, out) in &mut others {
+                    vignette(camera, *x, y, out);
+                    tile.pixels[row + *x - rect.x0] = self.pixel_of(out);
+                }
+            }
             for (&x, task) in columns.iter().zip(&mut tasks) {
                 vignette(camera, x, y, &mut task.out);
                 let task = &*task;
