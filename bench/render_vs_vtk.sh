@@ -22,14 +22,14 @@ path=$out/colon512_path_lps.json
 rm -f "$out/endocast.jsonl"
 
 echo "== endocast: the paper's protocol (Tables 1 and 2) on the colon phantom"
-$bin bench --size 512 --frames "$frames" --json "$out/endocast.jsonl"
+$bin bench --phantom-size 512 --frames "$frames" --json-file "$out/endocast.jsonl"
 # peer_runs FILE: endocast's runs on the peer's path and transfer functions, appended to FILE.
 peer_runs() {
   for tf in ramp complex; do
-    $bin bench "$nii" --path "$path" --mode dvr --tf "bench/tf/colon_$tf.json" --json "$1"
+    $bin bench "$nii" --path "$path" --mode dvr --tf "bench/tf/colon_$tf.json" --json-file "$1"
   done
-  $bin bench "$nii" --path "$path" --mode iso --iso -500 --json "$1"
-  $bin bench "$nii" --path "$path" --mode mip --json "$1"
+  $bin bench "$nii" --path "$path" --mode iso --iso -500 --json-file "$1"
+  $bin bench "$nii" --path "$path" --mode mip --json-file "$1"
 }
 echo "== endocast: the peer's runs, same path and transfer functions"
 peer_runs "$out/endocast.jsonl"

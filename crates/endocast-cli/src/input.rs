@@ -3,9 +3,10 @@
 use crate::parse::{parse_dims, parse_spacing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use endocast_core::render::Layers;
 use endocast_io::raw::RawSpec;
 use endocast_io::{ElementType, Endian, Limits, Loaded, OpenOptions};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// How to read the input scan.
 #[derive(Args, Debug)]
@@ -40,13 +41,26 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
+    /// The resource limits: the defaults, with `--max-voxels` when given.
+    pub fn limits(&self) -> Limits {
+        self.max_voxels
+            .map_or_else(Limits::default, Limits::with_max_voxels)
+    }
+
+    /// Refuses before anything is read or rendered when `frames` frames of `size` for `output`
+    /// would take more memory than the limits allow.
+    pub fn check_frames(&self, output: &Path, size: [usize; 2], frames: u64) -> Result<()> {
+        self.limits()
+            .check_frames(output, size, Layers::NONE, frames)
+            .context("the image is too large")?;
+        Ok(())
+    }
+
     /// Reads the scan these options name.
     pub fn open(&self) -> Result<Loaded> {
         let mut options = OpenOptions::default();
         options.series.clone_from(&self.series);
-        if let Some(max) = self.max_voxels {
-            options.limits = Limits::with_max_voxels(max);
-        }
+        options.limits = self.limits();
         options.raw = self.raw_spec()?;
         options.orientation.clone_from(&self.orientation);
         endocast_io::open(&self.path, &options).context("cannot read the scan")

@@ -1,11 +1,13 @@
 //! The options that decide how a scan looks (preset, mode, isovalues, transfer function,
 //! sampling) and how many threads render it; shared by `render` and `bench`.
 
+use crate::peel::PeelArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, RenderSettings, TransferFunction};
-use std::path::Path;
+use endocast_core::tissue::{self, ScanValues};
+use endocast_core::Volume;
 
 /// How a scan is rendered.
 #[derive(Args, Debug, Clone)]
@@ -15,7 +17,7 @@ pub struct LookArgs {
     /// override the preset.
     #[arg(long)]
     preset: Option<String>,
-    /// iso, dvr, hybrid, two-iso, mip or minip (default: the preset's, else hybrid).
+    /// iso, dvr, hybrid, two-iso, mip, minip or peel (default: the preset's, else hybrid).
     #[arg(long)]
     mode: Option<String>,
     /// Isovalue of the lumen wall, physical units (HU for CT).
@@ -37,9 +39,15 @@ pub struct LookArgs {
     /// Jitter each pixel's samples by a deterministic per-pixel offset.
     #[arg(long)]
     jitter: bool,
+    /// Shade DVR samples with their gradient (Blinn-Phong; six extra samples per visible sample).
+    /// The hybrid mode never shades behind its surface.
+    #[arg(long)]
+    shade_dvr: bool,
     /// Skip empty bricks (the image is the same either way, only slower without).
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "true|false")]
     skip_empty: bool,
+    #[command(flatten)]
+    peel: PeelArgs,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -51,15 +59,46 @@ impl LookArgs {
         self.preset.as_deref().map(find_preset).transpose()
     }
 
-    /// The preset (or defaults), overridden by every option given.
+    /// The preset (or defaults), overridden by every option given; values as the table gives
+    /// them (HU), whatever the scan (see [`LookArgs::on_scan`]).
     pub fn settings(&self) -> Result<RenderSettings> {
-        let mut s = match self.preset()? {
+        let base = match self.preset()? {
             Some(preset) => preset.settings(),
             None => RenderSettings::default(),
         };
+        self.overridden(base)
+    }
+
+    /// The look on `volume`: the preset (or the default view) carried to the scan's own units
+    /// ([`tissue::resolve`], [`tissue::default_settings`]), then every option given, which
+    /// wins (`--iso` is in the scan's units). Also says in one line what was resolved.
+    pub fn on_scan(&self, volume: &Volume) -> Result<ScanLook> {
+        let scan = ScanValues::measure(volume);
+        let (base, preset, summary) = match self.preset()? {
+            Some(preset) => {
+                let resolved = tissue::resolve(preset, volume, &scan);
+                (resolved.settings(), Some(resolved.preset), resolved.summary)
+            }
+            None => {
+                let s = tissue::default_settings(&scan);
+                let summary = format!("wall at {:.1} ({scan})", s.iso_hu);
+                (s, None, summary)
+            }
+        };
+        Ok(ScanLook {
+            settings: self.overridden(base)?,
+            preset,
+            summary,
+            scan,
+        })
+    }
+
+    fn overridden(&self, mut s: RenderSettings) -> Result<RenderSettings> {
         if let Some(mode) = &self.mode {
             s.mode = Mode::from_name(mode).with_context(|| {
-                format!("unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip or minip")
+                format!(
+                    "unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip, minip or peel"
+                )
             })?;
         }
         if let Some(iso) = self.iso {
@@ -81,9 +120,27 @@ impl LookArgs {
             s.step_vox = finite("--step", step)?;
         }
         s.jitter = self.jitter;
+        s.shade_dvr |= self.shade_dvr;
         s.skip_empty = self.skip_empty;
+        self.peel.apply(&mut s)?;
+        if let Some(spec) = self.peel.tf_after() {
+            s.peel.tf_after = Some(transfer_function(spec)?);
+        }
         Ok(s)
     }
+}
+
+/// How a scan looks, its values understood.
+#[derive(Debug, Clone)]
+pub struct ScanLook {
+    /// The settings, options applied.
+    pub settings: RenderSettings,
+    /// The preset in the scan's units, if one was named.
+    pub preset: Option<Preset>,
+    /// What was resolved, in one line.
+    pub summary: String,
+    /// What the histogram says.
+    pub scan: ScanValues,
 }
 
 /// The preset called `name`, or an error listing the known ones.
@@ -105,19 +162,7 @@ fn finite(name: &str, value: f64) -> Result<f64> {
 
 /// A transfer function from a JSON file, or a preset by name.
 pub fn transfer_function(spec: &str) -> Result<TransferFunction> {
-    let path = Path::new(spec);
-    if path.exists() || spec.ends_with(".json") {
-        let points = endocast_io::transfer_json::read_transfer_json(path)
-            .context("cannot read the transfer function")?;
-        return TransferFunction::from_points(&points.opacity, &points.color)
-            .with_context(|| format!("{}: not a usable transfer function", path.display()));
-    }
-    TransferFunction::preset(spec).with_context(|| {
-        format!(
-            "--tf {spec:?} is neither a file nor a preset ({})",
-            TransferFunction::PRESETS.join(", ")
-        )
-    })
+    endocast_io::transfer_json::transfer_function(spec).context("cannot use the transfer function")
 }
 
 /// Runs `work` on a pool of `threads` workers (all cores when `None`).

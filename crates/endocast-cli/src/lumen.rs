@@ -30,6 +30,7 @@ impl LumenArgs {
             iso,
             threshold: self.lumen_threshold,
             bright_lumen: self.bright_lumen,
+            within: None,
         }
     }
 

@@ -6,7 +6,9 @@ mod look;
 mod lumen;
 mod optics;
 mod parse;
+mod peel;
 mod progress;
+mod scene_args;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -36,6 +38,8 @@ enum Command {
     Fly(Box<commands::fly::FlyArgs>),
     /// List the procedure presets: mode, transfer function, isovalues, lumen, slice window, lens.
     Presets(commands::presets::PresetsArgs),
+    /// The lumen's wall (an isosurface) as a triangle mesh: STL, OBJ or PLY in world mm.
+    Mesh(Box<commands::mesh::MeshArgs>),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
     /// The interactive workstation: fly through a scan with the slices, the controls, key
@@ -44,6 +48,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    remove_temporary_files_on_signals();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
@@ -55,12 +60,31 @@ fn main() -> ExitCode {
         Command::Path(args) => commands::path::run(&args),
         Command::Fly(args) => commands::fly::run(&args),
         Command::View(args) => commands::view::run(&args),
+        Command::Mesh(args) => commands::mesh::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            // Messages may quote file names and headers: no control character gets through.
+            eprintln!("error: {}", endocast_io::escape(&format!("{error:#}")));
             ExitCode::FAILURE
         }
     }
+}
+
+/// On SIGINT or SIGTERM, removes the temporary files of the outputs being written (a film in
+/// progress, a PNG being written) and exits with status 128 + the signal's number, as a
+/// shell reports a command killed by it.
+fn remove_temporary_files_on_signals() {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+        return; // the default handlers stay: interrupted, temporary files may remain
+    };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            endocast_io::atomic::remove_temporary_files();
+            eprintln!("\ninterrupted: temporary files removed");
+            std::process::exit(128 + signal);
+        }
+    });
 }

@@ -4,13 +4,9 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::{Lens, Optics, Projection, StereoRig};
-use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
+use endocast_core::presets::{self, Preset};
 use endocast_core::views::stereo::StereoOutput;
 use std::path::{Path, PathBuf};
-
-/// The field of a fisheye lens when neither `--fov` nor the preset gives one for it, degrees:
-/// a wide endoscope's.
-pub const FISHEYE_DEFAULT_FOV_DEG: f64 = 170.0;
 
 /// How the camera forms its image.
 #[derive(Args, Debug, Clone, Default)]
@@ -39,19 +35,7 @@ impl LensArgs {
         near_mm: f64,
         default_height_mm: f64,
     ) -> Result<Optics> {
-        let projection = self
-            .lens
-            .or(preset.map(|p| p.projection))
-            .unwrap_or(Projection::Pinhole);
-        let preset_fov = preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg);
-        let field = match (fov, projection) {
-            (Some(fov), _) => fov,
-            (None, Projection::Orthographic) => default_height_mm,
-            (None, p) if p.is_fisheye() && preset.is_none_or(|p| !p.projection.is_fisheye()) => {
-                FISHEYE_DEFAULT_FOV_DEG
-            }
-            (None, _) => preset_fov,
-        };
+        let (projection, field) = presets::lens_defaults(preset, self.lens, fov, default_height_mm);
         let (min, max) = projection.field_range();
         if !(min..=max).contains(&field) {
             bail!(

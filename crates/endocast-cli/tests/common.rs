@@ -1,6 +1,5 @@
 //! Running the binary and finding the shared data.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 /// Runs `endocast` with `args`.
@@ -35,17 +34,6 @@ pub fn info_json(path: &str, extra: &[&str]) -> serde_json::Value {
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).expect("info --json prints JSON")
-}
-
-/// `../shared/data` from the workspace root, or `None` (with a message) when absent.
-pub fn shared_data() -> Option<PathBuf> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    if path.exists() {
-        Some(path)
-    } else {
-        eprintln!("skipping: {} is absent", path.display());
-        None
-    }
 }
 
 /// The numbers of a JSON array.

@@ -1,7 +1,8 @@
 //! Every scan in `../shared/data` loads through `endocast info` with the dimensions, spacing
 //! and value range its README gives.
 
-use crate::common::{info_json, numbers, shared_data};
+use crate::common::{info_json, numbers};
+use endocast_testdata::shared_data;
 
 /// One dataset and what its README says.
 struct Expected {
@@ -113,7 +114,7 @@ const EXPECTED: &[Expected] = &[
 
 #[test]
 fn every_shared_scan_matches_its_readme() {
-    let Some(root) = shared_data() else { return };
+    let Some(root) = shared_data("") else { return };
     for e in EXPECTED {
         let path = root.join(e.path);
         let report = info_json(path.to_str().expect("utf-8 path"), &[]);
@@ -154,7 +155,7 @@ fn every_shared_scan_matches_its_readme() {
 
 #[test]
 fn dicom_ct_reports_modality_series_and_hounsfield_units() {
-    let Some(root) = shared_data() else { return };
+    let Some(root) = shared_data("") else { return };
     let report = info_json(
         root.join("abdomen-ct-pancreas-dicom").to_str().unwrap(),
         &[],
@@ -169,7 +170,7 @@ fn dicom_ct_reports_modality_series_and_hounsfield_units() {
 
 #[test]
 fn gantry_tilt_is_reported_not_silenced() {
-    let Some(root) = shared_data() else { return };
+    let Some(root) = shared_data("") else { return };
     let report = info_json(root.join("head-ct-ge-gantry-tilt").to_str().unwrap(), &[]);
     assert_eq!(
         report["orthogonal"], false,
@@ -182,4 +183,49 @@ fn gantry_tilt_is_reported_not_silenced() {
             .any(|w| w.as_str().unwrap().to_lowercase().contains("tilt")),
         "warnings: {warnings:?}"
     );
+}
+
+/// A folder of one DICOM image and a note: `info` and `render` print the "skipped" note once,
+/// and `info`'s numbers carry no padding zeros, negative zeros or "+ -" offsets.
+#[test]
+fn the_skipped_note_appears_once_and_info_numbers_read_cleanly() {
+    let Some(source) = shared_data("dicom-transfer-syntaxes/1.dcm") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(&source, dir.path().join("1.dcm")).unwrap();
+    std::fs::write(dir.path().join("notes.txt"), "not an image").unwrap();
+    let folder = dir.path().to_str().unwrap();
+    let png = dir.path().join("v.png");
+    for args in [
+        vec!["info", folder],
+        vec![
+            "render",
+            folder,
+            "--size",
+            "16x16",
+            "-o",
+            png.to_str().unwrap(),
+        ],
+    ] {
+        let out = crate::common::endocast(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let all = String::from_utf8_lossy(&out.stdout) + String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            all.matches("skipped 1 file that is").count(),
+            1,
+            "{args:?}: {all}"
+        );
+        if args[0] == "info" {
+            assert!(
+                !all.contains(".0000") && !all.contains("+ -") && !all.contains("-0,"),
+                "{all}"
+            );
+            assert!(all.contains("physical = stored\n"), "{all}");
+        }
+    }
 }

@@ -124,36 +124,52 @@ fn a_dashboard_flight_writes_one_wide_png_per_frame_and_coverage_grows_backward(
     assert!(dir.path().join("frames.coverage.nii.gz").exists());
 }
 
+/// The number of samples in an MP4's `stsz` box.
+fn mp4_frames(bytes: &[u8]) -> u32 {
+    let at = bytes
+        .windows(4)
+        .position(|w| w == b"stsz")
+        .expect("an stsz box")
+        + 12;
+    u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap())
+}
+
 #[test]
-fn mp4_through_ffmpeg_when_present() {
-    let ffmpeg = std::process::Command::new("ffmpeg")
-        .arg("-version")
-        .output();
-    if !ffmpeg.is_ok_and(|o| o.status.success()) {
-        eprintln!("skipping: ffmpeg is not on PATH");
-        return;
-    }
+fn mp4_needs_no_ffmpeg_and_holds_every_frame() {
     let dir = tempfile::tempdir().unwrap();
     let tube = phantom(dir.path(), "straight-tube", "48");
     let route = tube_path(dir.path(), &tube, "p.json");
+    let fly = |out: &str, path_var: &Path| {
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_endocast"))
+            .args(["fly", &tube, "--path", &route, "--iso", "-480", "--json"])
+            .args(["--size", "48x48", "--frame-step", "6", "-o", out])
+            .env("PATH", path_var)
+            .output()
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+        let report: serde_json::Value = serde_json::from_slice(&status.stdout).unwrap();
+        report["frames"].as_u64().unwrap() as usize
+    };
+    // PATH holds nothing: no ffmpeg to fall back on.
+    let empty = tempfile::tempdir().unwrap();
     let mp4 = dir.path().join("f.mp4");
-    let mp4 = mp4.to_str().unwrap();
-    let args = [
-        "fly",
-        &tube,
-        "--path",
-        &route,
-        "--iso",
-        "-480",
-        "--size",
-        "48x48",
-        "--frame-step",
-        "6",
-        "-o",
-        mp4,
-    ];
-    ok(&args);
-    assert_eq!(&std::fs::read(mp4).unwrap()[4..8], b"ftyp");
+    let reported = fly(mp4.to_str().unwrap(), empty.path());
+    let bytes = std::fs::read(&mp4).unwrap();
+    assert_eq!(&bytes[4..8], b"ftyp");
+    let frames = dir.path().join("frames");
+    assert_eq!(fly(frames.to_str().unwrap(), empty.path()), reported);
+    let pngs = std::fs::read_dir(&frames).unwrap().count();
+    assert!(pngs > 1);
+    assert_eq!(pngs, reported, "--json reports the frames written");
+    assert_eq!(
+        mp4_frames(&bytes) as usize,
+        pngs,
+        "one MP4 frame per PNG frame"
+    );
 }
 
 #[test]
@@ -241,7 +257,7 @@ fn path_json(args: &[&str]) -> serde_json::Value {
 
 #[test]
 fn real_scans_trachea_into_a_bronchus_and_down_the_aorta() {
-    let Some(data) = crate::common::shared_data() else {
+    let Some(data) = endocast_testdata::shared_data("") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();

@@ -1,7 +1,8 @@
 //! Endoscopic renders from inside four real scans (poses in `bench/scenes.json`): the lumen wall
 //! must close around the view — nearly every ray hits it, at depths a lumen of that organ allows.
 
-use crate::common::{endocast, read_npy, shared_data};
+use crate::common::{endocast, read_npy};
+use endocast_testdata::shared_data;
 use std::path::PathBuf;
 
 /// The scenes file, with paths relative to the repository root.
@@ -23,7 +24,7 @@ fn triple(v: &serde_json::Value) -> String {
 
 #[test]
 fn the_lumen_wall_surrounds_the_endoscope_in_every_real_scan() {
-    if shared_data().is_none() {
+    if shared_data("").is_none() {
         return;
     }
     let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");

@@ -48,12 +48,165 @@ fn from_the_centre_of_a_sphere_shell_every_depth_is_the_radius() {
     let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(stats["rays"], 48 * 32);
     assert_eq!(stats["iso_hits"], 48 * 32);
+    // The pose it used: the eye given, looking along +z, up orthogonal to the view.
+    let camera = &stats["camera"];
+    assert_eq!(camera["eye"], serde_json::json!([0.0, 0.0, 0.0]));
+    assert_eq!(camera["look_direction"], serde_json::json!([0.0, 0.0, 1.0]));
+    assert_eq!(camera["field"], 100.0);
+    assert_eq!(camera["projection"], "pinhole");
+    let up = crate::common::numbers(&camera["up"]);
+    assert!(up[2].abs() < 1e-12 && ((up[0].powi(2) + up[1].powi(2)).sqrt() - 1.0).abs() < 1e-12);
     let ((h, w), values) = read_npy(&depth);
     assert_eq!((h, w), (32, 48));
     let worst = values.iter().map(|d| (d - 22.4).abs()).fold(0.0, f32::max);
     // End to end through NIfTI and the CLI; the renderer's own tests hold it to 0.05 voxel.
     assert!(worst < 0.1, "worst depth error {worst} mm");
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+}
+
+/// Renders a 24×24 DVR view of a sphere shell from outside and returns the PNG's bytes.
+fn dvr_view(dir: &std::path::Path, extra: &[&str]) -> Vec<u8> {
+    let volume = dir.join("shell.nii");
+    if !volume.exists() {
+        let args = [
+            "phantom",
+            "sphere-shell",
+            "-o",
+            volume.to_str().unwrap(),
+            "--size",
+            "24",
+        ];
+        assert!(endocast(&args).status.success());
+    }
+    let png = dir.join("dvr.png");
+    let mut args = vec![
+        "render",
+        volume.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ];
+    args.extend_from_slice(&["--mode", "dvr", "--size", "24x24", "--tf", "ramp"]);
+    args.extend_from_slice(extra);
+    let out = endocast(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::read(&png).unwrap()
+}
+
+#[test]
+fn shade_dvr_changes_a_dvr_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let flat = dvr_view(dir.path(), &[]);
+    let shaded = dvr_view(dir.path(), &["--shade-dvr"]);
+    assert_ne!(flat, shaded, "--shade-dvr made no difference");
+}
+
+#[test]
+fn bench_takes_size_and_prints_json_lines_on_stdout() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("b.jsonl");
+    let args = [
+        "bench",
+        "--phantom-size",
+        "32",
+        "--frames",
+        "2",
+        "--size",
+        "16x12",
+        "--mode",
+        "iso",
+        "--json",
+        "--json-file",
+        file.to_str().unwrap(),
+    ];
+    let out = endocast(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("every stdout line is JSON"))
+        .collect();
+    assert!(!lines.is_empty());
+    assert!(lines
+        .iter()
+        .all(|l| l["size"] == serde_json::json!([16, 12]) && l["frames"] == 2));
+    assert_eq!(
+        std::fs::read_to_string(&file).unwrap(),
+        stdout,
+        "the file holds the same lines"
+    );
+    // The old name of --size still works.
+    let old = [
+        "bench",
+        "--phantom-size",
+        "32",
+        "--frames",
+        "2",
+        "--image",
+        "16x12",
+        "--mode",
+        "iso",
+    ];
+    assert!(endocast(&old).status.success());
+}
+
+#[test]
+fn peels_of_the_joint_phantom_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = dir.path().join("joint.nii.gz");
+    let v = volume.to_str().unwrap();
+    assert!(endocast(&["phantom", "joint", "-o", v, "--size", "64"])
+        .status
+        .success());
+    // The eye on the axis 10 mm below the first joint space (its lower surface 1.25 mm below
+    // the centre, the second joint space 12.8 mm higher), looking up across both.
+    let depth = dir.path().join("depth.npy");
+    let png = dir.path().join("peel.png");
+    for (peel, expected) in [("1", 8.75), ("2", 21.55), ("last", 21.55)] {
+        let out = endocast(&[
+            "render",
+            v,
+            "-o",
+            png.to_str().unwrap(),
+            "--mode",
+            "peel",
+            "--peel",
+            peel,
+            "--peel-threshold",
+            "650",
+            "--peel-falling",
+            "--eye",
+            "0,0,-10",
+            "--look-at",
+            "0,0,1",
+            "--up",
+            "0,1,0",
+            "--size",
+            "3x3",
+            "--fov",
+            "10",
+            "--depth-out",
+            depth.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (_, values) = read_npy(&depth);
+        assert!(
+            (values[4] - expected).abs() < 0.1,
+            "peel {peel}: {}",
+            values[4]
+        );
+    }
 }
 
 #[test]
@@ -84,6 +237,11 @@ fn bad_render_options_are_clear_errors() {
         (vec!["--iso-opacity", "1.5"], "iso-opacity"),
         (vec!["--size", "0x10"], "size"),
         (vec!["--threads", "0"], "threads"),
+        (vec!["--peel", "0"], "--peel"),
+        (vec!["--peel-keep", "1.5"], "peel-keep"),
+        (vec!["--unpeeled", "maybe"], "maybe"),
+        (vec!["--tf-after", "/no/such/after.json"], "after.json"),
+        (vec!["--peel-threshold", "inf"], "peel-threshold"),
     ] {
         let mut args = vec!["render", v, "-o", o];
         args.extend(extra.iter().copied());

@@ -4,10 +4,13 @@
 
 mod bad_input;
 mod common;
+mod default_views;
 mod info_shared_data;
+mod integrity;
 mod navigation;
 mod phantom_convert;
 mod presets;
 mod real_scans;
 mod render;
+mod scene;
 mod view;

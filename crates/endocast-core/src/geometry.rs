@@ -86,6 +86,27 @@ impl Geometry {
         })
     }
 
+    /// The geometry whose [`Self::world_from_voxel`] is `world_from_voxel` (LPS mm from voxel
+    /// index): spacing from the lengths of its columns, direction from the unit columns, origin
+    /// from its translation. Fails as [`Self::new`] does (a zero or non-finite column, dependent
+    /// axes).
+    pub fn from_world_from_voxel(
+        dims: [usize; 3],
+        world_from_voxel: DAffine3,
+    ) -> Result<Self, GeometryError> {
+        let m = world_from_voxel.matrix3;
+        let spacing = DVec3::new(m.x_axis.length(), m.y_axis.length(), m.z_axis.length());
+        if !spacing.is_finite() || spacing.min_element() <= 0.0 {
+            return Err(GeometryError::BadSpacing(spacing.to_array()));
+        }
+        let direction = DMat3::from_cols(
+            m.x_axis / spacing.x,
+            m.y_axis / spacing.y,
+            m.z_axis / spacing.z,
+        );
+        Self::new(dims, spacing, world_from_voxel.translation, direction)
+    }
+
     /// An axis-aligned LPS geometry (identity direction) with the given spacing and origin.
     pub fn axis_aligned(
         dims: [usize; 3],
@@ -230,6 +251,21 @@ fn dominant_label(axis: DVec3) -> char {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_affine_gives_back_its_geometry() {
+        let spacing = DVec3::new(0.5, 1.0, 2.5);
+        let origin = DVec3::new(-10.0, 3.0, 7.0);
+        let tilted = DMat3::from_rotation_z(0.3) * DMat3::from_rotation_x(-0.2);
+        let g = Geometry::new([4, 5, 6], spacing, origin, tilted).unwrap();
+        let back = Geometry::from_world_from_voxel([4, 5, 6], g.world_from_voxel()).unwrap();
+        assert!(back.spacing_mm().abs_diff_eq(spacing, 1e-12));
+        assert!(back.origin_mm().abs_diff_eq(origin, 1e-12));
+        assert!(back.direction().abs_diff_eq(tilted, 1e-12));
+        let flat = DAffine3::from_scale(DVec3::new(1.0, 0.0, 1.0));
+        let error = Geometry::from_world_from_voxel([2, 2, 2], flat).unwrap_err();
+        assert!(matches!(error, GeometryError::BadSpacing(_)));
+    }
 
     #[test]
     fn affine_round_trip_with_shear() {

@@ -17,12 +17,15 @@ pub mod camera;
 pub mod coverage;
 pub mod flight;
 pub mod geometry;
+pub mod isosurface;
 pub mod navigate;
 pub mod path;
 pub mod phantom;
 pub mod pose;
 pub mod presets;
 pub mod render;
+pub mod scene;
+pub mod tissue;
 pub mod views;
 pub mod volume;
 

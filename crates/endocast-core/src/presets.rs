@@ -19,12 +19,42 @@
 
 use crate::camera::Projection;
 use crate::navigate::LumenSide;
-use crate::render::{Mode, RenderSettings, TransferFunction};
+use crate::render::{Mode, PeelLayer, PeelSettings, RenderSettings, TransferFunction};
 use crate::views::slices::Window;
 
 /// Vertical field of view of a pinhole endoscope, degrees: the default of every preset and of
 /// commands run without one.
 pub const DEFAULT_FOV_DEG: f64 = 90.0;
+
+/// The field of a fisheye lens when neither the caller nor the preset gives one, degrees: a
+/// wide endoscope's.
+pub const FISHEYE_DEFAULT_FOV_DEG: f64 = 170.0;
+
+/// The projection and field of a view under `preset` (if any), for the `projection` and
+/// `field` a caller asked for (if any): the projection defaults to the preset's, else a
+/// pinhole; the field to the preset's field of view — a fisheye's
+/// [`FISHEYE_DEFAULT_FOV_DEG`] when the preset's own lens is no fisheye — or, orthographic,
+/// `default_height_mm`. The field is not checked against the projection's range here (the
+/// camera does that).
+pub fn lens_defaults(
+    preset: Option<&Preset>,
+    projection: Option<Projection>,
+    field: Option<f64>,
+    default_height_mm: f64,
+) -> (Projection, f64) {
+    let projection = projection
+        .or(preset.map(|p| p.projection))
+        .unwrap_or(Projection::Pinhole);
+    let field = match (field, projection) {
+        (Some(field), _) => field,
+        (None, Projection::Orthographic) => default_height_mm,
+        (None, p) if p.is_fisheye() && preset.is_none_or(|p| !p.projection.is_fisheye()) => {
+            FISHEYE_DEFAULT_FOV_DEG
+        }
+        (None, _) => preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg),
+    };
+    (projection, field)
+}
 
 /// A second isosurface ([`Mode::TwoIso`]'s upper one: stent, calcification).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,6 +67,19 @@ pub struct Surface {
     pub color: Option<[f32; 3]>,
 }
 
+/// The depth peeling of a [`Mode::Peel`] preset (see [`PeelSettings`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PresetPeel {
+    /// Peel threshold, physical units.
+    pub threshold: f64,
+    /// Whether crossings into the darker material count (else into the brighter).
+    pub falling: bool,
+    /// The peel shown.
+    pub layer: PeelLayer,
+    /// Name of the transfer function behind the peel (see [`TransferFunction::preset`]).
+    pub tf_after: &'static str,
+}
+
 /// The lumen a preset flies through: region growing keeps the voxels on `side` of `threshold`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PresetLumen {
@@ -45,6 +88,44 @@ pub struct PresetLumen {
     pub threshold: f64,
     /// Whether the lumen is darker (air, CSF on T1) or brighter (contrast) than the wall.
     pub side: LumenSide,
+    /// What fills the lumen, in one word for messages ("air", "contrast", "CSF").
+    pub tissue: &'static str,
+    /// Which component of the lumen the procedure means.
+    pub structure: Structure,
+}
+
+/// Which connected component of a lumen a procedure means, when no point is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Structure {
+    /// The largest; for a dark lumen, the largest that does not touch the volume's border (the
+    /// air around the patient does).
+    Largest,
+    /// The largest that reaches into a box at the object's centre and does not touch the
+    /// border: the lateral ventricles, not the CSF around the brain nor a lesion.
+    Central,
+    /// The airway tree grown from the trachea's round section in the top axial slices, its
+    /// threshold lowered until it stops leaking into the lung.
+    Trachea,
+}
+
+/// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
+/// scan's own units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reference {
+    /// Hounsfield units: air −1000, water 0; CT scans shift them by their offset.
+    Hounsfield,
+    /// The intensities of a T1 brain MRI (the shared `chris_t1`), anchored at its CSF and
+    /// white-matter levels: a scan's own CSF and tissue levels stretch them (and reverse them
+    /// where CSF is bright).
+    T1Brain {
+        /// Ventricular CSF on the reference scale.
+        csf: f64,
+        /// White matter on the reference scale.
+        tissue: f64,
+    },
+    /// The intensities of the scan the preset was tuned on, used as they are (no tissue level
+    /// anchors them yet).
+    AsGiven,
 }
 
 /// One procedure's defaults. Built only in [`ALL`]; find one with [`Preset::find`].
@@ -68,6 +149,8 @@ pub struct Preset {
     pub iso_color: Option<[f32; 3]>,
     /// The second isosurface of [`Mode::TwoIso`], where the preset has one.
     pub iso2: Option<Surface>,
+    /// The peel of [`Mode::Peel`], where the preset has one.
+    pub peel: Option<PresetPeel>,
     /// The lumen a flight navigates; `None` for the benchmark presets, which are no procedure.
     pub lumen: Option<PresetLumen>,
     /// Window of the slice views, physical units.
@@ -76,6 +159,8 @@ pub struct Preset {
     pub projection: Projection,
     /// The endoscope's field of view, degrees (vertical for a pinhole).
     pub fov_deg: f64,
+    /// The scale the values above are written on.
+    pub reference: Reference,
 }
 
 /// The window for CT with an air-filled lumen: air black, soft tissue light grey, bone white.
@@ -92,13 +177,17 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
+            tissue: "gas",
+            structure: Structure::Largest,
         }),
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "bronchoscopy",
@@ -109,10 +198,13 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         // −900, not −500: at −500 the thin bronchial wall leaks into the lung (−820…−950 HU).
         lumen: Some(PresetLumen {
             threshold: -900.0,
             side: LumenSide::Below,
+            tissue: "air",
+            structure: Structure::Trachea,
         }),
         // The lung window.
         window: Window {
@@ -121,6 +213,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "angioscopy",
@@ -136,9 +229,12 @@ pub const ALL: &[Preset] = &[
             opacity: 1.0,
             color: None,
         }),
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: 130.0,
             side: LumenSide::Above,
+            tissue: "contrast",
+            structure: Structure::Largest,
         }),
         // A vessel window: contrast light grey, calcium and metal white, fat dark.
         window: Window {
@@ -147,6 +243,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "sinus",
@@ -157,9 +254,12 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: -500.0,
             side: LumenSide::Below,
+            tissue: "air",
+            structure: Structure::Largest,
         }),
         // The bone window: air black, thin sinus walls distinct from soft tissue.
         window: Window {
@@ -168,6 +268,7 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "ventricles",
@@ -178,9 +279,12 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.6,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: Some(PresetLumen {
             threshold: 75.0,
             side: LumenSide::Below,
+            tissue: "CSF",
+            structure: Structure::Central,
         }),
         // T1 intensity units (chris_t1: CSF 25–40, white matter 106–130): 0 black, 160 white.
         window: Window {
@@ -189,6 +293,51 @@ pub const ALL: &[Preset] = &[
         },
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        // The CSF and tissue class medians `tissue::measure_csf` finds on chris_t1 (partial
+        // volume lifts CSF from its 25–40 core): that scan keeps the table's values.
+        reference: Reference::T1Brain {
+            csf: 43.0,
+            tissue: 119.0,
+        },
+    },
+    Preset {
+        name: "arthroscopy",
+        description:
+            "T1 MRI joint: from inside one bone, the opposing bone's surface past the joint \
+                      space (peel back into tissue above 30)",
+        mode: Mode::Peel,
+        tf: "arthroscopy",
+        // The peel draws the opposing bone as an opaque surface.
+        iso: 30.0,
+        iso_opacity: 1.0,
+        iso_color: Some([0.93, 0.88, 0.78]),
+        iso2: None,
+        // Measured on shared/data/knee-mri (T1, no contrast). Around the femorotibial joint
+        // two-class Otsu splits the dark joint space, cortex and menisci (mean 24) from marrow
+        // (48) at 36, but 36 lies inside the femoral marrow's texture (median 41, quartile 34),
+        // which would peel; 30 lies midway between the dark class and the tibial marrow's 10th
+        // percentile (35). From inside one bone the first crossing back above it is the other.
+        peel: Some(PresetPeel {
+            threshold: 30.0,
+            falling: false,
+            layer: PeelLayer::Nth(1),
+            tf_after: "arthroscopy",
+        }),
+        // The bones' marrow is the "lumen" the eye starts in.
+        lumen: Some(PresetLumen {
+            threshold: 30.0,
+            side: LumenSide::Above,
+            tissue: "marrow",
+            structure: Structure::Largest,
+        }),
+        // T1 intensity units: joint space black, marrow light grey.
+        window: Window {
+            level_hu: 50.0,
+            width_hu: 100.0,
+        },
+        projection: Projection::Pinhole,
+        fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::AsGiven,
     },
     Preset {
         name: "ramp",
@@ -199,10 +348,12 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.5,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: None,
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
     Preset {
         name: "complex",
@@ -213,10 +364,12 @@ pub const ALL: &[Preset] = &[
         iso_opacity: 0.5,
         iso_color: None,
         iso2: None,
+        peel: None,
         lumen: None,
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
+        reference: Reference::Hounsfield,
     },
 ];
 
@@ -264,6 +417,15 @@ impl Preset {
         if let Some(color) = self.iso_color {
             s.iso_color = color;
         }
+        if let Some(peel) = self.peel {
+            s.peel = PeelSettings {
+                threshold_hu: Some(peel.threshold),
+                falling: peel.falling,
+                layer: peel.layer,
+                tf_after: TransferFunction::preset(peel.tf_after),
+                ..PeelSettings::default()
+            };
+        }
         if let Some(upper) = self.iso2 {
             s.iso2_hu = upper.iso;
             s.iso2_opacity = upper.opacity;
@@ -289,10 +451,10 @@ mod tests {
             assert!(!preset.description.is_empty() && !preset.description.contains('\n'));
         }
         assert_eq!(Preset::find("gastroscopy"), None);
-        assert_eq!(iter().count(), 7);
+        assert_eq!(iter().count(), 8);
         assert_eq!(
             lumen_names(),
-            "colonoscopy, bronchoscopy, angioscopy, sinus, ventricles"
+            "colonoscopy, bronchoscopy, angioscopy, sinus, ventricles, arthroscopy"
         );
     }
 
@@ -304,6 +466,11 @@ mod tests {
             assert_eq!(s.tf, TransferFunction::preset(preset.tf).unwrap());
             assert!(preset.window.width_hu > 0.0);
             assert_eq!(preset.iso2.is_some(), preset.mode == Mode::TwoIso);
+            assert_eq!(preset.peel.is_some(), preset.mode == Mode::Peel);
+            if let Some(peel) = preset.peel {
+                assert!(TransferFunction::preset(peel.tf_after).is_some());
+                assert_eq!(s.peel_threshold_hu(), peel.threshold);
+            }
             assert!((10.0..=170.0).contains(&preset.fov_deg));
         }
     }

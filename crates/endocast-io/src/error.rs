@@ -1,5 +1,9 @@
-//! The one error type of every reader and writer: few broad kinds, each naming the file.
+//! The one error type of every reader and writer: few broad kinds, each naming the file. The
+//! message shows control characters from file names and file content escaped
+//! ([`crate::escape()`]).
 
+use crate::escape::escape;
+use std::fmt::Display;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -8,7 +12,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum ReadError {
     /// The operating system refused (missing file, permission, disk full, ...).
-    #[error("{}: {cause}", path.display())]
+    #[error("{}: {}", shown(.path), escaped(.cause))]
     Io {
         /// The file or directory.
         path: PathBuf,
@@ -16,7 +20,7 @@ pub enum ReadError {
         cause: std::io::Error,
     },
     /// The file is not what its format requires: what was expected and what was found.
-    #[error("{}: {message}", path.display())]
+    #[error("{}: {}", shown(.path), escaped(.message))]
     Format {
         /// The file.
         path: PathBuf,
@@ -24,7 +28,7 @@ pub enum ReadError {
         message: String,
     },
     /// A valid file using a feature we do not read (e.g. a DICOM transfer syntax or data type).
-    #[error("{}: unsupported {what}", path.display())]
+    #[error("{}: unsupported {}", shown(.path), escaped(.what))]
     Unsupported {
         /// The file.
         path: PathBuf,
@@ -32,7 +36,7 @@ pub enum ReadError {
         what: String,
     },
     /// The header asks for more than the configured resource limit.
-    #[error("{}: {what} needs {requested} but the limit is {limit}", path.display())]
+    #[error("{}: {} needs {requested} but the limit is {limit}", shown(.path), escaped(.what))]
     Limit {
         /// The file.
         path: PathBuf,
@@ -44,7 +48,7 @@ pub enum ReadError {
         limit: u64,
     },
     /// Parts of the input contradict each other (e.g. slices of different sizes in a series).
-    #[error("{}: inconsistent input: {message}", path.display())]
+    #[error("{}: inconsistent input: {}", shown(.path), escaped(.message))]
     Inconsistent {
         /// The file or directory.
         path: PathBuf,
@@ -96,6 +100,14 @@ impl ReadError {
             | Self::Inconsistent { path, .. } => path,
         }
     }
+}
+
+fn shown(path: &Path) -> String {
+    escape(&path.display().to_string())
+}
+
+fn escaped(text: &impl Display) -> String {
+    escape(&text.to_string())
 }
 
 /// Result of reading or writing a scan.

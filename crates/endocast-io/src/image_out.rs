@@ -1,5 +1,6 @@
-//! Writers for rendered images: 8-bit PNG (RGB or RGBA, tagged sRGB) and single-channel float
-//! images as NumPy `.npy` files (e.g. a depth image in millimetres with NaN where no ray hit).
+//! Writers for rendered images: 8-bit PNG (RGB or RGBA, tagged sRGB) or JPEG (RGB, chosen by
+//! the file's ending, see [`ImageFormat`]) and single-channel float images as NumPy `.npy`
+//! files (e.g. a depth image in millimetres with NaN where no ray hit).
 //!
 //! Both take pixels row by row, row 0 at the top of the image, left to right within a row, and
 //! write through [`write_file`] so a failed write never leaves a half file behind.
@@ -7,6 +8,75 @@
 use crate::atomic::write_file;
 use crate::error::{ReadError, Result};
 use std::path::Path;
+
+/// The formats a rendered view is written in, by the output's ending.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// `.png`: lossless.
+    Png,
+    /// `.jpg` or `.jpeg`: baseline JPEG, quality [`JPEG_QUALITY`], no chroma subsampling.
+    Jpeg,
+}
+
+/// The quality of JPEG output (1–100).
+pub const JPEG_QUALITY: u8 = 92;
+
+impl ImageFormat {
+    /// The format `path`'s ending names (case-insensitive); any other ending, or none, is
+    /// refused with a message naming the ones written.
+    pub fn for_path(path: &Path) -> Result<Self> {
+        let ending = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ending.as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("jpg" | "jpeg") => Ok(Self::Jpeg),
+            Some(other) => Err(ReadError::unsupported(
+                path,
+                format!("image output .{other}: write .png or .jpg"),
+            )),
+            None => Err(ReadError::unsupported(
+                path,
+                "image output without an ending: write .png or .jpg",
+            )),
+        }
+    }
+}
+
+/// Writes an 8-bit RGB image in the format `path`'s ending names ([`ImageFormat::for_path`]):
+/// `pixels` holds `width·height·3` bytes, row 0 at the top.
+pub fn write_image_rgb8(path: &Path, width: u32, height: u32, pixels: &[u8]) -> Result<()> {
+    match ImageFormat::for_path(path)? {
+        ImageFormat::Png => write_png_rgb8(path, width, height, pixels),
+        ImageFormat::Jpeg => write_jpeg_rgb8(path, width, height, pixels),
+    }
+}
+
+/// Writes an 8-bit RGB JPEG (quality [`JPEG_QUALITY`], 4:4:4): `pixels` holds
+/// `width·height·3` bytes, row 0 at the top. Edges are at most 65 535 pixels.
+pub fn write_jpeg_rgb8(path: &Path, width: u32, height: u32, pixels: &[u8]) -> Result<()> {
+    let edges = u16::try_from(width)
+        .ok()
+        .zip(u16::try_from(height).ok())
+        .filter(|&(w, h)| w > 0 && h > 0);
+    let Some((w, h)) = edges else {
+        return Err(ReadError::format(
+            path,
+            format!("a JPEG has 1 to 65535 pixels per edge, the image is {width}×{height}"),
+        ));
+    };
+    check_len(path, width, height, 3, pixels.len())?;
+    write_file(path, |out| {
+        let mut encoder = jpeg_encoder::Encoder::new(out, JPEG_QUALITY);
+        encoder.set_sampling_factor(jpeg_encoder::SamplingFactor::F_1_1);
+        encoder
+            .encode(pixels, w, h, jpeg_encoder::ColorType::Rgb)
+            .map_err(|e| match e {
+                jpeg_encoder::EncodingError::IoError(io) => io,
+                other => std::io::Error::other(other.to_string()),
+            })
+    })
+}
 
 /// Writes an 8-bit RGB PNG: `pixels` holds `width·height·3` bytes, row 0 at the top.
 pub fn write_png_rgb8(path: &Path, width: u32, height: u32, pixels: &[u8]) -> Result<()> {
@@ -130,6 +200,28 @@ mod tests {
         assert_eq!(h[127], b'\n');
         // NumPy's own writer also pads the smallest shape to 128 bytes.
         assert_eq!(npy_header(1, 1).len(), 128);
+    }
+
+    #[test]
+    fn the_ending_picks_png_or_jpeg_and_refuses_others() {
+        let dir = tempfile::tempdir().unwrap();
+        let rgb: Vec<u8> = (0..16 * 8 * 3).map(|n| (n * 5 % 256) as u8).collect();
+        for (name, magic) in [
+            ("a.png", &b"\x89PNG"[..]),
+            ("b.JPG", &[0xFF, 0xD8, 0xFF][..]),
+        ] {
+            let p = dir.path().join(name);
+            write_image_rgb8(&p, 16, 8, &rgb).unwrap();
+            assert!(std::fs::read(&p).unwrap().starts_with(magic), "{name}");
+        }
+        for name in ["c.bmp", "d"] {
+            let p = dir.path().join(name);
+            let err = write_image_rgb8(&p, 16, 8, &rgb).unwrap_err().to_string();
+            assert!(err.contains(name) && err.contains(".png or .jpg"), "{err}");
+            assert!(!p.exists());
+        }
+        let p = dir.path().join("wide.jpg");
+        assert!(write_jpeg_rgb8(&p, 70_000, 1, &vec![0; 210_000]).is_err());
     }
 
     #[test]

@@ -18,13 +18,17 @@
 //! ```
 
 pub mod atomic;
+mod compressed;
 pub mod dicom;
 mod encode;
 pub mod error;
+mod escape;
+mod guard;
 pub mod image_out;
 pub mod limits;
 mod loaded;
 pub mod markups;
+pub mod mesh;
 pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;
@@ -38,7 +42,10 @@ pub mod transfer_json;
 pub mod video;
 
 pub use error::{ReadError, Result};
-pub use image_out::{write_npy_f32, write_png_rgb8, write_png_rgba8};
+pub use escape::escape;
+pub use image_out::{
+    write_image_rgb8, write_jpeg_rgb8, write_npy_f32, write_png_rgb8, write_png_rgba8, ImageFormat,
+};
 pub use limits::Limits;
 pub use loaded::{Format, Loaded, OpenOptions, SeriesSummary, SourceInfo};
 pub use open::{open, write};

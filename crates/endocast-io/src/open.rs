@@ -2,6 +2,7 @@
 //! source said about itself, and the warnings gathered on the way.
 
 use crate::error::{ReadError, Result};
+use crate::escape::escape;
 use crate::loaded::{Format, Loaded, OpenOptions};
 use crate::{dicom, metaimage, nifti, nrrd, raw};
 use endocast_core::{Geometry, Volume};
@@ -10,7 +11,8 @@ use std::path::Path;
 
 /// Reads the scan at `path`, choosing the reader from the path: a directory is a DICOM series;
 /// otherwise the extension; otherwise the file's magic bytes. Raw files are read only when
-/// `options.raw` describes them.
+/// `options.raw` describes them. The warnings come with control characters escaped
+/// ([`escape`]), as error messages do.
 pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let meta = std::fs::metadata(path).map_err(|e| ReadError::io(path, e))?;
     if options.raw.is_some() {
@@ -31,7 +33,12 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         Format::MetaImage => metaimage::read(path, options),
         Format::Raw => raw::read(path, options),
     }?;
-    apply_orientation(path, loaded, options.orientation.as_deref())
+    let mut loaded = apply_orientation(path, loaded, options.orientation.as_deref())?;
+    // Warnings quote headers and file names: no control characters reach the terminal.
+    for warning in &mut loaded.warnings {
+        *warning = escape(warning);
+    }
+    Ok(loaded)
 }
 
 /// Gives an undeclared orientation the code the user named (see [`OpenOptions::orientation`]).

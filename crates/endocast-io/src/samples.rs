@@ -128,8 +128,11 @@ pub fn read_voxels(
         ReadError::format(
             path,
             format!(
-                "rescale slope {} / intercept {} must be finite with a non-zero slope",
-                rescale.slope, rescale.intercept
+                "rescale slope {} / intercept {} must be finite with a non-zero slope, and \
+                 keep every {} sample finite",
+                rescale.slope,
+                rescale.intercept,
+                ty.name()
             ),
         )
     };
@@ -137,7 +140,9 @@ pub fn read_voxels(
         return read_wide(path, reader, ty, endian, count, rescale, warnings);
     };
     let map = ValueMap::new(rescale.slope, rescale.intercept + type_min * rescale.slope)
-        .map_err(|_| bad_rescale())?;
+        .ok()
+        .filter(|map| map.physical(u16::MAX).is_finite())
+        .ok_or_else(bad_rescale)?;
     let mut voxels = vec![0u16; count];
     let mut bytes = vec![0u8; CHUNK_SAMPLES * ty.size()];
     for (chunk_index, out) in voxels.chunks_mut(CHUNK_SAMPLES).enumerate() {
@@ -218,6 +223,36 @@ fn decode_wide(bytes: &[u8], ty: ElementType, endian: Endian) -> f64 {
     }
 }
 
+/// The value map for finite physical values in `[lo, hi]`, or a clear error when 16 bits
+/// cannot span the range: wider than the largest `f64` (values of ±1e308, as a misread
+/// datatype or byte order gives) or too narrow for a non-zero step.
+fn wide_value_map(
+    path: &Path,
+    ty: ElementType,
+    lo: f64,
+    hi: f64,
+    integral: bool,
+) -> Result<ValueMap> {
+    let problem = if !(hi - lo).is_finite() {
+        "a range wider than the largest floating-point number, which 16-bit voxels cannot \
+         represent (a wrong datatype or byte order in the header?)"
+    } else {
+        "a range too narrow for 16-bit voxels to resolve"
+    };
+    ValueMap::fitting(lo, hi, integral)
+        .ok()
+        .filter(|map| map.physical(u16::MAX).is_finite())
+        .ok_or_else(|| {
+            ReadError::format(
+                path,
+                format!(
+                    "the {} sample values span [{lo:e}, {hi:e}]: {problem}",
+                    ty.name()
+                ),
+            )
+        })
+}
+
 fn read_wide(
     path: &Path,
     reader: &mut dyn Read,
@@ -254,8 +289,7 @@ fn read_wide(
             path.display()
         ));
     }
-    let map =
-        ValueMap::fitting(lo, hi, integral).map_err(|e| ReadError::format(path, e.to_string()))?;
+    let map = wide_value_map(path, ty, lo, hi, integral)?;
     if map.scale() != 1.0 {
         warnings.push(format!(
             "{}: {} values in [{lo}, {hi}] quantised to 16 bits (step {:.3e})",
@@ -357,6 +391,29 @@ mod tests {
         let (vox, map) = read(&bytes, ElementType::I32, Endian::Big, 2).unwrap();
         assert_eq!(map.physical(vox[0]), -70_000.0);
         assert_eq!(map.physical(vox[1]), -69_000.0);
+    }
+
+    #[test]
+    fn extreme_floats_are_a_clear_error() {
+        let values = [-1e308f64, 0.0, 1e308];
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let err = read(&bytes, ElementType::F64, Endian::Little, 3)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("t: the float64 sample values span [-1e308, 1e308]"),
+            "{err}"
+        );
+        let tiny = [0.0f64, 1e-320];
+        let bytes: Vec<u8> = tiny.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let err = read(&bytes, ElementType::F64, Endian::Little, 2).unwrap_err();
+        assert!(err.to_string().contains("too narrow"), "{err}");
+        // Extreme but spanning less than f64::MAX: quantised, with a warning.
+        let wide = [-1e307f64, 1.5e308];
+        let bytes: Vec<u8> = wide.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let (vox, map) = read(&bytes, ElementType::F64, Endian::Little, 2).unwrap();
+        assert_eq!(map.physical(vox[0]), -1e307);
+        assert!((map.physical(vox[1]) / 1.5e308 - 1.0).abs() < 1e-12);
     }
 
     #[test]

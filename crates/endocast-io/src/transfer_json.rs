@@ -14,6 +14,7 @@
 //! interpolation belong to the renderer's transfer function.
 
 use crate::error::{ReadError, Result};
+use endocast_core::render::TransferFunction;
 use serde_json::Value;
 use std::path::Path;
 
@@ -33,6 +34,23 @@ pub struct TfPoints {
 pub fn read_transfer_json(path: &Path) -> Result<TfPoints> {
     let text = crate::text::read_text(path, MAX_BYTES, "a transfer function file")?;
     parse_transfer_json(path, &text)
+}
+
+/// The transfer function `spec` names: a JSON file (when that path exists or ends in `.json`)
+/// or else a preset by name ([`TransferFunction::PRESETS`]); how `--tf` and the Python
+/// bindings read it.
+pub fn transfer_function(spec: &str) -> Result<TransferFunction> {
+    let path = Path::new(spec);
+    if path.exists() || spec.ends_with(".json") {
+        let points = read_transfer_json(path)?;
+        return TransferFunction::from_points(&points.opacity, &points.color)
+            .map_err(|e| ReadError::format(path, format!("not a usable transfer function: {e}")));
+    }
+    TransferFunction::preset(spec).ok_or_else(|| {
+        let presets = TransferFunction::PRESETS.join(", ");
+        let what = format!("transfer function: neither a file nor a preset ({presets})");
+        ReadError::unsupported(path, what)
+    })
 }
 
 /// Parses the text of a transfer-function file; `path` only names it in errors.
@@ -123,6 +141,17 @@ fn point<const N: usize>(entry: &Value) -> std::result::Result<(f64, [f32; N]), 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_spec_is_a_file_or_a_preset() {
+        assert!(transfer_function("colonoscopy").is_ok());
+        let unknown = transfer_function("gastroscopy").unwrap_err().to_string();
+        assert!(unknown.contains("neither a file nor a preset"), "{unknown}");
+        let missing = transfer_function("no/such/tf.json")
+            .unwrap_err()
+            .to_string();
+        assert!(missing.contains("no/such/tf.json"), "{missing}");
+    }
 
     fn parse(text: &str) -> Result<TfPoints> {
         parse_transfer_json(Path::new("tf.json"), text)

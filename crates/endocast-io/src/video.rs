@@ -1,5 +1,6 @@
-//! Frame sinks for fly-throughs: a folder of numbered PNGs, an animated GIF, or an MP4 through
-//! the `ffmpeg` command-line tool. [`open_sink`] picks one from the output path.
+//! Frame sinks for fly-throughs: a folder of numbered PNGs, an animated GIF, or an MP4 (H.264
+//! by the bundled OpenH264 encoder and our own muxer, or by the `ffmpeg` command-line tool when
+//! asked). [`open_sink`] picks one from the output path.
 //!
 //! Every sink streams: a frame is encoded (or handed to `ffmpeg`) when it is pushed and nothing
 //! keeps the frames, so a flight of any length runs in bounded memory. No sink leaves a half
@@ -18,6 +19,7 @@
 //! # Ok::<(), endocast_io::ReadError>(())
 //! ```
 
+use crate::atomic::Pending;
 use crate::error::{ReadError, Result};
 use crate::image_out::write_png_rgb8;
 use endocast_core::views::Image;
@@ -26,6 +28,9 @@ use std::io::{BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::thread::JoinHandle;
+
+mod h264;
+mod mp4;
 
 /// Where the frames of a fly-through go.
 pub trait FrameSink {
@@ -52,7 +57,7 @@ pub enum SinkKind {
     PngFolder,
     /// `.gif`: an animated GIF that loops.
     Gif,
-    /// `.mp4`: H.264 video by the `ffmpeg` command-line tool.
+    /// `.mp4`: H.264 video (yuv420p), by the built-in encoder or by `ffmpeg`.
     Mp4,
 }
 
@@ -85,8 +90,9 @@ pub struct VideoOptions {
     /// Frames per second, 0.1–240. Default 25. (GIF stores delays in hundredths of a second, so
     /// its rate is rounded to the nearest such delay.)
     pub fps: f64,
-    /// The `ffmpeg` program for MP4: a name looked up on `PATH` or a path. Default `ffmpeg`.
-    pub ffmpeg: PathBuf,
+    /// MP4 through this `ffmpeg` program (libx264; a name looked up on `PATH` or a path)
+    /// instead of the built-in OpenH264 encoder. Default `None`: built in, nothing to install.
+    pub ffmpeg: Option<PathBuf>,
     /// GIF colour quantisation speed, 1 (best) to 30 (fastest), NeuQuant's sampling factor.
     /// Default 10.
     pub gif_speed: i32,
@@ -96,14 +102,14 @@ impl Default for VideoOptions {
     fn default() -> Self {
         Self {
             fps: 25.0,
-            ffmpeg: PathBuf::from("ffmpeg"),
+            ffmpeg: None,
             gif_speed: 10,
         }
     }
 }
 
-/// Opens the sink `path` asks for (see [`SinkKind::for_path`]). MP4 checks here that `ffmpeg`
-/// runs, so a missing tool is reported before any frame is rendered.
+/// Opens the sink `path` asks for (see [`SinkKind::for_path`]). MP4 through `ffmpeg` checks here
+/// that it runs, so a missing tool is reported before any frame is rendered.
 pub fn open_sink(path: &Path, options: &VideoOptions) -> Result<Box<dyn FrameSink>> {
     if !(options.fps.is_finite() && (0.1..=240.0).contains(&options.fps)) {
         let message = format!("{} frames per second is outside 0.1–240", options.fps);
@@ -116,7 +122,10 @@ pub fn open_sink(path: &Path, options: &VideoOptions) -> Result<Box<dyn FrameSin
     Ok(match SinkKind::for_path(path)? {
         SinkKind::PngFolder => Box::new(PngFolder::create(path)?),
         SinkKind::Gif => Box::new(GifSink::create(path, options)?),
-        SinkKind::Mp4 => Box::new(Mp4Sink::create(path, options)?),
+        SinkKind::Mp4 => match &options.ffmpeg {
+            None => Box::new(H264Sink::create(path, options)?),
+            Some(program) => Box::new(FfmpegSink::create(path, program, options)?),
+        },
     })
 }
 
@@ -172,6 +181,10 @@ struct TempTarget {
     target: PathBuf,
     temporary: PathBuf,
     committed: bool,
+    /// Lists the temporary file for a signal handler (see [`remove_temporary_files`]).
+    ///
+    /// [`remove_temporary_files`]: crate::atomic::remove_temporary_files
+    _listed: Pending,
 }
 
 impl TempTarget {
@@ -186,6 +199,7 @@ impl TempTarget {
         ));
         Ok(Self {
             target: target.to_path_buf(),
+            _listed: Pending::new(&temporary),
             temporary,
             committed: false,
         })
@@ -354,11 +368,84 @@ impl FrameSink for GifSink {
     }
 }
 
+/// H.264 in MP4 by the built-in encoder ([`h264`]) and muxer ([`mp4`]), into a temporary file
+/// created at the first frame.
+struct H264Sink {
+    target: TempTarget,
+    fps: f64,
+    coder: Option<(h264::H264Encoder, mp4::Mp4Muxer<BufWriter<File>>)>,
+    size: FrameSize,
+}
+
+impl H264Sink {
+    fn create(path: &Path, options: &VideoOptions) -> Result<Self> {
+        Ok(Self {
+            target: TempTarget::new(path)?,
+            fps: options.fps,
+            coder: None,
+            size: FrameSize::default(),
+        })
+    }
+
+    /// The encoder and the muxer for frames of `width × height`, made at the first frame.
+    fn start(
+        &self,
+        width: usize,
+        height: usize,
+    ) -> Result<(h264::H264Encoder, mp4::Mp4Muxer<BufWriter<File>>)> {
+        let path = &self.target.target;
+        let encoder = h264::H264Encoder::new(width, height, self.fps)
+            .map_err(|e| ReadError::io(path, std::io::Error::other(e)))?;
+        let file = File::create(&self.target.temporary).map_err(|e| ReadError::io(path, e))?;
+        let (w, h) = encoder.padded_size();
+        // Both edges are at most MP4_MAX_EDGE (even), checked by the caller.
+        let muxer = mp4::Mp4Muxer::new(BufWriter::new(file), w as u16, h as u16, self.fps)
+            .map_err(|e| ReadError::io(path, e))?;
+        Ok((encoder, muxer))
+    }
+}
+
+/// The longest frame edge written to MP4 (the sample entry holds 16 bits). The built-in
+/// encoder refuses more than 3840 × 2160 itself, with its own message.
+const MP4_MAX_EDGE: usize = 16384;
+
+impl FrameSink for H264Sink {
+    fn push(&mut self, rgb: &[u8], width: usize, height: usize) -> Result<()> {
+        let path = self.target.target.clone();
+        self.size.check(&path, rgb, (width, height), MP4_MAX_EDGE)?;
+        if self.coder.is_none() {
+            self.coder = Some(self.start(width, height)?);
+        }
+        let Some((encoder, muxer)) = self.coder.as_mut() else {
+            return Err(ReadError::format(&path, "the H.264 encoder failed before"));
+        };
+        let frame = encoder
+            .encode(rgb)
+            .map_err(|e| ReadError::io(&path, std::io::Error::other(e)))?;
+        muxer.push(&frame).map_err(|e| ReadError::io(&path, e))
+    }
+
+    fn frames(&self) -> usize {
+        self.coder.as_ref().map_or(0, |(_, muxer)| muxer.frames())
+    }
+
+    fn finish(mut self: Box<Self>) -> Result<PathBuf> {
+        let path = self.target.target.clone();
+        let (_, muxer) = self.coder.take().ok_or_else(|| no_frames(&path))?;
+        let io = |e| ReadError::io(&path, e);
+        let writer = muxer.finish().map_err(io)?;
+        let file = writer.into_inner().map_err(|e| io(e.into_error()))?;
+        file.sync_all().map_err(io)?;
+        drop(file);
+        self.target.commit()
+    }
+}
+
 /// Most of `ffmpeg`'s error output kept for the error message, bytes.
 const STDERR_KEPT: usize = 4000;
 
 /// H.264 in MP4 by an `ffmpeg` child process reading raw RGB frames on its standard input.
-struct Mp4Sink {
+struct FfmpegSink {
     target: TempTarget,
     program: PathBuf,
     fps: f64,
@@ -369,12 +456,12 @@ struct Mp4Sink {
     frames: usize,
 }
 
-impl Mp4Sink {
-    fn create(path: &Path, options: &VideoOptions) -> Result<Self> {
-        check_ffmpeg(path, &options.ffmpeg)?;
+impl FfmpegSink {
+    fn create(path: &Path, program: &Path, options: &VideoOptions) -> Result<Self> {
+        check_ffmpeg(path, program)?;
         Ok(Self {
             target: TempTarget::new(path)?,
-            program: options.ffmpeg.clone(),
+            program: program.to_path_buf(),
             fps: options.fps,
             child: None,
             stdin: None,
@@ -462,16 +549,16 @@ fn ffmpeg_missing(path: &Path, program: &Path, e: &std::io::Error) -> ReadError 
         path,
         format!(
             "MP4 output: the ffmpeg command-line tool `{}` could not be run ({e}); install \
-             ffmpeg, or write an animated GIF (an output ending in .gif) or a folder of PNGs",
+             ffmpeg or leave the built-in H.264 encoder to write the MP4",
             program.display()
         ),
     )
 }
 
-impl FrameSink for Mp4Sink {
+impl FrameSink for FfmpegSink {
     fn push(&mut self, rgb: &[u8], width: usize, height: usize) -> Result<()> {
         let path = self.target.target.clone();
-        self.size.check(&path, rgb, (width, height), 16384)?;
+        self.size.check(&path, rgb, (width, height), MP4_MAX_EDGE)?;
         if self.child.is_none() {
             self.spawn(width, height)?;
         }
@@ -498,7 +585,7 @@ impl FrameSink for Mp4Sink {
     }
 }
 
-impl Drop for Mp4Sink {
+impl Drop for FfmpegSink {
     fn drop(&mut self) {
         drop(self.stdin.take());
         if let Some(mut child) = self.child.take() {

@@ -3,11 +3,11 @@
 
 #![allow(clippy::unwrap_used)] // helpers of tests: a failed unwrap is a failed test
 
-use crate::common::shared_data;
 use dicom_dictionary_std::tags;
 use dicom_object::OpenFileOptions;
 use endocast_core::Modality;
 use endocast_io::{dicom, Format, OpenOptions, ReadError};
+use endocast_testdata::shared_data;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
@@ -67,6 +67,38 @@ fn all_nine_transfer_syntaxes_decode_to_identical_pixels() {
         .source
         .stored_type
         .ends_with("Implicit VR Little Endian"));
+}
+
+/// FNV-1a over the voxels' little-endian bytes.
+fn voxel_checksum(voxels: &[u16]) -> u64 {
+    voxels
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .fold(0xcbf2_9ce4_8422_2325, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        })
+}
+
+/// The JPEG-LS files decode to the pixels CharLS gave before the switch to a pure-Rust decoder
+/// (checksums recorded with CharLS 2.4.5 through dicom-rs 0.10), which are also the pixels of
+/// the uncompressed file.
+#[test]
+fn jpeg_ls_files_decode_to_the_pixels_charls_gave() {
+    const CHARLS_CHECKSUM: u64 = 0x3f7b_7f11_0b8d_2dd2;
+    let Some(dir) = shared_data("dicom-transfer-syntaxes") else {
+        return;
+    };
+    let reference = read(&dir.join("1.dcm"));
+    for name in ["7.dcm", "8.dcm"] {
+        let loaded = read(&dir.join(name));
+        assert!(loaded.source.stored_type.contains("JPEG-LS"), "{name}");
+        let sum = voxel_checksum(loaded.volume.voxels());
+        assert_eq!(sum, CHARLS_CHECKSUM, "{name}");
+        assert!(
+            loaded.volume.voxels() == reference.volume.voxels(),
+            "{name}"
+        );
+    }
 }
 
 #[test]

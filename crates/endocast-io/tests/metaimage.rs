@@ -4,7 +4,6 @@
 // Helpers panic on failure like the tests that call them.
 #![allow(clippy::unwrap_used)]
 
-use crate::common;
 use crate::test_volumes::{assert_same_volume, oblique_ct, scaled_volume, sheared_ct};
 use endocast_io::{metaimage, open, Format, Limits, Loaded, OpenOptions, ReadError};
 use glam::{DMat3, DVec3};
@@ -56,7 +55,7 @@ fn assert_knee(loaded: &Loaded, expected_voxels: &[u8]) {
 
 #[test]
 fn knee_raw_and_zlib() {
-    let Some(dir) = common::shared_data("knee-mri") else {
+    let Some(dir) = endocast_testdata::shared_data("knee-mri") else {
         return;
     };
     let raw_path = dir.join("knee3D_dataT.mha");

@@ -4,7 +4,6 @@
 // Helpers panic on failure like the tests that call them.
 #![allow(clippy::unwrap_used)]
 
-use crate::common;
 use crate::test_volumes::{assert_same_volume, oblique_ct, scaled_volume, sheared_ct};
 use endocast_io::{nifti, open, Format, Limits, OpenOptions, ReadError};
 use glam::DVec3;
@@ -18,7 +17,7 @@ fn read(path: &Path) -> Result<endocast_io::Loaded, ReadError> {
 
 #[test]
 fn brain_t1_is_ras_with_the_head_top_superior() {
-    let Some(dir) = common::shared_data("brain-mri-t1") else {
+    let Some(dir) = endocast_testdata::shared_data("brain-mri-t1") else {
         return;
     };
     let loaded = read(&dir.join("chris_t1.nii.gz")).unwrap();
@@ -68,7 +67,7 @@ fn brain_t1_is_ras_with_the_head_top_superior() {
 
 #[test]
 fn engine_ct_reads() {
-    let Some(dir) = common::shared_data("classic-engine-ct") else {
+    let Some(dir) = endocast_testdata::shared_data("classic-engine-ct") else {
         return;
     };
     let loaded = read(&dir.join("engine.nii.gz")).unwrap();

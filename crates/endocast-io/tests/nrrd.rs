@@ -4,9 +4,9 @@
 // Helpers panic on failure like the tests that call them.
 #![allow(clippy::unwrap_used)]
 
-use crate::common::shared_data;
 use endocast_core::{Geometry, Modality, ValueMap, Volume};
 use endocast_io::{nrrd, Limits, Loaded, OpenOptions, ReadError};
+use endocast_testdata::shared_data;
 use glam::{DMat3, DVec3};
 use std::path::{Path, PathBuf};
 

@@ -221,7 +221,6 @@ fn detached_metaimage(volume: &Volume) -> Seed {
 
 /// Real DICOM files in several transfer syntaxes, when the shared data is present.
 fn dicom_seeds() -> Vec<Seed> {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
     let files = [
         ("dicom-explicit-le", "dicom-transfer-syntaxes/1.dcm"),
         ("dicom-big-endian", "dicom-transfer-syntaxes/3.dcm"),
@@ -232,10 +231,10 @@ fn dicom_seeds() -> Vec<Seed> {
     ];
     let mut seeds = Vec::new();
     for (name, rel) in files {
-        let Ok(bytes) = std::fs::read(root.join(rel)) else {
-            eprintln!("skipping DICOM seed {rel}: shared data absent");
+        let Some(path) = endocast_testdata::shared_data(rel) else {
             continue;
         };
+        let bytes = std::fs::read(&path).expect("a shared DICOM file reads");
         seeds.push(Seed {
             name,
             files: vec![("s.dcm".into(), bytes)],

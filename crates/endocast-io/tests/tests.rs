@@ -2,13 +2,17 @@
 
 #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
-mod common;
+mod corruption;
 mod cross_format;
 mod dicom;
 mod image_out;
+mod mesh;
 mod metaimage;
+mod mp4;
 mod nifti;
 mod nrrd;
+mod peel_real_scans;
+mod scans_understood;
 mod stereo_real_scans;
 mod test_volumes;
 mod transfer_json;

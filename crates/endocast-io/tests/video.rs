@@ -1,4 +1,5 @@
-//! Frame sinks: PNG folders, animated GIFs and MP4 through ffmpeg.
+//! Frame sinks: PNG folders, animated GIFs and MP4 through ffmpeg (the built-in MP4 encoder:
+//! `mp4.rs`).
 
 use endocast_core::views::Image;
 use endocast_io::video::{open_sink, SinkKind, VideoOptions};
@@ -6,14 +7,14 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 
 /// Frame `n` of a small test flight: a horizontal gradient whose red channel steps with `n`.
-fn frame(n: usize, width: usize, height: usize) -> Vec<u8> {
+pub fn frame(n: usize, width: usize, height: usize) -> Vec<u8> {
     (0..width * height)
         .flat_map(|p| [(n * 40 % 256) as u8, (p % width * 255 / width) as u8, 90])
         .collect()
 }
 
 /// Files in `dir`, sorted.
-fn listing(dir: &Path) -> Vec<String> {
+pub fn listing(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -139,14 +140,14 @@ fn bad_frames_are_refused_and_leave_nothing() {
 }
 
 #[test]
-fn mp4_without_ffmpeg_says_what_to_do() {
+fn mp4_through_a_missing_ffmpeg_says_what_to_do() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("flight.mp4");
     let mut options = VideoOptions::default();
-    options.ffmpeg = dir.path().join("no-such-ffmpeg");
+    options.ffmpeg = Some(dir.path().join("no-such-ffmpeg"));
     let err = open_sink(&path, &options).err().unwrap().to_string();
     assert!(
-        err.contains("ffmpeg") && err.contains(".gif") && err.contains("flight.mp4"),
+        err.contains("no-such-ffmpeg") && err.contains("built-in") && err.contains("flight.mp4"),
         "{err}"
     );
     assert!(listing(dir.path()).is_empty());
@@ -166,7 +167,9 @@ fn mp4_through_ffmpeg() {
     }
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("flight.mp4");
-    let mut sink = open_sink(&path, &VideoOptions::default()).unwrap();
+    let mut options = VideoOptions::default();
+    options.ffmpeg = Some("ffmpeg".into());
+    let mut sink = open_sink(&path, &options).unwrap();
     // An odd size: padded to even for 4:2:0.
     for n in 0..12 {
         sink.push(&frame(n, 33, 25), 33, 25).unwrap();
@@ -199,7 +202,10 @@ fn mp4_streams_frames_to_ffmpeg_and_renames_on_success() {
     let path = dir.path().join("flight.mp4");
     let mut options = VideoOptions::default();
     // Records its arguments and the number of bytes it was fed.
-    options.ffmpeg = fake_ffmpeg(tools.path(), "echo \"$*\" > \"$out\"; wc -c >> \"$out\"");
+    options.ffmpeg = Some(fake_ffmpeg(
+        tools.path(),
+        "echo \"$*\" > \"$out\"; wc -c >> \"$out\"",
+    ));
     let mut sink = open_sink(&path, &options).unwrap();
     for n in 0..12 {
         sink.push(&frame(n, 33, 25), 33, 25).unwrap();
@@ -221,17 +227,20 @@ fn a_failing_ffmpeg_leaves_no_file_and_shows_its_message() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("flight.mp4");
     let mut options = VideoOptions::default();
-    options.ffmpeg = fake_ffmpeg(
+    options.ffmpeg = Some(fake_ffmpeg(
         tools.path(),
         "cat > /dev/null; echo partial > \"$out\"; echo 'Unknown encoder libx264' >&2; exit 1",
-    );
+    ));
     let mut sink = open_sink(&path, &options).unwrap();
     sink.push(&frame(0, 8, 8), 8, 8).unwrap();
     let err = sink.finish().unwrap_err().to_string();
     assert!(err.contains("Unknown encoder libx264"), "{err}");
     assert!(listing(dir.path()).is_empty());
     // Dropped before finishing: ffmpeg is stopped and its partial output removed.
-    options.ffmpeg = fake_ffmpeg(tools.path(), "echo partial > \"$out\"; cat > /dev/null");
+    options.ffmpeg = Some(fake_ffmpeg(
+        tools.path(),
+        "echo partial > \"$out\"; cat > /dev/null",
+    ));
     let mut sink = open_sink(&path, &options).unwrap();
     sink.push(&frame(0, 8, 8), 8, 8).unwrap();
     std::thread::sleep(std::time::Duration::from_millis(100));

@@ -23,7 +23,7 @@ fn main() {
         ..PhantomOptions::default()
     };
     let (volume, colon) = phantom::colon(&options);
-    let geometry = volume.geometry().clone();
+    let geometry = *volume.geometry();
     let line = &colon.centreline;
     let source = ScanSource::Phantom {
         name: "colon".into(),

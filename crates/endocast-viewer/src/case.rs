@@ -116,11 +116,20 @@ pub struct CaseError {
 }
 
 impl CaseError {
-    fn new(path: &Path, problem: impl ToString) -> Self {
+    fn new(path: &Path, problem: impl Into<Problem>) -> Self {
         Self {
             path: path.to_owned(),
-            problem: problem.to_string(),
+            problem: problem.into().0,
         }
+    }
+}
+
+/// A case error's problem in words (from any error or text).
+struct Problem(String);
+
+impl<T: std::fmt::Display> From<T> for Problem {
+    fn from(problem: T) -> Self {
+        Self(problem.to_string())
     }
 }
 

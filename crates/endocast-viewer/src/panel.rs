@@ -233,9 +233,11 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
     }
     if !session.key_frames().is_empty() && ui.button("Export key frames (path JSON)").clicked() {
         let path = Path::new("endocast-key-frames.json");
-        let mut document = endocast_io::path_file::PathDocument::default();
-        document.name = "key frames".into();
-        document.key_frames = session.key_frames().to_vec();
+        let document = endocast_io::path_file::PathDocument {
+            name: "key frames".into(),
+            key_frames: session.key_frames().to_vec(),
+            ..Default::default()
+        };
         action = Some(Action::Message(
             match endocast_io::path_file::write_path_json(path, &document) {
                 Ok(()) => format!("wrote {} (endocast fly --path reads it)", path.display()),

@@ -21,6 +21,9 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+/// Hands a finished stage of a frame to the UI: its quality, image, depths and render time.
+type Deliver<'a> = dyn Fn(Stage, Image, &[f32], Duration) + 'a;
+
 /// Frames averaged into the still when the view stands (the full frame included).
 pub const STILL_FRAMES: usize = 8;
 
@@ -290,7 +293,7 @@ fn render_anaglyph(
     prepared: &Prepared,
     request: &Request,
     rig: &StereoRig,
-    deliver: &dyn Fn(Stage, Image, &[f32], Duration),
+    deliver: &Deliver<'_>,
 ) -> Result<(), Cancelled> {
     let Ok(eyes) = rig.eyes(&request.view.camera) else {
         lock(&shared.latest).error = Some("this lens has no stereo eyes".into());

@@ -29,7 +29,7 @@ pub fn tube_session() -> (Session, TubeTruth) {
         ..PhantomOptions::default()
     };
     let (volume, tube) = phantom::straight_tube(&options);
-    let geometry = volume.geometry().clone();
+    let geometry = *volume.geometry();
     let points = tube.centreline.points();
     let mid = (points[0] + points[1]) / 2.0;
     let centre_mm = geometry.world_of(mid);

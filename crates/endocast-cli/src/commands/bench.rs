@@ -1,18 +1,21 @@
 //! `endocast bench`: frames per second along a fixed fly path. Without a scan it runs the
 //! protocol of Scharsach et al.'s Tables 1 and 2 on the colon phantom (512×512×478 at the default
 //! size): iso-only, then the hybrid mode at isosurface opacity 100 / 80 / 50 / 0 % with a simple
-//! ramp and a complex transfer function; with a scan and `--path` it measures one setting.
+//! ramp and a complex transfer function, then depth peeling; with a scan and `--path` it measures
+//! one setting.
 
 use crate::look::{find_preset, in_pool, LookArgs};
 use crate::optics::{LensArgs, StereoArgs};
 use crate::parse::parse_size;
+use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::StereoRig;
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::{
-    Camera, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, Renderer, StereoFrames,
+    Camera, Frame, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings, Renderer,
+    StereoFrames,
 };
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::OpenOptions;
@@ -35,14 +38,14 @@ pub struct BenchArgs {
     #[arg(long, value_name = "CODE")]
     orientation: Option<String>,
     /// Size of the colon phantom (512 gives the paper's 512×512×478).
-    #[arg(long, default_value_t = 512)]
-    size: usize,
+    #[arg(long, value_name = "N", default_value_t = 512)]
+    phantom_size: usize,
     /// Frames of the colon phantom's fly path (or along a --path file of points).
     #[arg(long, default_value_t = 60)]
     frames: usize,
-    /// Image size in pixels.
-    #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
-    image: [usize; 2],
+    /// Image size in pixels (`--image` is an old name).
+    #[arg(long, alias = "image", value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
+    size: [usize; 2],
     /// Vertical field of view in degrees (default: the preset's, else 90).
     #[arg(long, value_name = "DEG")]
     fov: Option<f64>,
@@ -57,9 +60,15 @@ pub struct BenchArgs {
     /// the pair's cost against one eye's.
     #[command(flatten)]
     stereo: StereoArgs,
+    /// Print one JSON line per measured setting instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Geometry drawn in every frame (the cost of meshes, a grid, the endoscope).
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Also append one JSON line per measured setting to this file.
     #[arg(long, value_name = "FILE")]
-    json: Option<PathBuf>,
+    json_file: Option<PathBuf>,
 }
 
 /// One measured setting: what it was and how fast it ran.
@@ -87,46 +96,52 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .lens
         .optics(preset, args.fov, 0.0, (hi - lo).length())?;
     let renderer = Arc::new(renderer);
+    let scene = args.scene.scene()?;
     let options = RenderOptions::new().quality(args.quality);
     let cameras: Vec<Camera> = poses
         .iter()
-        .map(|p| optics.camera(p.eye_mm, p.look_at_mm, p.up, args.image))
+        .map(|p| optics.camera(p.eye_mm, p.look_at_mm, p.up, args.size))
         .collect::<Result<_, _>>()
         .context("invalid camera on the path")?;
-    println!(
-        "{} frames of {}×{} ({} quality), {} lens, field {}, {} threads",
-        cameras.len(),
-        args.image[0],
-        args.image[1],
-        args.quality.name(),
-        optics.projection.name(),
-        optics.field,
-        args.look.threads.unwrap_or_else(rayon::current_num_threads)
+    let table = !args.json;
+    say(
+        table,
+        &format!(
+            "{} frames of {}×{} ({} quality), {} lens, field {}, {} threads",
+            cameras.len(),
+            args.size[0],
+            args.size[1],
+            args.quality.name(),
+            optics.projection.name(),
+            optics.field,
+            args.look.threads.unwrap_or_else(rayon::current_num_threads)
+        ),
     );
-    println!("| setting | min fps | avg fps | max fps | median ms | Msamples/s |");
-    println!("|---|---|---|---|---|---|");
+    say(
+        table,
+        "| setting | min fps | avg fps | max fps | median ms | Msamples/s |\n|---|---|---|---|---|---|",
+    );
     for cell in &cells {
-        let prepared = renderer
+        let mut prepared = renderer
             .prepare(&cell.settings)
             .context("invalid settings")?;
+        prepared.set_scene(scene.clone());
         let (mono, pair) = in_pool(args.look.threads, || {
             measure(args, &prepared, &options, &cameras)
         })?;
-        report(args, optics.field, &cell.name, &mono?)?;
-        if let Some((pair, ratios)) = pair {
-            report(
-                args,
-                optics.field,
-                &format!("{}, stereo pair", cell.name),
-                &pair,
-            )?;
-            let mut ratios = ratios;
+        report(args, optics.field, &cell.name, &mono?, None)?;
+        if let Some((pair, mut ratios)) = pair {
             ratios.sort_by(f64::total_cmp);
-            println!(
-                "|   pair ÷ one eye, median of the frames (min–max) | {:.2} ({:.2}–{:.2}) | | | | |",
-                ratios[ratios.len() / 2],
-                ratios[0],
-                ratios[ratios.len() - 1]
+            let name = format!("{}, stereo pair", cell.name);
+            report(args, optics.field, &name, &pair, Some(&ratios))?;
+            say(
+                table,
+                &format!(
+                    "|   pair ÷ one eye, median of the frames (min–max) | {:.2} ({:.2}–{:.2}) | | | | |",
+                    ratios[ratios.len() / 2],
+                    ratios[0],
+                    ratios[ratios.len() - 1]
+                ),
             );
         }
     }
@@ -184,11 +199,14 @@ fn parse_quality(name: &str) -> Result<Quality, String> {
 
 /// The colon phantom, its fly path, and the paper's table cells.
 fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> {
-    if !(32..=1024).contains(&args.size) {
-        bail!("--size must be between 32 and 1024, not {}", args.size);
+    if !(32..=1024).contains(&args.phantom_size) {
+        bail!(
+            "--phantom-size must be between 32 and 1024, not {}",
+            args.phantom_size
+        );
     }
     let (volume, colon) = phantom::colon(&PhantomOptions {
-        size: args.size,
+        size: args.phantom_size,
         ..PhantomOptions::default()
     });
     let line = &colon.centreline;
@@ -223,7 +241,33 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
             });
         }
     }
+    cells.extend(peel_cells(&base));
     Ok((Renderer::for_many_frames(volume), poses, cells))
+}
+
+/// Depth peeling on the colon (issue 19) at the wall's isovalue: the first peel is the wall the
+/// iso-only cell shows; the second and the last are the next loops of the colon behind it, the
+/// front discarded (a search alone) or kept at 30 % through the transfer function of the options
+/// (the ramp by default).
+fn peel_cells(base: &RenderSettings) -> Vec<Cell> {
+    [
+        ("peel 1", PeelLayer::Nth(1), 0.0),
+        ("peel 2", PeelLayer::Nth(2), 0.0),
+        ("peel last", PeelLayer::Last, 0.0),
+        ("peel 2, 30 % of the front kept", PeelLayer::Nth(2), 0.3),
+    ]
+    .into_iter()
+    .map(|(name, layer, keep)| {
+        let mut s = base.clone();
+        s.mode = Mode::Peel;
+        s.peel.threshold_hu = None;
+        (s.peel.layer, s.peel.keep) = (layer, keep);
+        Cell {
+            name: name.into(),
+            settings: s,
+        }
+    })
+    .collect()
 }
 
 /// A scan, the path the user gave, and the one setting the options describe.
@@ -256,8 +300,22 @@ fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
     }
 }
 
-/// Prints one table row (and appends a JSON line when asked).
-fn report(args: &BenchArgs, fov_deg: f64, name: &str, m: &Measured) -> Result<()> {
+/// Prints `text` when the table is printed (not under `--json`).
+fn say(table: bool, text: &str) {
+    if table {
+        println!("{text}");
+    }
+}
+
+/// Prints one table row or JSON line, and appends the JSON line to `--json-file`. `ratios`:
+/// a stereo pair's time over one eye's, per frame, sorted.
+fn report(
+    args: &BenchArgs,
+    fov_deg: f64,
+    name: &str,
+    m: &Measured,
+    ratios: Option<&[f64]>,
+) -> Result<()> {
     let total_s: f64 = m.ms.iter().sum::<f64>() / 1e3;
     let fps: Vec<f64> = m.ms.iter().map(|ms| 1e3 / ms).collect();
     let min = fps.iter().copied().fold(f64::INFINITY, f64::min);
@@ -267,18 +325,25 @@ fn report(args: &BenchArgs, fov_deg: f64, name: &str, m: &Measured) -> Result<()
     sorted.sort_by(f64::total_cmp);
     let median = sorted[sorted.len() / 2];
     let msamples = m.samples as f64 / total_s / 1e6;
-    println!("| {name} | {min:.1} | {avg:.1} | {max:.1} | {median:.1} | {msamples:.0} |");
-    if let Some(file) = &args.json {
-        let line = json!({
-            "setting": name,
-            "frames": m.ms.len(),
-            "image": args.image,
-            "fov_deg": fov_deg,
-            "fps_min": min, "fps_avg": avg, "fps_max": max,
-            "ms_median": median,
-            "ms": m.ms,
-            "samples_per_s": m.samples as f64 / total_s,
-        });
+    say(
+        !args.json,
+        &format!("| {name} | {min:.1} | {avg:.1} | {max:.1} | {median:.1} | {msamples:.0} |"),
+    );
+    let line = json!({
+        "setting": name,
+        "frames": m.ms.len(),
+        "size": args.size,
+        "fov_deg": fov_deg,
+        "fps_min": min, "fps_avg": avg, "fps_max": max,
+        "ms_median": median,
+        "ms": m.ms,
+        "samples_per_s": m.samples as f64 / total_s,
+        "pair_over_one_eye": ratios,
+    });
+    if args.json {
+        println!("{line}");
+    }
+    if let Some(file) = &args.json_file {
         let mut f = std::fs::OpenOptions::new()
             .create(true)
             .append(true)

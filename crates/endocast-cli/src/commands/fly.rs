@@ -9,6 +9,7 @@ use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::parse_size;
 use crate::progress::Progress;
+use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use endocast_core::coverage::Coverage;
@@ -35,7 +36,7 @@ pub struct FlyArgs {
     /// writes it) or a 3D Slicer Markups curve/point list (.mrk.json).
     #[arg(long = "path", value_name = "FILE")]
     route: PathBuf,
-    /// Output: a .gif, an .mp4 (needs the ffmpeg program) or a folder of PNG frames.
+    /// Output: a .gif, an .mp4 (H.264, yuv420p) or a folder of PNG frames.
     #[arg(short, long)]
     pub(crate) output: PathBuf,
     /// What each frame shows.
@@ -58,6 +59,8 @@ pub struct FlyArgs {
     #[command(flatten)]
     lens: LensArgs,
     #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
     stereo: StereoArgs,
     /// Endoscope image size, pixels.
     #[arg(long, value_name = "WxH", default_value = "384x384", value_parser = parse_size)]
@@ -65,6 +68,10 @@ pub struct FlyArgs {
     /// Frames per second of the video.
     #[arg(long, default_value_t = 25.0)]
     fps: f64,
+    /// Encode the MP4 with this ffmpeg program (libx264) instead of the built-in OpenH264
+    /// encoder.
+    #[arg(long, value_name = "PROGRAM")]
+    ffmpeg: Option<PathBuf>,
     /// Slice window centre and width, physical units (HU), for the dashboard (default: the
     /// preset's, e.g. -600,1500 for bronchoscopy; else -300,1400).
     #[arg(long, value_name = "LEVEL,WIDTH", allow_hyphen_values = true)]
@@ -74,6 +81,9 @@ pub struct FlyArgs {
     /// (1 seen, 2 unseen wall voxels).
     #[arg(long)]
     coverage: bool,
+    /// Print the result (output, frames, length, speed, coverage) as JSON on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 /// The `--layout` choices.
@@ -98,11 +108,16 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         );
     }
     let stereo = flight_stereo(args)?;
+    // Per frame: one render per eye and, for a dashboard, its composite image.
+    let eyes = if stereo.is_some() { 2 } else { 1 };
+    let dashboard = u64::from(args.layout == LayoutArg::Dashboard);
+    args.input
+        .check_frames(&args.output, args.size, eyes + dashboard)?;
     let route = read_route(&args.route).context("cannot read the path")?;
     let shots = route
         .shots(args.frame_step, args.look_ahead)
         .context("cannot sample the route")?;
-    let mut sinks = Sinks::open(&args.output, args.fps, stereo.map(|s| s.output))?;
+    let mut sinks = Sinks::open(&args.output, &video_options(args), stereo.map(|s| s.output))?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
@@ -135,6 +150,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         window,
     };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
+    flight.set_scene(args.scene.scene()?);
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {
@@ -155,18 +171,37 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     }
     progress.finish();
     let written = sinks.finish()?;
-    println!(
-        "{}: {} frames along {:.1} mm ({:.1} frames/s)",
-        written.display(),
-        shots.len(),
-        route.len_mm(),
-        progress.rate()
-    );
+    if !args.json {
+        println!(
+            "{}: {} frames along {:.1} mm ({:.1} frames/s)",
+            written.display(),
+            shots.len(),
+            route.len_mm(),
+            progress.rate()
+        );
+    }
+    let mut coverage = None;
     if let Some(forward) = flight.into_coverage() {
         let lumen = lumen.as_ref().context("coverage needs the lumen")?;
         let seen = fly_back(args, &renderer, &route, &options, &settings, forward)?;
         let geometry = renderer.volume().geometry();
-        fly_coverage::report(&args.output, geometry, lumen, &seen)?;
+        coverage = Some(fly_coverage::report(
+            &args.output,
+            geometry,
+            lumen,
+            &seen,
+            args.json,
+        )?);
+    }
+    if args.json {
+        let summary = serde_json::json!({
+            "output": written,
+            "frames": shots.len(),
+            "length_mm": route.len_mm(),
+            "frames_per_s": progress.rate(),
+            "coverage": coverage,
+        });
+        println!("{}", serde_json::to_string_pretty(&summary)?);
     }
     Ok(())
 }
@@ -228,9 +263,8 @@ enum Sinks {
 
 impl Sinks {
     /// The film(s) at `output`: `NAME-left` and `NAME-right` beside it for a pair.
-    fn open(output: &Path, fps: f64, stereo: Option<StereoOutput>) -> Result<Self> {
-        let options = video_options(fps);
-        let open = |path: &Path| open_sink(path, &options).context("cannot write the video");
+    fn open(output: &Path, options: &VideoOptions, stereo: Option<StereoOutput>) -> Result<Self> {
+        let open = |path: &Path| open_sink(path, options).context("cannot write the video");
         Ok(match stereo {
             Some(StereoOutput::Pair) => Self::Pair([
                 open(&beside(output, "left"))?,
@@ -272,9 +306,10 @@ impl Sinks {
     }
 }
 
-fn video_options(fps: f64) -> VideoOptions {
+fn video_options(args: &FlyArgs) -> VideoOptions {
     let mut options = VideoOptions::default();
-    options.fps = fps;
+    options.fps = args.fps;
+    options.ffmpeg.clone_from(&args.ffmpeg);
     options
 }
 

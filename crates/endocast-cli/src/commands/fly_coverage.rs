@@ -11,16 +11,25 @@ use std::path::{Path, PathBuf};
 /// Size of the coverage overview image, pixels.
 const OVERVIEW_PX: usize = 512;
 
-/// Prints the forward and merged figures of `seen` and writes, beside `output`,
-/// `OUT.coverage.json` (the figures), `OUT.coverage.png` (the lumen with the unseen wall in red)
-/// and `OUT.coverage.nii.gz` (the mask: 1 seen, 2 unseen wall voxels).
-pub fn report(output: &Path, geometry: &Geometry, lumen: &Lumen, seen: &WallSeen) -> Result<()> {
-    println!(
-        "coverage: {:.1} % of {} wall voxels seen flying forward, {:.1} % forward + backward",
-        100.0 * seen.fraction_forward(),
-        seen.wall_voxels(),
-        100.0 * seen.fraction_forward_backward()
-    );
+/// Prints the forward and merged figures of `seen` (unless `quiet`: `--json` prints them) and
+/// writes, beside `output`, `OUT.coverage.json` (the figures), `OUT.coverage.png` (the lumen
+/// with the unseen wall in red) and `OUT.coverage.nii.gz` (the mask: 1 seen, 2 unseen wall
+/// voxels). Returns the figures.
+pub fn report(
+    output: &Path,
+    geometry: &Geometry,
+    lumen: &Lumen,
+    seen: &WallSeen,
+    quiet: bool,
+) -> Result<serde_json::Value> {
+    if !quiet {
+        println!(
+            "coverage: {:.1} % of {} wall voxels seen flying forward, {:.1} % forward + backward",
+            100.0 * seen.fraction_forward(),
+            seen.wall_voxels(),
+            100.0 * seen.fraction_forward_backward()
+        );
+    }
     let json = json!({
         "wall_voxels": seen.wall_voxels(),
         "seen_forward": seen.seen_forward(),
@@ -43,7 +52,7 @@ pub fn report(output: &Path, geometry: &Geometry, lumen: &Lumen, seen: &WallSeen
     let mask = seen.mask_volume()?;
     endocast_io::write(&beside(output, "nii.gz"), &mask)
         .context("cannot write the coverage mask")?;
-    Ok(())
+    Ok(json)
 }
 
 /// `OUT.coverage.EXT` beside the output (OUT without its ending).

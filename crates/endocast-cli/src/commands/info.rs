@@ -114,15 +114,15 @@ impl Report {
     }
 
     fn text(&self) -> String {
-        let v3 = |v: [f64; 3]| format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2]);
+        let v3 = |v: [f64; 3]| format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]));
         let [nx, ny, nz] = self.dimensions;
-        let [sx, sy, sz] = self.spacing_mm;
+        let [sx, sy, sz] = self.spacing_mm.map(num);
         let mut out = format!(
             "file:         {}\nformat:       {} ({})\nmodality:     {}\n\
-             dimensions:   {nx} × {ny} × {nz}\nspacing:      {sx:.4} × {sy:.4} × {sz:.4} mm\n\
+             dimensions:   {nx} × {ny} × {nz}\nspacing:      {sx} × {sy} × {sz} mm\n\
              origin:       {} mm (LPS)\ndirection:    i {}  j {}  k {}{}\n\
-             orientation:  {}\nworld bounds: {} … {} mm\nvalues:       {} … {} {}\n\
-             stored:       u16, physical = stored × {} + {}\nmemory:       {:.1} MiB\n",
+             orientation:  {}\nworld bounds: {} … {} mm\nvalues:       {} … {}{}\n\
+             stored:       u16, physical = {}\nmemory:       {:.1} MiB\n",
             self.path,
             self.format,
             self.stored_type,
@@ -137,9 +137,12 @@ impl Report {
             v3(self.world_bounds_mm[1]),
             self.value_range[0],
             self.value_range[1],
-            self.value_unit,
-            self.value_map.scale,
-            self.value_map.offset,
+            if self.value_unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {}", self.value_unit)
+            },
+            linear_map(self.value_map.scale, self.value_map.offset),
             self.voxel_bytes as f64 / (1024.0 * 1024.0),
         );
         if let Some(uid) = &self.series_uid {
@@ -158,5 +161,52 @@ impl Report {
             out += &format!("warning:      {w}\n");
         }
         out
+    }
+}
+
+/// `x` with at most four decimals, trailing zeros dropped, and no negative zero.
+fn num(x: f64) -> String {
+    let text = format!("{x:.4}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
+}
+
+/// `stored × scale + offset`, leaving out a scale of 1 and an offset of 0 (a negative offset
+/// is subtracted).
+fn linear_map(scale: f64, offset: f64) -> String {
+    let mut text = String::from("stored");
+    if scale != 1.0 {
+        text += &format!(" × {scale}");
+    }
+    if offset < 0.0 {
+        text += &format!(" − {}", -offset);
+    } else if offset > 0.0 {
+        text += &format!(" + {offset}");
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_drop_trailing_zeros_and_negative_zero() {
+        assert_eq!(num(3.0), "3");
+        assert_eq!(num(1.07421875), "1.0742");
+        assert_eq!(num(-0.00001), "0");
+        assert_eq!(num(-275.0), "-275");
+        assert_eq!(num(0.25), "0.25");
+    }
+
+    #[test]
+    fn the_value_map_reads_as_a_formula() {
+        assert_eq!(linear_map(1.0, -1000.0), "stored − 1000");
+        assert_eq!(linear_map(1.0, 0.0), "stored");
+        assert_eq!(linear_map(0.5, 3.0), "stored × 0.5 + 3");
     }
 }

@@ -5,6 +5,7 @@ pub mod convert;
 pub mod fly;
 mod fly_coverage;
 pub mod info;
+pub mod mesh;
 pub mod path;
 pub mod phantom;
 pub mod presets;

@@ -7,8 +7,10 @@ use crate::lumen::LumenArgs;
 use crate::parse::parse_vec3;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::navigate::{plan_path, PathEnd, PlannedPath};
+use endocast_core::navigate::{default_view, plan_path, DefaultView, PathEnd};
 use endocast_core::path::SmoothOptions;
+use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
+use endocast_core::tissue::{self, ScanValues};
 use endocast_core::Volume;
 use endocast_io::path_file::{write_path_json, PathDocument};
 use endocast_io::route_file::is_markups;
@@ -64,10 +66,20 @@ pub fn run(args: &PathArgs) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     let volume = &loaded.volume;
-    let preset = args.preset.as_deref().map(find_preset).transpose()?;
-    let (threshold, side) = args.lumen.resolve(preset, args.iso)?;
-    let start = point(volume, args.from, args.from_voxel, "--from")?
-        .context("give the start with --from X,Y,Z (mm) or --from-voxel I,J,K")?;
+    let scan = ScanValues::measure(volume);
+    let preset = match args.preset.as_deref().map(find_preset).transpose()? {
+        Some(preset) => {
+            let resolved = tissue::resolve(preset, volume, &scan);
+            eprintln!("{}", resolved.summary);
+            Some(resolved.preset)
+        }
+        None => None,
+    };
+    let (threshold, side) = args.lumen.resolve(preset.as_ref(), args.iso)?;
+    let (start, threshold) = match point(volume, args.from, args.from_voxel, "--from")? {
+        Some(start) => (start, threshold),
+        None => default_start(volume, preset.as_ref(), &scan, &args.lumen, args.iso)?,
+    };
     let end =
         point(volume, args.to, args.to_voxel, "--to")?.map_or(PathEnd::Farthest, PathEnd::Point);
     let options = SmoothOptions {
@@ -79,7 +91,10 @@ pub fn run(args: &PathArgs) -> Result<()> {
     let (lumen, field, planned) = plan_path(volume, threshold, side, start, end, &options)
         .with_context(|| format!("no path in the lumen {side} {threshold}"))?;
     let seconds = clock.elapsed().as_secs_f64();
-    let points = resample(&planned, args.step)?;
+    let points = planned
+        .path
+        .points_every(args.step)
+        .with_context(|| format!("--step {}", args.step))?;
     write(&args.output, &points)?;
     let summary = json!({
         "output": args.output,
@@ -107,6 +122,39 @@ pub fn run(args: &PathArgs) -> Result<()> {
     Ok(())
 }
 
+/// Without `--from`: the eye of the preset's default view inside its structure (see
+/// [`default_view`]) and the threshold the structure was found at, said on stderr; an error
+/// naming the options without a preset or lumen.
+fn default_start(
+    volume: &Volume,
+    preset: Option<&Preset>,
+    scan: &ScanValues,
+    lumen: &LumenArgs,
+    iso: Option<f64>,
+) -> Result<(DVec3, f64)> {
+    let preset = preset.context(
+        "give the start with --from X,Y,Z (mm) or --from-voxel I,J,K, or a --preset to find it",
+    )?;
+    let mut choice = lumen.choice(Some(preset), iso);
+    choice.within = tissue::central_structure(preset, volume, scan);
+    match default_view(volume, Some(&choice), DEFAULT_FOV_DEG) {
+        DefaultView::InsideLumen {
+            pose, threshold, ..
+        } => {
+            let p = pose.eye_mm;
+            eprintln!(
+                "start in the {} (lumen grown at {threshold:.1}): --from {:.2},{:.2},{:.2}",
+                preset.name, p.x, p.y, p.z
+            );
+            Ok((p, threshold))
+        }
+        DefaultView::Framing { .. } => bail!(
+            "found no {} lumen in the scan; give the start with --from X,Y,Z (mm)",
+            preset.name
+        ),
+    }
+}
+
 /// A world point from `--NAME X,Y,Z` or `--NAME-voxel I,J,K`, or `None` when neither is given.
 fn point(
     volume: &Volume,
@@ -120,20 +168,6 @@ fn point(
         (None, Some(v)) => Some(volume.geometry().world_of(DVec3::from(v))),
         (None, None) => None,
     })
-}
-
-/// The smooth path's points every `step_mm` (and its last point).
-fn resample(planned: &PlannedPath, step_mm: f64) -> Result<Vec<DVec3>> {
-    let path = &planned.path;
-    if !(step_mm.is_finite() && step_mm > 0.0) {
-        bail!("--step must be a positive number of mm, not {step_mm}");
-    }
-    let count = (path.len_mm() / step_mm).ceil() as usize;
-    let mut points: Vec<DVec3> = (0..count)
-        .map(|n| path.point_at(n as f64 * step_mm))
-        .collect();
-    points.push(path.point_at(path.len_mm()));
-    Ok(points)
 }
 
 /// Writes the points as Slicer Markups (`.mrk.json`) or as our path JSON.

@@ -4,6 +4,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use endocast_core::navigate::LumenSide;
 use endocast_core::presets::{self, Preset};
+use endocast_core::render::PeelLayer;
 use serde_json::{json, Value};
 use std::io::Write;
 
@@ -55,6 +56,15 @@ fn preset_json(preset: &Preset) -> Value {
             "iso": upper.iso,
             "opacity": decimal(upper.opacity),
             "color": decimals(settings.iso2_color),
+        })),
+        "peel": preset.peel.map(|peel| json!({
+            "threshold": peel.threshold,
+            "falling": peel.falling,
+            "layer": match peel.layer {
+                PeelLayer::Nth(n) => n.to_string(),
+                PeelLayer::Last => "last".to_owned(),
+            },
+            "tf_after": peel.tf_after,
         })),
         "lumen": preset.lumen.map(|lumen| json!({
             "threshold": lumen.threshold,

@@ -5,6 +5,7 @@ use crate::look::{in_pool, LookArgs};
 use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
+use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::default_up;
@@ -12,9 +13,11 @@ use endocast_core::navigate::{default_view, DefaultView, FramingReason};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
+use endocast_core::tissue::{self, ScanValues};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
 use endocast_core::Volume;
+use endocast_io::ImageFormat;
 use glam::DVec3;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -25,7 +28,7 @@ use std::sync::Arc;
 pub struct RenderArgs {
     #[command(flatten)]
     input: InputArgs,
-    /// Output PNG (8-bit sRGB).
+    /// Output image: .png (8-bit sRGB) or .jpg.
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
@@ -36,6 +39,8 @@ pub struct RenderArgs {
     lens: LensArgs,
     #[command(flatten)]
     stereo: StereoArgs,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Eye position, world mm (LPS, as `endocast info` reports). Without it, an endoscopic
     /// preset looks along the largest lumen from its most central point; otherwise the view
     /// frames the whole volume from the front.
@@ -60,7 +65,7 @@ pub struct RenderArgs {
     /// Also write the depth image: float32 .npy, mm from the eye to the first hit, NaN where none.
     #[arg(long, value_name = "FILE.npy")]
     depth_out: Option<PathBuf>,
-    /// Print the frame's statistics as JSON.
+    /// Print the frame's statistics and the camera pose it used as JSON.
     #[arg(long)]
     json: bool,
     /// Trace one pixel and print every sample along its ray.
@@ -70,17 +75,22 @@ pub struct RenderArgs {
 
 /// Runs `endocast render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let settings = args.look.settings()?;
-    let preset = args.look.preset()?;
+    ImageFormat::for_path(&args.output).context("cannot write the image")?;
+    let eyes = if args.stereo.stereo.is_some() { 2 } else { 1 };
+    args.input.check_frames(&args.output, args.size, eyes)?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
+    let look = args.look.on_scan(&loaded.volume)?;
+    eprintln!("{}", look.summary);
+    let (settings, preset) = (look.settings, look.preset.as_ref());
     let camera = camera(args, preset, &loaded.volume, &settings)?;
     let renderer = Arc::new(Renderer::new(loaded.volume));
-    let prepared = renderer
+    let mut prepared = renderer
         .prepare(&settings)
         .context("invalid render settings")?;
+    prepared.set_scene(args.scene.scene()?);
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
     }
@@ -103,11 +113,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
             let [w, h] = [frame.width as u32, frame.height as u32];
             let rgb = frame.to_rgb8(settings.background);
-            endocast_io::image_out::write_png_rgb8(&args.output, w, h, &rgb)
+            endocast_io::write_image_rgb8(&args.output, w, h, &rgb)
                 .context("cannot write the image")?;
             frame
         }
     };
+    warn_if_empty(&frame, &settings, &look.scan);
     let [w, h] = [frame.width as u32, frame.height as u32];
     if let Some(depth) = &args.depth_out {
         endocast_io::image_out::write_npy_f32(depth, w, h, &frame.depth_mm)
@@ -116,7 +127,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&stats_json(&frame, &settings))?
+            serde_json::to_string_pretty(&stats_json(&frame, &settings, &camera))?
         );
     } else {
         println!(
@@ -175,7 +186,7 @@ fn write_stereo(
     let (left, right) = (left?, right?);
     let write = |path: &Path, image: &Image| {
         let [w, h] = [image.width() as u32, image.height() as u32];
-        endocast_io::image_out::write_png_rgb8(path, w, h, image.rgb())
+        endocast_io::write_image_rgb8(path, w, h, image.rgb())
             .with_context(|| format!("cannot write {}", path.display()))
     };
     if output == StereoOutput::Pair {
@@ -194,15 +205,22 @@ fn default_pose(
     settings: &RenderSettings,
     fov_deg: f64,
 ) -> Pose {
-    let choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
+    let mut choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
+    if let Some(choice) = choice.as_mut() {
+        choice.within =
+            preset.and_then(|p| tissue::central_structure(p, volume, &ScanValues::measure(volume)));
+    }
+    let clock = std::time::Instant::now();
     let view = default_view(volume, choice.as_ref(), fov_deg);
+    let found_ms = clock.elapsed().as_secs_f64() * 1e3;
     match &view {
         DefaultView::InsideLumen {
             pose,
             threshold,
             side,
         } => eprintln!(
-            "camera inside the largest lumen {side} {threshold}: --eye {} --look-at {} --up {}",
+            "camera inside the lumen {side} {threshold:.1} (found in {found_ms:.0} ms): --eye {} \
+             --look-at {} --up {}",
             triple(pose.eye_mm),
             triple(pose.look_at_mm),
             triple(pose.up)
@@ -218,6 +236,21 @@ fn default_pose(
         },
     }
     view.pose()
+}
+
+/// Warns, saying why and what to try, when nothing in the image was hit or drawn.
+fn warn_if_empty(frame: &Frame, settings: &RenderSettings, scan: &ScanValues) {
+    let drawn = frame.color.iter().any(|p| p.transmittance < 0.99);
+    if frame.stats.iso_hits > 0 || drawn {
+        return;
+    }
+    let (lo, hi) = scan.range;
+    eprintln!(
+        "warning: the image is empty: no ray met the wall at {:.1} or anything the transfer \
+         function shows (values {lo:.1} to {hi:.1}, {scan}); try --iso {:.1} (background/object \
+         boundary) without --eye, or another --preset",
+        settings.iso_hu, scan.object_threshold
+    );
 }
 
 /// `x,y,z` with two decimals, as `--eye` takes it.
@@ -249,9 +282,22 @@ fn print_trace(prepared: &Prepared, camera: &Camera, x: usize, y: usize) -> Resu
     Ok(())
 }
 
-fn stats_json(frame: &Frame, settings: &RenderSettings) -> serde_json::Value {
+/// The frame's statistics and the camera that took it (world mm, LPS; `field`: degrees across
+/// the image height, or mm of view height for an orthographic lens).
+fn stats_json(frame: &Frame, settings: &RenderSettings, camera: &Camera) -> serde_json::Value {
     let s = &frame.stats;
+    let v = |v: DVec3| [v.x, v.y, v.z];
     json!({
+        "camera": {
+            "eye": v(camera.eye_mm()),
+            "look_direction": v(camera.forward()),
+            "up": v(camera.up()),
+            "field": camera.field(),
+            "projection": camera.projection().name(),
+            "near_mm": camera.near_mm(),
+            "distortion": camera.lens().distortion,
+            "vignetting": camera.lens().vignetting,
+        },
         "mode": settings.mode.name(),
         "width": frame.width,
         "height": frame.height,

@@ -6,6 +6,7 @@ use super::Shot;
 use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
 use crate::render::{Camera, Prepared, RenderSettings, RenderStats, Renderer, StereoFrames};
+use crate::scene::Scene;
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
 use crate::views::stereo::{self, StereoOutput};
@@ -71,6 +72,8 @@ pub struct Flight {
     dashboard: Option<DashboardParts>,
     coverage: Option<Coverage>,
     prepared: Option<Prepared>,
+    /// Geometry drawn in every endoscope frame.
+    scene: Option<Arc<Scene>>,
     /// The frames rendered into (the second for a stereo pair's right eye), their buffers
     /// reused from shot to shot.
     frames: StereoFrames,
@@ -86,8 +89,18 @@ impl Flight {
             dashboard: None,
             coverage: None,
             prepared: None,
+            scene: None,
             frames: StereoFrames::default(),
         }
+    }
+
+    /// Draws `scene` (meshes, grid, markers, the endoscope's instruments) in every endoscope
+    /// frame from now on.
+    pub fn set_scene(&mut self, scene: Option<Arc<Scene>>) {
+        if let Some(prepared) = &mut self.prepared {
+            prepared.set_scene(scene.clone());
+        }
+        self.scene = scene;
     }
 
     /// The dashboard's overview (rendered at [`Flight::overview_size`]) and the route drawn on it.
@@ -182,7 +195,7 @@ impl Flight {
             None => self.options.optics,
         };
         let camera = optics.camera(pose.eye_mm, pose.look_at_mm, pose.up, self.options.size)?;
-        let prepared = prepared(&mut self.prepared, &self.renderer, settings)?;
+        let prepared = prepared(&mut self.prepared, &self.renderer, settings, &self.scene)?;
         let (seen_by, eyes) = match self.options.stereo {
             None => {
                 prepared.render_into(&camera, &mut self.frames.eyes[0]);
@@ -274,6 +287,7 @@ fn prepared<'s>(
     slot: &'s mut Option<Prepared>,
     renderer: &Arc<Renderer>,
     settings: &RenderSettings,
+    scene: &Option<Arc<Scene>>,
 ) -> Result<&'s Prepared, FlightError> {
     let prepared = match slot.take() {
         Some(mut p) => {
@@ -282,7 +296,11 @@ fn prepared<'s>(
             }
             p
         }
-        None => renderer.prepare(settings)?,
+        None => {
+            let mut p = renderer.prepare(settings)?;
+            p.set_scene(scene.clone());
+            p
+        }
     };
     Ok(slot.insert(prepared))
 }

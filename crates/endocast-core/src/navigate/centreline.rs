@@ -26,8 +26,18 @@ use std::collections::BinaryHeap;
 /// Exponent of the centring cost (see the module doc).
 const COST_EXPONENT: i32 = 3;
 /// How far a start or end point in the wall, or right against it, is moved to reach a lumen
-/// voxel clear of the wall, mm.
+/// voxel clear of the wall, mm, at least: on coarse voxels it is [`SNAP_RADIUS_VOXELS`] of the
+/// largest spacing (see [`snap_radius_mm`]).
 pub const SNAP_RADIUS_MM: f64 = 5.0;
+/// The snap radius in voxels (of the largest spacing) where that is more than
+/// [`SNAP_RADIUS_MM`]: a point one voxel off a narrow lumen of 3 mm voxels still snaps.
+pub const SNAP_RADIUS_VOXELS: f64 = 3.0;
+
+/// The snap radius for voxels of `spacing_mm`: [`SNAP_RADIUS_MM`], or
+/// [`SNAP_RADIUS_VOXELS`] of the largest spacing where that is more.
+pub fn snap_radius_mm(spacing_mm: DVec3) -> f64 {
+    SNAP_RADIUS_MM.max(SNAP_RADIUS_VOXELS * spacing_mm.max_element())
+}
 /// No predecessor (the start).
 const NONE: u8 = u8::MAX;
 
@@ -56,7 +66,7 @@ pub struct CentrelinePath {
 
 /// The minimal centred path through `lumen` (found in `volume`, with its distance `field`) from
 /// `start_mm` to `end`. A point in the wall, or within a voxel of it, is snapped to the nearest
-/// lumen voxel clear of the wall within [`SNAP_RADIUS_MM`]. Errors: a non-finite point, a point
+/// lumen voxel clear of the wall within [`snap_radius_mm`]. Errors: a non-finite point, a point
 /// outside the volume, a point in the wall with nothing to snap to, and a point in another lumen
 /// component than `lumen` ([`NavError::Disconnected`], naming both points).
 pub fn centreline(
@@ -71,6 +81,7 @@ pub fn centreline(
         lumen,
         field,
     };
+    let radius_mm = snap_radius_mm(volume.geometry().spacing_mm());
     let start = snapper.snap(start_mm);
     let end_voxel = match end {
         PathEnd::Point(p) => Some((p, snapper.snap(p))),
@@ -82,14 +93,14 @@ pub fn centreline(
     };
     let start = match (start, end_voxel.as_ref()) {
         (Err(Snap::OtherLumen), Some((end_mm, _))) => return Err(disconnected(*end_mm)),
-        (start, _) => start.map_err(|s| s.into_error(start_mm))?,
+        (start, _) => start.map_err(|s| s.into_error(start_mm, radius_mm))?,
     };
     let graph = Graph::new(volume, lumen, field);
     let path = match end_voxel {
         Some((end_mm, snapped)) => {
             let goal = snapped.map_err(|s| match s {
                 Snap::OtherLumen => disconnected(end_mm),
-                other => other.into_error(end_mm),
+                other => other.into_error(end_mm, radius_mm),
             })?;
             graph.search(start, Some(goal)).path_to(&graph, goal)
         }
@@ -113,7 +124,7 @@ enum Snap {
 }
 
 impl Snap {
-    fn into_error(self, p_mm: DVec3) -> NavError {
+    fn into_error(self, p_mm: DVec3, radius_mm: f64) -> NavError {
         match self {
             Self::NotFinite(value) => NavError::BadNumber {
                 what: "point coordinate (mm)",
@@ -126,7 +137,7 @@ impl Snap {
             // A point in another lumen with no end point to name is in this lumen's wall.
             Self::Wall | Self::OtherLumen => NavError::PointInWall {
                 point_mm: p_mm.to_array(),
-                radius_mm: SNAP_RADIUS_MM,
+                radius_mm,
             },
         }
     }
@@ -141,7 +152,7 @@ struct Snapper<'a> {
 
 impl Snapper<'_> {
     /// The voxel of `p_mm` when it is in the lumen and clear of the wall (farther than one
-    /// voxel), else the nearest such voxel within [`SNAP_RADIUS_MM`].
+    /// voxel), else the nearest such voxel within [`snap_radius_mm`].
     fn snap(&self, p_mm: DVec3) -> Result<[usize; 3], Snap> {
         if let Some(&bad) = p_mm.to_array().iter().find(|c| !c.is_finite()) {
             return Err(Snap::NotFinite(bad));
@@ -175,10 +186,11 @@ impl Snapper<'_> {
             && self.field.distance_at_voxel(v) > self.field.min_spacing_mm() * 1.001
     }
 
-    /// The clear voxel nearest to `p_mm` within [`SNAP_RADIUS_MM`] of it, around voxel `v`.
+    /// The clear voxel nearest to `p_mm` within [`snap_radius_mm`] of it, around voxel `v`.
     fn nearest_clear(&self, v: [usize; 3], p_mm: DVec3) -> Option<[usize; 3]> {
         let spacing = self.volume.geometry().spacing_mm();
-        let reach = [spacing.x, spacing.y, spacing.z].map(|s| (SNAP_RADIUS_MM / s).ceil() as usize);
+        let radius = snap_radius_mm(spacing);
+        let reach = [spacing.x, spacing.y, spacing.z].map(|s| (radius / s).ceil() as usize);
         let dims = self.volume.dims();
         let range = |a: usize| v[a].saturating_sub(reach[a])..=(v[a] + reach[a]).min(dims[a] - 1);
         let mut best: Option<(f64, [usize; 3])> = None;
@@ -187,7 +199,7 @@ impl Snapper<'_> {
                 for i in range(0) {
                     let d = self.field.world_of_voxel([i, j, k]).distance(p_mm);
                     let closer = best.is_none_or(|(b, _)| d < b);
-                    if d <= SNAP_RADIUS_MM && closer && self.clear([i, j, k]) {
+                    if d <= radius && closer && self.clear([i, j, k]) {
                         best = Some((d, [i, j, k]));
                     }
                 }
@@ -344,6 +356,7 @@ mod tests {
     use super::*;
     use crate::navigate::lumen::LumenSide;
     use crate::phantom::{self, PhantomOptions};
+    use crate::{Geometry, Modality};
 
     fn options(size: usize) -> PhantomOptions {
         PhantomOptions {
@@ -474,6 +487,26 @@ mod tests {
         let path = go(near_wall, centre).unwrap();
         assert!(path.points_mm[0].distance(near_wall) <= SNAP_RADIUS_MM);
         assert!(path.min_distance_mm > 1.0);
+    }
+
+    #[test]
+    fn the_snap_radius_grows_with_coarse_voxels() {
+        assert_eq!(snap_radius_mm(DVec3::ONE), SNAP_RADIUS_MM);
+        assert_eq!(snap_radius_mm(DVec3::new(1.0, 1.0, 4.0)), 12.0);
+        // The sphere shell on 4 mm voxels: a point 0.7 voxel into the wall is 2.8 mm from the
+        // lumen, but the nearest voxel clear of the wall lies beyond a fixed 5 mm.
+        let (fine, shell) = phantom::sphere_shell(&options(32));
+        let g = Geometry::axis_aligned(fine.dims(), DVec3::splat(4.0), DVec3::ZERO).unwrap();
+        let volume =
+            Volume::new(g, fine.voxels().to_vec(), fine.value_map(), Modality::Ct).unwrap();
+        let c = shell.centre_vox.round();
+        let (lumen, field) = field_of(&volume, [c.x as usize, c.y as usize, c.z as usize]);
+        let g = volume.geometry();
+        let near_wall = g.world_of(shell.centre_vox + DVec3::X * (shell.inner_radius_vox + 0.7));
+        let centre = g.world_of(shell.centre_vox);
+        let path = centreline(&volume, &lumen, &field, near_wall, PathEnd::Point(centre)).unwrap();
+        let moved = path.points_mm[0].distance(near_wall);
+        assert!(moved > SNAP_RADIUS_MM && moved <= 12.0, "{moved}");
     }
 
     #[test]

@@ -41,6 +41,25 @@ pub enum NavError {
         /// The threshold, physical units.
         threshold: f64,
     },
+    /// The lumen around the start runs out of the structure: it reaches several faces of the
+    /// volume or fills much of it (the air around a head through the nostrils, the background
+    /// of an MRI). Reported before any search, which would wander through it.
+    #[error(
+        "the lumen {side} {threshold:.1} around the start leaks out: it reaches {faces} of the \
+         volume's 6 faces and holds {percent:.0} % of it (the air or background outside the \
+         body?); start inside the structure, or move the threshold (--lumen-threshold) so its wall \
+         closes; with a --preset and no start, the structure is found for you"
+    )]
+    LumenLeaks {
+        /// The region-growing threshold, physical units.
+        threshold: f64,
+        /// Which side of it the lumen lies on.
+        side: LumenSide,
+        /// How many faces of the volume the lumen touches.
+        faces: usize,
+        /// Percentage of the volume's voxels in the lumen.
+        percent: f64,
+    },
     /// A point (world mm) lies outside the volume.
     #[error("point {point_mm:?} mm lies outside the volume")]
     PointOutside {

@@ -10,6 +10,11 @@ use super::error::{check_finite, NavError};
 pub use super::side::LumenSide;
 use crate::{ValueMap, Volume};
 
+/// A lumen touching more faces of the volume than this leaks (see [`Lumen::leak`]).
+pub const LEAK_FACES: usize = 3;
+/// A lumen holding more than this fraction of the volume leaks (see [`Lumen::leak`]).
+pub const LEAK_FRACTION: f64 = 0.25;
+
 /// One bit per voxel of a box, `i` fastest.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BitGrid {
@@ -166,6 +171,40 @@ impl Lumen {
             .transpose()
     }
 
+    /// The largest component that reaches into the inclusive voxel box `lo..=hi` and does not
+    /// touch the volume's border: the lateral ventricles from a box at the brain's centre,
+    /// whatever dark CSF, skull or background lies around the brain. `Ok(None)` when every
+    /// lumen voxel of the box belongs to a component that touches the border.
+    pub fn largest_through_box(
+        volume: &Volume,
+        threshold: f64,
+        side: LumenSide,
+        (lo, hi): ([usize; 3], [usize; 3]),
+    ) -> Result<Option<Self>, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let dims = volume.dims();
+        let hi = [0, 1, 2].map(|a| hi[a].min(dims[a] - 1));
+        let test = ValueTest::new(volume.value_map(), threshold, side);
+        let mut visited = BitGrid::new(dims);
+        let mut best: Option<Component> = None;
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let v = [i, j, k];
+                    if visited.get(v) || !test.holds(volume.voxels()[volume.index(i, j, k)]) {
+                        continue;
+                    }
+                    let c = fill(volume, &test, v, &mut visited);
+                    if !c.touches_border(dims) && best.is_none_or(|b| c.count > b.count) {
+                        best = Some(c);
+                    }
+                }
+            }
+        }
+        best.map(|c| Self::from_seed(volume, c.seed, threshold, side))
+            .transpose()
+    }
+
     /// Copies the component's bits out of the volume-wide visited set into its bounding box.
     fn from_visited(
         visited: &BitGrid,
@@ -229,6 +268,30 @@ impl Lumen {
     pub fn bounds(&self) -> ([usize; 3], [usize; 3]) {
         let hi = [0, 1, 2].map(|a| self.lo[a] + self.mask.dims[a] - 1);
         (self.lo, hi)
+    }
+
+    /// How many of the volume's six faces the lumen touches.
+    pub fn faces_touched(&self) -> usize {
+        let (lo, hi) = self.bounds();
+        (0..3)
+            .map(|a| usize::from(lo[a] == 0) + usize::from(hi[a] + 1 == self.volume_dims[a]))
+            .sum()
+    }
+
+    /// The lumen as a leak out of the structure (see [`NavError::LumenLeaks`]): touching more
+    /// than [`LEAK_FACES`] faces of the volume, or holding more than [`LEAK_FRACTION`] of it.
+    /// A tube cut by the field of view touches one or two faces; the air around a body, all
+    /// four sides.
+    pub fn leak(&self) -> Option<NavError> {
+        let faces = self.faces_touched();
+        let total: usize = self.volume_dims.iter().product();
+        let fraction = self.count as f64 / total as f64;
+        (faces > LEAK_FACES || fraction > LEAK_FRACTION).then_some(NavError::LumenLeaks {
+            threshold: self.threshold,
+            side: self.side,
+            faces,
+            percent: 100.0 * fraction,
+        })
     }
 
     /// Number of voxels in the lumen.
@@ -467,6 +530,45 @@ mod tests {
         // The tissue is the lumen when the lumen is bright.
         let tissue = Lumen::from_seed(&volume, [0, 0, 0], -480.0, LumenSide::Above).unwrap();
         assert_eq!(tissue.voxel_count(), 32 * 32 * 32 - lumen.voxel_count());
+    }
+
+    #[test]
+    fn the_air_outside_the_body_leaks_and_the_inside_does_not() {
+        let (volume, _) = phantom::sphere_shell(&PhantomOptions {
+            size: 32,
+            ..Default::default()
+        });
+        let inside = Lumen::from_seed(&volume, [16, 16, 16], -480.0, LumenSide::Below).unwrap();
+        assert_eq!((inside.faces_touched(), inside.leak()), (0, None));
+        let outside = Lumen::from_seed(&volume, [0, 0, 0], -480.0, LumenSide::Below).unwrap();
+        assert_eq!(outside.faces_touched(), 6);
+        let message = outside.leak().unwrap().to_string();
+        assert!(
+            message.contains("leaks out") && message.contains("6 of"),
+            "{message}"
+        );
+        // A tube cut by the field of view touches its two end faces only.
+        let (tube, _) = phantom::straight_tube(&PhantomOptions {
+            size: 32,
+            ..Default::default()
+        });
+        let lumen = Lumen::from_seed(&tube, [16, 16, 16], -480.0, LumenSide::Below).unwrap();
+        assert_eq!((lumen.faces_touched(), lumen.leak()), (2, None));
+    }
+
+    #[test]
+    fn the_largest_component_through_a_box_skips_those_touching_the_border() {
+        let (volume, _) = phantom::sphere_shell(&PhantomOptions {
+            size: 32,
+            ..Default::default()
+        });
+        let through = |lo, hi| {
+            Lumen::largest_through_box(&volume, -480.0, LumenSide::Below, (lo, hi)).unwrap()
+        };
+        let inner = through([14; 3], [18; 3]).unwrap();
+        assert!(inner.contains([16, 16, 16]) && inner.faces_touched() == 0);
+        // A box in the outside air only: that air touches the border.
+        assert_eq!(through([0; 3], [2; 3]), None);
     }
 
     #[test]

@@ -28,13 +28,17 @@ mod preset;
 mod side;
 #[cfg(test)]
 mod test_util;
+mod trachea;
 mod viewpoint;
 
-pub use centreline::{centreline, CentrelinePath, PathEnd, SNAP_RADIUS_MM};
+pub use centreline::{
+    centreline, snap_radius_mm, CentrelinePath, PathEnd, SNAP_RADIUS_MM, SNAP_RADIUS_VOXELS,
+};
 pub use collision::Collider;
 pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
 pub use plan::{plan_path, seed_voxel, smooth_centreline, PlannedPath};
-pub use preset::{preset_lumen, LumenChoice, LumenChoiceError};
-pub use viewpoint::{default_view, default_viewpoint, DefaultView, FramingReason};
+pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
+pub use trachea::find_trachea;
+pub use viewpoint::{default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason};

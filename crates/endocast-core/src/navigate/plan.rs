@@ -24,7 +24,8 @@ pub struct PlannedPath {
 }
 
 /// The lumen around `start_mm` (world mm) on `side` of `threshold`, its distance field and the
-/// planned path from `start_mm` to `end`, smoothed with `options` and re-smoothed more tightly
+/// planned path (refused with [`NavError::LumenLeaks`] before any search when the lumen leaks
+/// out of the structure, see [`Lumen::leak`]) from `start_mm` to `end`, smoothed with `options` and re-smoothed more tightly
 /// until it stays inside the lumen (see [`smooth_centreline`]).
 pub fn plan_path(
     volume: &Volume,
@@ -36,6 +37,9 @@ pub fn plan_path(
 ) -> Result<(Lumen, DistanceField, PlannedPath), NavError> {
     let seed = seed_voxel(volume, start_mm)?;
     let lumen = Lumen::from_seed(volume, seed, threshold, side)?;
+    if let Some(leak) = lumen.leak() {
+        return Err(leak);
+    }
     let field = DistanceField::new(&lumen, volume.geometry());
     let planned = smooth_centreline(volume, &lumen, &field, start_mm, end, options)?;
     Ok((lumen, field, planned))

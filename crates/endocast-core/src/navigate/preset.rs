@@ -26,6 +26,22 @@ pub struct LumenChoice<'a> {
     /// The lumen is brighter than the wall (contrast, CSF on T2). Default false: the preset's
     /// side, else darker (air, CSF on T1).
     pub bright_lumen: bool,
+    /// A central structure the lumen must be (see [`Central`]); default none: the largest
+    /// lumen.
+    pub within: Option<Central>,
+}
+
+/// A structure at the object's centre (the lateral ventricles): the largest component that
+/// reaches into `region` and does not touch the volume's border. Where the lumen at the
+/// threshold leaks out (ventricles joined to the CSF around the brain, and through a dark
+/// skull to the background), the threshold is moved towards `floor` in steps until it does
+/// not.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Central {
+    /// Inclusive voxel box, lowest and highest corner.
+    pub region: ([usize; 3], [usize; 3]),
+    /// The lumen's own level (CSF), physical units: the threshold never reaches it.
+    pub floor: f64,
 }
 
 /// A lumen choice that names no threshold.
@@ -116,6 +132,7 @@ mod tests {
             iso,
             threshold,
             bright_lumen,
+            within: None,
         }
     }
 

@@ -3,9 +3,11 @@
 
 use super::distance::DistanceField;
 use super::lumen::{Lumen, LumenSide};
-use super::preset::{LumenChoice, LumenChoiceError};
+use super::preset::{Central, LumenChoice, LumenChoiceError};
+use super::trachea::find_trachea;
 use crate::camera::framing_pose;
 use crate::pose::Pose;
+use crate::presets::Structure;
 use crate::Volume;
 use glam::{DMat3, DVec3};
 
@@ -29,11 +31,17 @@ const POWER_STEPS: usize = 64;
 /// when the threshold is not finite or no voxel lies on the lumen side.
 pub fn default_viewpoint(volume: &Volume, threshold_hu: f64, side: LumenSide) -> Option<Pose> {
     let lumen = Lumen::largest(volume, threshold_hu, side, side == LumenSide::Below).ok()??;
-    let field = DistanceField::new(&lumen, volume.geometry());
-    let eye_voxel = most_central(&lumen, &field);
+    Some(viewpoint_in(volume, &lumen))
+}
+
+/// The camera inside `lumen` (a component of `volume`): at its most central voxel, looking
+/// along its local long axis towards the longer free run (see [`default_viewpoint`]).
+pub fn viewpoint_in(volume: &Volume, lumen: &Lumen) -> Pose {
+    let field = DistanceField::new(lumen, volume.geometry());
+    let eye_voxel = most_central(lumen, &field);
     let eye_mm = field.world_of_voxel(eye_voxel);
     let reach_mm = AXIS_REACH * field.max_mm();
-    let axis = principal_axis(&lumen, &field, eye_mm, reach_mm);
+    let axis = principal_axis(lumen, &field, eye_mm, reach_mm);
     let forward = if free_run(&field, eye_mm, axis) >= free_run(&field, eye_mm, -axis) {
         axis
     } else {
@@ -46,11 +54,11 @@ pub fn default_viewpoint(volume: &Volume, threshold_hu: f64, side: LumenSide) ->
         DVec3::Z
     };
     let up = (reference - forward * reference.dot(forward)).normalize();
-    Some(Pose {
+    Pose {
         eye_mm,
         look_at_mm: eye_mm + forward * field.max_mm().max(1.0),
         up,
-    })
+    }
 }
 
 /// The camera a command uses when the user placed none, and why it was chosen.
@@ -116,14 +124,61 @@ pub fn default_view(volume: &Volume, lumen: Option<&LumenChoice<'_>>, fov_deg: f
         Ok(lumen) => lumen,
         Err(error) => return framing(FramingReason::Choice(error)),
     };
-    match default_viewpoint(volume, threshold, side) {
-        Some(pose) => DefaultView::InsideLumen {
+    let structure = choice.preset.and_then(|p| p.lumen).map(|l| l.structure);
+    let largest = || default_viewpoint(volume, threshold, side).map(|pose| (pose, threshold));
+    let found = match (choice.within, structure) {
+        (Some(central), _) => central_lumen(volume, threshold, side, &central),
+        (None, Some(Structure::Trachea)) if side == LumenSide::Below => {
+            find_trachea(volume, threshold)
+                .map(|(tree, t)| (viewpoint_in(volume, &tree), t))
+                .or_else(largest)
+        }
+        _ => largest(),
+    };
+    match found {
+        Some((pose, threshold)) => DefaultView::InsideLumen {
             pose,
             threshold,
             side,
         },
         None => framing(FramingReason::NoLumen { threshold, side }),
     }
+}
+
+/// Thresholds tried for a [`Central`] structure, from the given one towards its floor.
+const CENTRAL_STEPS: usize = 6;
+/// The smallest central structure taken, mm³ (the lateral ventricles hold 7–30 ml).
+const CENTRAL_MIN_MM3: f64 = 1000.0;
+
+/// The camera in the [`Central`] structure and the threshold it was found at: the first of
+/// [`CENTRAL_STEPS`] thresholds from `threshold` towards the floor whose central component
+/// holds at least [`CENTRAL_MIN_MM3`]; the largest one found otherwise.
+fn central_lumen(
+    volume: &Volume,
+    threshold: f64,
+    side: LumenSide,
+    central: &Central,
+) -> Option<(Pose, f64)> {
+    let spacing = volume.geometry().spacing_mm();
+    let voxel_mm3 = spacing.x * spacing.y * spacing.z;
+    let mut best: Option<(Lumen, f64)> = None;
+    for step in 0..CENTRAL_STEPS {
+        let t = threshold + (central.floor - threshold) * step as f64 / CENTRAL_STEPS as f64;
+        let Ok(Some(lumen)) = Lumen::largest_through_box(volume, t, side, central.region) else {
+            continue;
+        };
+        let big = lumen.voxel_count() as f64 * voxel_mm3 >= CENTRAL_MIN_MM3;
+        if best
+            .as_ref()
+            .is_none_or(|(b, _)| lumen.voxel_count() > b.voxel_count())
+        {
+            best = Some((lumen, t));
+        }
+        if big {
+            break;
+        }
+    }
+    best.map(|(lumen, t)| (viewpoint_in(volume, &lumen), t))
 }
 
 /// The voxel nearest the lumen's centroid among those within half a voxel of the largest

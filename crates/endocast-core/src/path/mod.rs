@@ -223,6 +223,27 @@ impl Path {
         self.spline.point(self.table.parameter_at(s_mm))
     }
 
+    /// Points every `step_mm` of arc length from the start, and the last point (what
+    /// `endocast path` writes). Fails when the step is not a positive number or would give
+    /// more points than a path's table holds.
+    pub fn points_every(&self, step_mm: f64) -> Result<Vec<DVec3>, PathError> {
+        if !(step_mm.is_finite() && step_mm > 0.0) {
+            return Err(PathError::BadOption("step_mm", step_mm));
+        }
+        let count = (self.len_mm() / step_mm).ceil();
+        if count >= spline::MAX_TABLE_ENTRIES as f64 {
+            return Err(PathError::TooManySamples {
+                requested: usize::MAX,
+                limit: spline::MAX_TABLE_ENTRIES,
+            });
+        }
+        let mut points: Vec<DVec3> = (0..count as usize)
+            .map(|n| self.point_at(n as f64 * step_mm))
+            .collect();
+        points.push(self.point_at(self.len_mm()));
+        Ok(points)
+    }
+
     /// The camera pose at arc length `s_mm` (0 to [`Path::len_mm`]; beyond is clamped): the eye
     /// on the path, looking at the path point `look_ahead_mm` further on (clamped at the end;
     /// along the tangent where that leaves no distance), with the up vector of the

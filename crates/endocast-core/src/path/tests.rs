@@ -279,3 +279,19 @@ fn smooth_until_tightens_the_control_spacing() {
     let finer = path.resmoothed(1.0).unwrap();
     assert!(finer.control_points().len() > path.control_points().len());
 }
+
+#[test]
+fn points_every_step_end_at_the_last_point() {
+    let raw: Vec<DVec3> = (0..=20)
+        .map(|i| DVec3::new(f64::from(i), 0.0, 0.0))
+        .collect();
+    let path = Path::smooth(&raw, &SmoothOptions::default()).unwrap();
+    let points = path.points_every(3.0).unwrap();
+    assert_eq!(points.len(), 8, "0, 3, ..., 18 and the end at 20");
+    for pair in points[..7].windows(2) {
+        assert!((pair[0].distance(pair[1]) - 3.0).abs() < 1e-6);
+    }
+    assert!(points[7].distance(DVec3::new(20.0, 0.0, 0.0)) < 1e-9);
+    assert!(path.points_every(0.0).is_err() && path.points_every(f64::NAN).is_err());
+    assert!(path.points_every(1e-12).is_err());
+}

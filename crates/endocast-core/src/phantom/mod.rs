@@ -69,7 +69,7 @@ pub enum Phantom {
     Colon,
     /// A contrast-filled vessel with a stent and calcifications ([`vessel`]).
     Vessel,
-    /// Two bone surfaces with a thin contrast layer between them ([`joint`]).
+    /// Three bones with a thin contrast layer between each two ([`joint`]).
     Joint,
     /// Air cavities divided by thin bony septa ([`sinus`]).
     Sinus,
@@ -117,7 +117,9 @@ impl Phantom {
             }
             Self::Colon => "winding air tube with haustral folds and polyps: fly-through",
             Self::Vessel => "contrast-filled vessel with a metal stent and calcifications",
-            Self::Joint => "two bone surfaces around a thin bright contrast layer: two isosurfaces",
+            Self::Joint => {
+                "three bones around two thin contrast layers: two isosurfaces, depth peeling"
+            }
             Self::Sinus => "air cavities divided by thin bony septa: thin structures",
         }
     }

@@ -10,14 +10,6 @@ use super::simd::sse::sides;
 /// fourth step is one more sample; fifteen midpoints in two batches measured slower).
 pub(crate) const BISECTION_LEVELS: u32 = 3;
 
-/// The samples `(t, value)` just before and just after an isosurface crossing, and its side.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Bracket {
-    pub before: (f32, f32),
-    pub after: (f32, f32),
-    pub rising: bool,
-}
-
 /// `levels` (1–[`BISECTION_LEVELS`]) bisection steps of the bracket `[before, after]` with one
 /// batch of samples: the batch holds the whole tree of midpoints those steps can visit (heap
 /// order, node `i`'s halves at `2i` and `2i + 1`), each computed as the step-by-step bisection

@@ -222,6 +222,21 @@ impl Frame {
         rgba
     }
 
+    /// The bytes the buffers of a `[width, height]` frame with `layers` take (colour, depth and
+    /// value always, the optional layers asked for), or `None` when the count overflows: what a
+    /// caller checks against its memory limit before asking for such a frame.
+    pub fn bytes_for([width, height]: [usize; 2], layers: Layers) -> Option<u64> {
+        let optional = |on: Layers, bytes: usize| if layers.contains(on) { bytes } else { 0 };
+        let per_pixel = size_of::<Premultiplied>()
+            + 2 * size_of::<f32>()
+            + optional(Layers::HIT_POSITION, size_of::<[f32; 3]>())
+            + optional(Layers::NORMAL, size_of::<[f32; 3]>())
+            + optional(Layers::DEPTHS, size_of::<[f32; DEPTH_LAYERS]>());
+        (width as u64)
+            .checked_mul(height as u64)?
+            .checked_mul(per_pixel as u64)
+    }
+
     /// Sizes the frame's buffers for `[width, height]` and `layers` (keeping their memory):
     /// the layers not asked for are emptied.
     pub(crate) fn resize(&mut self, [width, height]: [usize; 2], layers: Layers) {
@@ -257,6 +272,20 @@ mod tests {
         assert_eq!(to_u8(0.5), 128);
         assert_eq!(to_u8(-3.0), 0);
         assert_eq!(to_u8(f32::NAN), 0);
+    }
+
+    #[test]
+    fn bytes_for_counts_every_buffer_resize_makes() {
+        let layers = Layers::NORMAL | Layers::DEPTHS;
+        let mut frame = Frame::default();
+        frame.resize([7, 5], layers);
+        let held = frame.color.len() * size_of::<Premultiplied>()
+            + (frame.depth_mm.len() + frame.value.len()) * 4
+            + frame.normal.len() * 12
+            + frame.layer_depths_mm.len() * 16;
+        assert_eq!(Frame::bytes_for([7, 5], layers), Some(held as u64));
+        assert_eq!(Frame::bytes_for([7, 5], Layers::NONE), Some(35 * 24));
+        assert_eq!(Frame::bytes_for([usize::MAX, 3], Layers::ALL), None);
     }
 
     #[test]

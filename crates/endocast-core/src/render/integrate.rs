@@ -2,11 +2,16 @@
 //! pieces — [`Integrator::search`] and [`Integrator::refine`] (the isosurface hit of §3.3),
 //! [`Integrator::surface`] (gradient, normal, Blinn-Phong), [`Integrator::composite`]
 //! (front-to-back DVR with early termination) — over a [`RayMarch`]. Finding a crossing in a
-//! batch and bisecting its bracket are in [`super::crossing`].
+//! batch and bisecting its bracket are in [`super::crossing`]; depth peeling is in [`peel`].
 
-use super::bricks::{Activity, BrickGrid};
-use super::crossing::{bisect, crosses, first_crossing, Bracket, BISECTION_LEVELS};
+mod peel;
+
+pub(crate) use peel::PeelParams;
+
+use super::bricks::{Activity, BitSet, BrickGrid};
+use super::crossing::{bisect, crosses, first_crossing, BISECTION_LEVELS};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
+use super::ray_task::Bracket;
 use super::ray_task::{PixelOut, RayTask};
 use super::sample::{Accum, SampleGrid, Sampler, Shader};
 use super::settings::{Crossing, Mode};
@@ -53,6 +58,15 @@ pub(crate) struct Params {
     pub refine_steps: u32,
     pub shade_dvr: bool,
     pub skip_empty: bool,
+    pub peel: PeelParams,
+}
+
+/// A transfer function as a walk reads it: its lookup table and the bricks in which it is not
+/// transparent.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Classified<'a> {
+    pub table: &'a TfTable,
+    pub active: &'a BitSet,
 }
 
 /// The per-frame context of the integrators.
@@ -61,6 +75,8 @@ pub(crate) struct Integrator<'a> {
     pub grid: &'a BrickGrid,
     pub activity: &'a Activity,
     pub table: &'a TfTable,
+    /// The transfer function behind a peel ([`Mode::Peel`]; the same as `table` otherwise).
+    pub after: Classified<'a>,
     pub shader: Shader,
     pub params: Params,
     /// The eye (voxel space) and the crossing side of the lower isovalue for rays starting
@@ -82,6 +98,15 @@ impl Integrator<'_> {
             Mode::TwoIso => self.two_iso(march, dir_world, probe),
             Mode::Mip => self.extreme(march, probe, |a, b| a > b),
             Mode::Minip => self.extreme(march, probe, |a, b| a < b),
+            Mode::Peel => self.peel(march, dir_world, probe),
+        }
+    }
+
+    /// The transfer function of every mode but the part of a peel behind its surface.
+    fn before(&self) -> Classified<'_> {
+        Classified {
+            table: self.table,
+            active: &self.activity.tf,
         }
     }
 
@@ -94,7 +119,13 @@ impl Integrator<'_> {
     /// Whether brick `b` can hold a visible DVR sample.
     #[inline]
     fn tf_active(&self, b: u32) -> bool {
-        !self.params.skip_empty || self.activity.tf.get(b as usize)
+        self.active_in(&self.activity.tf, b)
+    }
+
+    /// Whether brick `b` is set in `active` (every brick is without empty-space skipping).
+    #[inline]
+    fn active_in(&self, active: &BitSet, b: u32) -> bool {
+        !self.params.skip_empty || active.get(b as usize)
     }
 
     /// Renders a group of rays, each as [`Self::run`] would. Iso and hybrid go phase by phase
@@ -137,7 +168,7 @@ impl Integrator<'_> {
                 for (r, task) in rising.iter_mut().zip(chunk.iter()) {
                     *r = self.rising(&task.march, iso);
                 }
-                let brackets = avx2.search8(&self.sampler, active, iso, chunk, rising);
+                let brackets = avx2.search8(self.sampler.voxel_grid(), active, iso, chunk, rising);
                 for (task, bracket) in chunk.iter_mut().zip(brackets) {
                     task.bracket = bracket;
                 }
@@ -191,7 +222,7 @@ impl Integrator<'_> {
     }
 
     /// Composites the lower isosurface, shaded at the hit `out.depth_mm`, onto `out`.
-    fn lit_surface(&self, march: &RayMarch, dir_world: Vec3, out: &mut PixelOut) {
+    pub(super) fn lit_surface(&self, march: &RayMarch, dir_world: Vec3, out: &mut PixelOut) {
         let surface = self.params.lower;
         let lit = self.surface(march.grid().at(out.depth_mm), surface.color, dir_world);
         out.accum.under_surface(lit, surface.opacity);
@@ -230,7 +261,12 @@ impl Integrator<'_> {
 
     /// The first crossing of `iso` in iso-active bricks; the march is left so that the next walk
     /// starts with the first sample past the crossing.
-    fn search<P: Probe>(&self, march: &mut RayMarch, iso: f32, probe: &mut P) -> Option<Bracket> {
+    pub(super) fn search<P: Probe>(
+        &self,
+        march: &mut RayMarch,
+        iso: f32,
+        probe: &mut P,
+    ) -> Option<Bracket> {
         let rising = self.rising(march, iso);
         self.search_from(march, (iso, rising), (0.0, 0.0), probe)
     }
@@ -318,7 +354,7 @@ impl Integrator<'_> {
     /// Bisection of the bracket `(t, value)` before and after a crossing (the two samples the
     /// march took, so their values are not fetched again), then linear interpolation inside the
     /// final bracket (no refinement: the sample after the crossing).
-    fn refine(&self, line: SampleGrid, iso: f32, bracket: Bracket) -> f32 {
+    pub(super) fn refine(&self, line: SampleGrid, iso: f32, bracket: Bracket) -> f32 {
         let Bracket {
             mut before,
             mut after,
@@ -353,7 +389,7 @@ impl Integrator<'_> {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = self.sampler.avx2() {
             for chunk in tasks.chunks_mut(8) {
-                avx2.refine8(&self.sampler, iso, chunk, steps);
+                avx2.refine8(self.sampler.voxel_grid(), iso, chunk, steps);
             }
             return;
         }
@@ -417,17 +453,18 @@ impl Integrator<'_> {
             .shade(color, self.shader.normal(gradient), dir_world)
     }
 
-    /// Composites one DVR sample through the transfer function, shaded on request.
+    /// Composites one DVR sample through the transfer function `table`, shaded on request.
     #[inline(always)]
     fn add_sample(
         &self,
+        table: &TfTable,
         acc: &mut Accum,
         line: SampleGrid,
         s: Sample,
         dir_world: Vec3,
         shade: bool,
     ) {
-        let entry = self.table.lookup(s.value);
+        let entry = table.lookup(s.value);
         let alpha = entry.w;
         let mut rgb = Vec3A::from_vec4(entry);
         if shade {
@@ -443,12 +480,24 @@ impl Integrator<'_> {
     }
 
     /// Front-to-back DVR in TF-active bricks onto `out`, until early termination.
-    fn composite<P: Probe>(
+    pub(super) fn composite<P: Probe>(
         &self,
         march: &mut RayMarch,
         out: &mut PixelOut,
         dir_world: Vec3,
         shade: bool,
+        probe: &mut P,
+    ) {
+        self.composite_with(self.before(), march, out, (dir_world, shade), probe);
+    }
+
+    /// [`Self::composite`] through the transfer function `tf`.
+    fn composite_with<P: Probe>(
+        &self,
+        tf: Classified<'_>,
+        march: &mut RayMarch,
+        out: &mut PixelOut,
+        (dir_world, shade): (Vec3, bool),
         probe: &mut P,
     ) {
         let stop = self.params.early_termination;
@@ -460,60 +509,45 @@ impl Integrator<'_> {
         let mut acc = out.accum;
         let line = march.grid();
         let mode = Walk::COMPOSITE;
-        let active = |b| self.tf_active(b);
+        let active = |b| self.active_in(tf.active, b);
         let terminated = if shade || P::TRACES {
             march.walk(&self.sampler, mode, active, |s: Sample| {
-                self.add_sample(&mut acc, line, s, dir_world, shade);
+                self.add_sample(tf.table, &mut acc, line, s, dir_world, shade);
                 probe.sample(s.t, s.value, acc.alpha());
                 until_opaque(acc.alpha(), stop)
             })
         } else {
             march.walk_batches(&self.sampler, mode, active, |batch| {
-                self.composite_batch(&mut acc, &batch, stop)
+                composite_batch(tf.table, &mut acc, &batch, stop)
             })
         };
         out.accum = acc;
         out.terminated = terminated;
     }
 
-    /// Unshaded compositing of a whole batch, with the same operations in the same order as
-    /// one sample at a time, but without a test per sample: the opacity only grows, so the
-    /// batch is redone one by one only when it ends at or past `stop`, to stop at the exact
-    /// sample.
-    #[inline(always)]
-    fn composite_batch(&self, acc: &mut Accum, batch: &Batch, stop: f32) -> Option<Stopped> {
-        let entries = self.table.lookup8(&batch.values);
-        let entries = &entries[..batch.count];
-        let mut whole = *acc;
-        for entry in entries {
-            whole.under(Vec3A::from_vec4(*entry), entry.w);
-        }
-        if whole.alpha() < stop {
-            *acc = whole;
-            return None;
-        }
-        let mut taken = 0;
-        for entry in entries {
-            acc.under(Vec3A::from_vec4(*entry), entry.w);
-            taken += 1;
-            if acc.alpha() >= stop {
-                break;
-            }
-        }
-        Some(Stopped {
-            taken,
-            next: batch.first + taken as i32,
-        })
-    }
-
     /// Two surfaces and DVR outside both: every sample is tested for a crossing of either
     /// isovalue since the previous one (surfaces composited in depth order), then composited by
     /// the transfer function if it lies outside the band between the isovalues.
     fn two_iso(&self, march: &mut RayMarch, dir_world: Vec3, probe: &mut impl Probe) -> PixelOut {
+        let mut out = PixelOut::default();
+        self.two_iso_part(march, dir_world, &mut out, &mut (0.0, 0.0), probe);
+        out
+    }
+
+    /// [`Self::two_iso`] over one part of a ray onto `out`, `previous` (`(t, value)`) the last
+    /// sample of the part before (ignored where the march's first sample is fresh); left at the
+    /// part's last sample.
+    pub(super) fn two_iso_part(
+        &self,
+        march: &mut RayMarch,
+        dir_world: Vec3,
+        out: &mut PixelOut,
+        previous: &mut (f32, f32),
+        probe: &mut impl Probe,
+    ) {
         let (lower, upper) = (self.params.lower, self.params.upper);
         let stop = self.params.early_termination;
-        let mut out = PixelOut::default();
-        let mut previous = (0.0f32, 0.0f32);
+        let mut last = *previous;
         let line = march.grid();
         let acc = &mut out.accum;
         let depth = &mut out.depth_mm;
@@ -523,21 +557,22 @@ impl Integrator<'_> {
             |b| self.iso_active(b) || self.tf_active(b),
             |s: Sample| {
                 // The test every sample takes stays small; the rare crossing is handled aside.
-                let crossed = |iso: f32| (previous.1 < iso) != (s.value < iso);
+                let crossed = |iso: f32| (last.1 < iso) != (s.value < iso);
                 if !s.fresh && (crossed(lower.iso) || crossed(upper.iso)) {
                     let after = (s.t, s.value);
-                    self.add_crossed_surfaces(acc, depth, (line, dir_world), previous, after);
+                    self.add_crossed_surfaces(acc, depth, (line, dir_world), last, after);
                 }
                 if s.value < lower.iso || s.value > upper.iso {
-                    self.add_sample(acc, line, s, dir_world, self.params.shade_dvr);
+                    let shade = self.params.shade_dvr;
+                    self.add_sample(self.table, acc, line, s, dir_world, shade);
                 }
-                previous = (s.t, s.value);
+                last = (s.t, s.value);
                 probe.sample(s.t, s.value, acc.alpha());
                 until_opaque(acc.alpha(), stop)
             },
         );
+        *previous = last;
         out.terminated = terminated;
-        out
     }
 
     /// Two-iso: the surfaces crossed between samples `before` and `after` (`(t, value)`),
@@ -619,6 +654,35 @@ impl Integrator<'_> {
         }
         out
     }
+}
+
+/// Unshaded compositing of a whole batch through `table`, with the same operations in the same
+/// order as one sample at a time, but without a test per sample: the opacity only grows, so the
+/// batch is redone one by one only when it ends at or past `stop`, to stop at the exact sample.
+#[inline(always)]
+fn composite_batch(table: &TfTable, acc: &mut Accum, batch: &Batch, stop: f32) -> Option<Stopped> {
+    let entries = table.lookup8(&batch.values);
+    let entries = &entries[..batch.count];
+    let mut whole = *acc;
+    for entry in entries {
+        whole.under(Vec3A::from_vec4(*entry), entry.w);
+    }
+    if whole.alpha() < stop {
+        *acc = whole;
+        return None;
+    }
+    let mut taken = 0;
+    for entry in entries {
+        acc.under(Vec3A::from_vec4(*entry), entry.w);
+        taken += 1;
+        if acc.alpha() >= stop {
+            break;
+        }
+    }
+    Some(Stopped {
+        taken,
+        next: batch.first + taken as i32,
+    })
 }
 
 /// Stop the march once the accumulated opacity reaches the early-termination threshold.

@@ -89,6 +89,12 @@ impl Walk {
         join: true,
         long: true,
     };
+    /// Compositing in front of a peel: crossings tested too, and resumed after each one.
+    pub const PEEL: Self = Self {
+        padded: true,
+        join: true,
+        long: false,
+    };
     /// MIP/MinIP: bricks judged one by one against the extreme so far.
     pub const EXTREME: Self = Self {
         padded: false,
@@ -183,6 +189,37 @@ impl RayMarch {
         self.grid.offset = offset - offset.floor();
         // The end as `with_walk` sets it, from the range's end the brick walk keeps.
         self.end = self.index_at(self.dda.t_end).max(0);
+    }
+
+    /// The part of this march's ray from `t0` to `t1` mm (samples `t0 ≤ t_n < t1` of the same
+    /// grid, none this march has taken), to walk next: a ray split at a translucent surface
+    /// walks its parts in turn (`scene_pass`). The part starts one sample before `t0` where
+    /// this march did not take that sample, so that a padded walk still sees both samples
+    /// around a crossing there; it is not fresh where this march took the sample before it.
+    /// `t1` must not lie past this ray's end ([`Self::span`]).
+    pub(crate) fn part(&self, ray: &VoxelRay, (t0, t1): (f32, f32), bricks: [usize; 3]) -> Self {
+        let dda = BrickDda::new(ray, (f64::from(t0), f64::from(t1.max(t0))), bricks);
+        let next = self.next.max(self.index_at(t0) - 1);
+        Self {
+            dda,
+            pending: None,
+            grid: self.grid,
+            next,
+            end: self.index_at(t1).max(next),
+            has_previous: self.has_previous && next == self.next,
+            stats: MarchStats::default(),
+        }
+    }
+
+    /// Where the march's ray starts and ends, mm from the eye (after [`Self::limit`]).
+    pub(crate) fn span(&self) -> (f32, f32) {
+        (self.grid.t_start, self.dda.t_end)
+    }
+
+    /// The distance of the last sample a walk may still take (after early termination: the
+    /// sample that ended the ray), or `None` where there is none.
+    pub(crate) fn last_sample_t(&self) -> Option<f32> {
+        (self.end > 0).then(|| self.grid.t_of(self.end - 1))
     }
 
     /// The first sample index at or after `t`.

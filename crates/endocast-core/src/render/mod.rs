@@ -53,6 +53,7 @@ pub mod progressive;
 pub mod quality;
 mod ray_task;
 mod sample;
+mod scene_pass;
 mod settings;
 mod simd;
 mod stereo;
@@ -60,11 +61,16 @@ mod still;
 mod tiles;
 mod transfer;
 pub mod traverse;
+mod voxel_grid;
 
 #[cfg(test)]
 mod camera_tests;
 #[cfg(test)]
 mod interactive_tests;
+#[cfg(test)]
+mod peel_tests;
+#[cfg(test)]
+mod scene_tests;
 #[cfg(test)]
 mod tests;
 
@@ -76,16 +82,19 @@ pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
 pub use options::{Cancelled, Progress, Quality, RenderOptions};
 pub use progressive::progressive;
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
-pub use settings::{Crossing, Mode, RenderSettings, SettingsError};
+pub use settings::{
+    Crossing, Mode, PeelLayer, PeelSettings, RenderSettings, SettingsError, Unpeeled,
+};
 pub use stereo::StereoFrames;
 pub use still::{Jitter, Still};
 pub use transfer::{TfTable, TransferError, TransferFunction, OPACITY_UNIT_MM};
 
 use frame::to_u8;
 use glam::{DAffine3, DVec3, Vec3};
-use integrate::{Integrator, Params, Probe, Surface};
+use integrate::{Classified, Integrator, Params, PeelParams, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
+use scene_pass::SceneRow;
 #[cfg(target_arch = "x86_64")]
 use simd::rays4::RaySetup;
 use std::sync::Arc;
@@ -94,6 +103,7 @@ use stereo::SearchStarts;
 use tiles::{Control, Extra, Pixel, Tile, TileRect, Tiling, TILE};
 use traverse::{BrickDda, VoxelRay};
 
+use crate::scene::{PlacedScene, Scene};
 use crate::Volume;
 
 /// A volume ready for rendering: the volume and its brick grid (built once), and for sessions
@@ -184,6 +194,8 @@ struct Derived {
     settings: RenderSettings,
     table: TfTable,
     activity: Activity,
+    /// The transfer function behind a peel and its active bricks ([`Mode::Peel`] only).
+    after: Option<(TfTable, BitSet)>,
     params: Params,
     shader: Shader,
     step_mm: f64,
@@ -204,12 +216,25 @@ impl Derived {
         } else {
             (settings.iso2_hu, settings.iso_hu)
         };
-        let mut isovalues = vec![stored(settings.iso_hu)];
+        let peel = settings.mode == Mode::Peel;
+        // A peel's surface is its threshold's.
+        let wall_hu = if peel {
+            settings.peel_threshold_hu()
+        } else {
+            settings.iso_hu
+        };
+        let mut isovalues = vec![stored(wall_hu)];
         if settings.mode == Mode::TwoIso {
             table.make_transparent_between(stored(lower_hu), stored(upper_hu));
             isovalues.push(stored(settings.iso2_hu));
         }
         let activity = Activity::classify(&renderer.grid, &isovalues, &table);
+        let after = peel.then(|| {
+            let tf = settings.peel.tf_after.as_ref().unwrap_or(&settings.tf);
+            let after = TfTable::new(tf, map, volume.stored_range(), step_mm);
+            let active = Activity::classify(&renderer.grid, &[], &after).tf;
+            (after, active)
+        });
         let surface = |iso_hu: f64, opacity: f32, color: [f32; 3]| Surface {
             iso: stored(iso_hu),
             opacity,
@@ -217,19 +242,31 @@ impl Derived {
         };
         let params = Params {
             mode: settings.mode,
-            lower: surface(settings.iso_hu, settings.iso_opacity, settings.iso_color),
+            lower: surface(wall_hu, settings.iso_opacity, settings.iso_color),
             upper: surface(settings.iso2_hu, settings.iso2_opacity, settings.iso2_color),
             crossing: settings.crossing,
             early_termination: settings.early_termination,
             refine_steps: settings.refine_steps,
             shade_dvr: settings.shade_dvr,
             skip_empty: settings.skip_empty,
+            peel: PeelParams {
+                nth: match settings.peel.layer {
+                    PeelLayer::Nth(n) => Some(n),
+                    PeelLayer::Last => None,
+                },
+                // Into the brighter material is up the stored values unless the map turns
+                // their order around.
+                rising: settings.peel.falling == (map.scale() < 0.0),
+                keep: settings.peel.keep,
+                context: settings.peel.unpeeled == Unpeeled::Context,
+            },
         };
         let shader = Shader::new(geometry.world_from_voxel().matrix3, settings.lighting);
         Ok(Self {
             settings: settings.clone(),
             table,
             activity,
+            after,
             params,
             shader,
             step_mm,
@@ -246,10 +283,13 @@ pub struct Prepared {
     settings: RenderSettings,
     table: TfTable,
     activity: Activity,
+    after: Option<(TfTable, BitSet)>,
     params: Params,
     shader: Shader,
     step_mm: f64,
     voxel_from_world: DAffine3,
+    /// Geometry drawn with the volume ([`Self::set_scene`]).
+    scene: Option<Arc<Scene>>,
 }
 
 /// A pixel's ray in the world and in voxel space, and its part inside the volume (mm).
@@ -313,10 +353,12 @@ impl Prepared {
             settings: d.settings,
             table: d.table,
             activity: d.activity,
+            after: d.after,
             params: d.params,
             shader: d.shader,
             step_mm: d.step_mm,
             voxel_from_world,
+            scene: None,
         })
     }
 
@@ -327,6 +369,7 @@ impl Prepared {
         self.settings = d.settings;
         self.table = d.table;
         self.activity = d.activity;
+        self.after = d.after;
         self.params = d.params;
         self.shader = d.shader;
         self.step_mm = d.step_mm;
@@ -360,11 +403,16 @@ impl Prepared {
 
     /// The integrators for frames of `camera`.
     fn integrator(&self, camera: &Camera) -> Integrator<'_> {
+        let (table, active) = match &self.after {
+            Some((table, active)) => (table, active),
+            None => (&self.table, &self.activity.tf),
+        };
         let mut integrator = Integrator {
             sampler: self.renderer.sampler(),
             grid: &self.renderer.grid,
             activity: &self.activity,
             table: &self.table,
+            after: Classified { table, active },
             shader: self.shader,
             params: self.params,
             eye_side: None,
@@ -427,7 +475,9 @@ impl Prepared {
             assert_eq!(max.len(), w * h, "one maximum distance per pixel");
         }
         let integrator = self.integrator(camera);
-        let tile = |rect| self.tile(&integrator, camera, options, rect);
+        let scene = self.scene.as_ref().filter(|s| !s.is_empty());
+        let placed = scene.map(|s| s.placed(camera));
+        let tile = |rect| self.tile(&integrator, camera, options, placed.as_ref(), rect);
         let control = Control {
             cancel: options.cancel,
             progress: options.progress,
@@ -441,6 +491,7 @@ impl Prepared {
         integrator: &Integrator<'_>,
         camera: &Camera,
         options: &RenderOptions<'_>,
+        scene: Option<&PlacedScene<'_>>,
         rect: TileRect,
     ) -> Tile {
         let pixels = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
@@ -456,6 +507,7 @@ impl Prepared {
         let width = camera.size()[0];
         let missed = self.pixel_of(&PixelOut::default());
         let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
+        let mut others = Vec::new();
         for y in rect.y0..rect.y1 {
             columns.clear();
             tasks.clear();
@@ -471,6 +523,27 @@ impl Prepared {
             integrator.run_group(&mut tasks);
             let row = tile.pixels.len();
             tile.pixels.resize(row + rect.x1 - rect.x0, missed);
+            if let Some(scene) = scene {
+                let scene_row = SceneRow {
+                    scene,
+                    camera,
+                    options,
+                    y,
+                };
+                others.clear();
+                let xs = rect.x0..rect.x1;
+                self.add_scene(
+                    integrator,
+                    &scene_row,
+                    xs,
+                    (&columns, &mut tasks),
+                    &mut others,
+                );
+                for (x, out) in &mut others {
+                    vignette(camera, *x, y, out);
+                    tile.pixels[row + *x - rect.x0] = self.pixel_of(out);
+                }
+            }
             for (&x, task) in columns.iter().zip(&mut tasks) {
                 vignette(camera, x, y, &mut task.out);
                 let task = &*task;

@@ -1,10 +1,17 @@
 //! One ray's work and result as the integrators and the SIMD packet search share them:
 //! [`RayTask`] (march, direction, what its phases hand on) and [`PixelOut`] (what it produced).
 
-use super::crossing::Bracket;
 use super::march::RayMarch;
 use super::sample::Accum;
 use glam::Vec3;
+
+/// The samples `(t, value)` just before and just after an isosurface crossing, and its side.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Bracket {
+    pub before: (f32, f32),
+    pub after: (f32, f32),
+    pub rising: bool,
+}
 
 /// What a ray produced.
 #[derive(Debug, Clone, Copy, PartialEq)]

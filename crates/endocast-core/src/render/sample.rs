@@ -2,46 +2,14 @@
 //! world-space normals, Blinn-Phong shading with a headlight, and front-to-back compositing.
 
 use super::simd::Avx2;
+use super::voxel_grid::VoxelGrid;
+pub use super::voxel_grid::{Lanes, SampleGrid};
 use crate::Volume;
 use glam::{DMat3, Mat3, Vec3, Vec3A};
 
 pub(super) mod bricked;
 
 pub use bricked::BrickedVoxels;
-
-/// A ray's fixed sample grid in voxel space: sample `n` lies `t_n = t_start + (n + offset) · step`
-/// mm from the eye, at voxel position `origin + direction · t_n` (`Copy`, so closures can read
-/// it while a walk holds the march).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SampleGrid {
-    /// The eye, voxel index space.
-    pub origin: Vec3,
-    /// Voxel index units per mm along the ray.
-    pub direction: Vec3,
-    /// Where the ray starts, mm from the eye.
-    pub t_start: f32,
-    /// Offset of the grid from `t_start`, in steps (0–1).
-    pub offset: f32,
-    /// Distance between samples, mm.
-    pub step: f32,
-}
-
-impl SampleGrid {
-    /// Voxel position at distance `t` (mm).
-    #[inline]
-    pub fn at(&self, t: f32) -> Vec3 {
-        self.origin + self.direction * t
-    }
-
-    /// Distance of sample `n` from the eye, mm.
-    #[inline]
-    pub fn t_of(&self, n: i32) -> f32 {
-        self.t_start + (n as f32 + self.offset) * self.step
-    }
-}
-
-/// Eight stored values, one per lane of a batch.
-pub type Lanes = [f32; 8];
 
 /// Trilinear reconstruction of a volume's stored values, in `f32`, with positions clamped to the
 /// voxel centres' hull (so a gradient stencil at the border reads the border value).
@@ -56,15 +24,8 @@ pub type Lanes = [f32; 8];
 /// multiply-add), so both give bit-identical values.
 #[derive(Debug, Clone, Copy)]
 pub struct Sampler<'a> {
-    pub(super) voxels: &'a [u16],
-    /// Largest position per axis (`n − 1`).
-    pub(super) extent: Vec3,
-    /// Largest base index per axis of the 2×2×2 cell (`n − 2`, or 0 for a single voxel).
-    pub(super) max_base: [i32; 3],
-    /// Memory strides to the next voxel per axis; 0 along an axis of one voxel.
-    pub(super) stride: [usize; 3],
-    /// The voxels brick by brick, where the batches read them that way, and bricks per axis.
-    pub(super) bricked: Option<(&'a [u16], [i32; 3])>,
+    /// The voxels and their layout, as the batches read them.
+    grid: VoxelGrid<'a>,
     /// Where batches run on AVX2 (the CPU has it, x has two voxels or more for the paired
     /// gathers, and every index fits the gathers' `i32`).
     avx2: Option<Avx2>,
@@ -73,18 +34,11 @@ pub struct Sampler<'a> {
 impl<'a> Sampler<'a> {
     /// A sampler over `volume`'s voxels.
     pub fn new(volume: &'a Volume) -> Self {
-        let [nx, ny, nz] = volume.dims();
-        let step = |n: usize, s: usize| if n > 1 { s } else { 0 };
-        // Volumes are limited far below 2³¹ voxels per axis; saturate rather than wrap anyway.
-        let max_base = [nx, ny, nz].map(|n| i32::try_from(n.saturating_sub(2)).unwrap_or(i32::MAX));
-        let voxels = volume.voxels();
+        let nx = volume.dims()[0];
+        let fits = i32::try_from(volume.voxels().len()).is_ok();
         Self {
-            voxels,
-            extent: Vec3::new((nx - 1) as f32, (ny - 1) as f32, (nz - 1) as f32),
-            max_base,
-            stride: [step(nx, 1), step(ny, nx), step(nz, nx * ny)],
-            bricked: None,
-            avx2: Avx2::detect().filter(|_| nx >= 2 && i32::try_from(voxels.len()).is_ok()),
+            grid: VoxelGrid::new(volume),
+            avx2: Avx2::detect().filter(|_| nx >= 2 && fits),
         }
     }
 
@@ -99,15 +53,22 @@ impl<'a> Sampler<'a> {
         };
         let bricks = bricked.bricks().map(|b| b as i32);
         Self {
-            bricked: Some((bricked.voxels(), bricks)),
+            grid: VoxelGrid {
+                bricked: Some((bricked.voxels(), bricks)),
+                ..plain.grid
+            },
             avx2: Some(avx2),
-            ..plain
         }
     }
 
     /// The AVX2 token where batches run on AVX2.
     pub(crate) fn avx2(&self) -> Option<Avx2> {
         self.avx2
+    }
+
+    /// The voxels and their layout (what the AVX2 batches read).
+    pub(crate) fn voxel_grid(&self) -> &VoxelGrid<'a> {
+        &self.grid
     }
 
     /// The same sampler without the AVX2 batches (to compare both paths).
@@ -120,7 +81,7 @@ impl<'a> Sampler<'a> {
     pub fn grid8(&self, grid: &SampleGrid, n: i32, count: usize) -> Lanes {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = self.avx2 {
-            return avx2.grid8(self, grid, n);
+            return avx2.grid8(&self.grid, grid, n);
         }
         let mut out = [0.0; 8];
         for (lane, value) in (n..).zip(out.iter_mut().take(count)) {
@@ -134,7 +95,7 @@ impl<'a> Sampler<'a> {
     pub fn points8(&self, [x, y, z]: &[Lanes; 3]) -> Lanes {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = self.avx2 {
-            return avx2.points8(self, [x, y, z]);
+            return avx2.points8(&self.grid, [x, y, z]);
         }
         std::array::from_fn(|k| self.value(Vec3::new(x[k], y[k], z[k])))
     }
@@ -144,7 +105,7 @@ impl<'a> Sampler<'a> {
     pub fn along8(&self, line: &SampleGrid, t: &Lanes) -> Lanes {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = self.avx2 {
-            return avx2.along8(self, line, t);
+            return avx2.along8(&self.grid, line, t);
         }
         t.map(|t| self.value(line.at(t)))
     }
@@ -152,16 +113,17 @@ impl<'a> Sampler<'a> {
     /// The trilinearly interpolated stored value at voxel position `p`.
     #[inline(always)]
     pub fn value(&self, p: Vec3) -> f32 {
-        let p = p.clamp(Vec3::ZERO, self.extent);
+        let grid = &self.grid;
+        let p = p.clamp(Vec3::ZERO, grid.extent);
         // p ≥ 0, so truncation is the floor; `as i32` saturates and maps NaN to 0.
-        let bx = (p.x as i32).min(self.max_base[0]);
-        let by = (p.y as i32).min(self.max_base[1]);
-        let bz = (p.z as i32).min(self.max_base[2]);
+        let bx = (p.x as i32).min(grid.max_base[0]);
+        let by = (p.y as i32).min(grid.max_base[1]);
+        let bz = (p.z as i32).min(grid.max_base[2]);
         let (fx, fy, fz) = (p.x - bx as f32, p.y - by as f32, p.z - bz as f32);
-        let [_, sy, sz] = self.stride;
+        let [_, sy, sz] = grid.stride;
         // bx, by, bz lie in [0, max_base]: the casts are exact.
         let index = bx as usize + by as usize * sy + bz as usize * sz;
-        let [low, high] = self.corners(index);
+        let [low, high] = grid.corners(index);
         // The four lerps along x at once (SIMD lanes: the same IEEE operations as one by one),
         // giving [c00, c10, c01, c11] (c_yz); then y, then z.
         let c = low + (high - low) * fx;

@@ -22,20 +22,25 @@ pub enum Mode {
     Mip,
     /// Minimum intensity projection (airways).
     Minip,
+    /// Volumetric depth peeling (Borland et al. 2006): the surface where the ray crosses the
+    /// peel threshold for the n-th (or last) time, with what lies before it discarded or
+    /// faded; see [`PeelSettings`].
+    Peel,
 }
 
 impl Mode {
     /// Every mode, in a fixed order.
-    pub const ALL: [Mode; 6] = [
+    pub const ALL: [Mode; 7] = [
         Self::Iso,
         Self::Dvr,
         Self::Hybrid,
         Self::TwoIso,
         Self::Mip,
         Self::Minip,
+        Self::Peel,
     ];
 
-    /// The kebab-case name: `iso`, `dvr`, `hybrid`, `two-iso`, `mip`, `minip`.
+    /// The kebab-case name: `iso`, `dvr`, `hybrid`, `two-iso`, `mip`, `minip`, `peel`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Iso => "iso",
@@ -44,6 +49,7 @@ impl Mode {
             Self::TwoIso => "two-iso",
             Self::Mip => "mip",
             Self::Minip => "minip",
+            Self::Peel => "peel",
         }
     }
 
@@ -66,6 +72,72 @@ pub enum Crossing {
     Rising,
     /// From above the isovalue to below it.
     Falling,
+}
+
+/// Which peel a ray of [`Mode::Peel`] shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PeelLayer {
+    /// The n-th crossing (1 = the first).
+    Nth(u32),
+    /// The last crossing along the ray.
+    Last,
+}
+
+impl Default for PeelLayer {
+    fn default() -> Self {
+        Self::Nth(1)
+    }
+}
+
+/// What rays that never reach the wanted peel show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Unpeeled {
+    /// Nothing: they are transparent (the background shows). The default.
+    #[default]
+    Discard,
+    /// The whole ray composited with the transfer function of before the peel, as context.
+    Context,
+}
+
+/// Volumetric depth peeling ([`Mode::Peel`]; Borland et al., "Volumetric depth peeling for
+/// medical image display", SPIE 2006). The ray is marched from the eye; each crossing of the
+/// threshold into the brighter material (or, with `falling`, into the darker one) counts one
+/// peel. Up to the wanted peel the ray is composited with [`RenderSettings::tf`]; at it, that
+/// colour and opacity are scaled by `keep` (0 discards them, the paper's usual choice), the
+/// surface of the crossing is drawn as the isosurface is in the other modes (refined by
+/// bisection, Blinn-Phong shaded, [`RenderSettings::iso_color`] at
+/// [`RenderSettings::iso_opacity`]; its distance is the pixel's depth), and behind it the ray
+/// is composited with `tf_after`.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct PeelSettings {
+    /// The peel threshold, physical units; `None` (the default) takes
+    /// [`RenderSettings::iso_hu`].
+    pub threshold_hu: Option<f64>,
+    /// The peel shown. Default the first.
+    pub layer: PeelLayer,
+    /// Count crossings into the darker material instead of the brighter. Default false.
+    pub falling: bool,
+    /// Share of the colour and opacity accumulated before the peel that is kept, 0–1.
+    /// Default 0 (discarded).
+    pub keep: f32,
+    /// What rays without the wanted peel show. Default [`Unpeeled::Discard`].
+    pub unpeeled: Unpeeled,
+    /// Transfer function behind the peel; `None` (the default) takes [`RenderSettings::tf`].
+    pub tf_after: Option<TransferFunction>,
+}
+
+impl Default for PeelSettings {
+    fn default() -> Self {
+        Self {
+            threshold_hu: None,
+            layer: PeelLayer::default(),
+            falling: false,
+            keep: 0.0,
+            unpeeled: Unpeeled::Discard,
+            tf_after: None,
+        }
+    }
 }
 
 /// Settings that cannot be rendered.
@@ -139,6 +211,8 @@ pub struct RenderSettings {
     pub lighting: Lighting,
     /// Colour behind everything, 0–1. Default black.
     pub background: [f32; 3],
+    /// Depth peeling, read by [`Mode::Peel`] only. Default [`PeelSettings::default`].
+    pub peel: PeelSettings,
 }
 
 impl Default for RenderSettings {
@@ -161,6 +235,7 @@ impl Default for RenderSettings {
             refine_steps: 4,
             lighting: Lighting::default(),
             background: [0.0; 3],
+            peel: PeelSettings::default(),
         }
     }
 }
@@ -175,6 +250,11 @@ impl RenderSettings {
     /// The step between samples in mm for voxels whose smallest spacing is `min_spacing_mm`.
     pub fn step_mm(&self, min_spacing_mm: f64) -> f64 {
         self.step_vox * min_spacing_mm
+    }
+
+    /// The peel threshold in physical units: [`PeelSettings::threshold_hu`], else the isovalue.
+    pub fn peel_threshold_hu(&self) -> f64 {
+        self.peel.threshold_hu.unwrap_or(self.iso_hu)
     }
 
     /// Checks every number against its range.
@@ -233,6 +313,21 @@ impl RenderSettings {
             (1.0..=1000.0).contains(&shininess),
             "[1, 1000]",
         )?;
+        let peel = &self.peel;
+        check(
+            "peel threshold",
+            self.peel_threshold_hu(),
+            true,
+            "finite numbers",
+        )?;
+        unit("peel keep", peel.keep)?;
+        if peel.layer == PeelLayer::Nth(0) {
+            return Err(SettingsError::OutOfRange {
+                name: "peel",
+                value: 0.0,
+                range: "1, 2, 3 … or last",
+            });
+        }
         if self.mode == Mode::TwoIso && self.iso_hu >= self.iso2_hu {
             return Err(SettingsError::IsovaluesOutOfOrder {
                 lower: self.iso_hu,
@@ -282,6 +377,27 @@ mod tests {
             RenderSettings {
                 mode: Mode::TwoIso,
                 iso_hu: 800.0,
+                ..Default::default()
+            },
+            RenderSettings {
+                peel: PeelSettings {
+                    keep: 1.5,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            RenderSettings {
+                peel: PeelSettings {
+                    layer: PeelLayer::Nth(0),
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            RenderSettings {
+                peel: PeelSettings {
+                    threshold_hu: Some(f64::INFINITY),
+                    ..Default::default()
+                },
                 ..Default::default()
             },
         ];

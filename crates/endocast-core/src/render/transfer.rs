@@ -67,7 +67,7 @@ impl TransferFunction {
     }
 
     /// The names [`TransferFunction::preset`] knows, in a fixed order.
-    pub const PRESETS: [&'static str; 7] = [
+    pub const PRESETS: [&'static str; 8] = [
         "ramp",
         "complex",
         "colonoscopy",
@@ -75,6 +75,7 @@ impl TransferFunction {
         "angioscopy",
         "sinus",
         "ventricles",
+        "arthroscopy",
     ];
 
     /// A named preset (see [`TransferFunction::PRESETS`]), thresholds from the measured values of
@@ -89,6 +90,8 @@ impl TransferFunction {
     ///   faint, calcification and metal opaque.
     /// - `sinus`: mucosa faint, bone (> ≈ 400 HU) clearly visible through it.
     /// - `ventricles`: T1 MRI (CSF ≈ 30, white matter ≈ 120): tissue faint, brightest white.
+    /// - `arthroscopy`: T1 MRI of a joint (joint space ≈ 5–20, muscle and cartilage ≈ 25–40,
+    ///   marrow ≈ 48, fat brighter): soft tissue faint, marrow and fat ivory.
     pub fn preset(name: &str) -> Option<Self> {
         type Points = (&'static [(f64, f32)], &'static [(f64, [f32; 3])]);
         let (opacity, color): Points = match name.trim().to_ascii_lowercase().as_str() {
@@ -198,6 +201,22 @@ impl TransferFunction {
                     (75.0, [0.8, 0.6, 0.55]),
                     (130.0, [0.95, 0.9, 0.85]),
                     (255.0, [1.0, 1.0, 1.0]),
+                ],
+            ),
+            "arthroscopy" => (
+                &[
+                    (0.0, 0.0),
+                    (22.0, 0.0),
+                    (30.0, 0.01),
+                    (40.0, 0.05),
+                    (60.0, 0.3),
+                    (200.0, 0.5),
+                ],
+                &[
+                    (0.0, [0.0, 0.0, 0.0]),
+                    (30.0, [0.8, 0.45, 0.4]),
+                    (45.0, [0.93, 0.88, 0.78]),
+                    (200.0, [1.0, 1.0, 0.95]),
                 ],
             ),
             _ => return None,

@@ -5,10 +5,17 @@
 //! a length field makes it ask for gigabytes. Walking the headers first (seeking over values,
 //! descending into sequences and items) costs a few hundred small reads per file and keeps every
 //! allocation bounded by the file's real size.
+//!
+//! A deflated data set (transfer syntax 1.2.840.10008.1.2.1.99) is inflated here first: its
+//! deflate stream must reach its final block exactly at the end of the file (raw deflate has no
+//! checksum, so its end and length are what can be checked), and the inflated elements are then
+//! walked like those of any other file.
 
+use crate::compressed;
 use crate::error::{ReadError, Result};
+use flate2::bufread::DeflateDecoder;
 use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::io::{self, BufReader, Cursor, Read, Seek, SeekFrom};
 use std::path::Path;
 
 /// The "undefined length" marker of sequences, items and encapsulated pixel data.
@@ -34,15 +41,24 @@ enum Encoding {
     ExplicitBig,
 }
 
-struct Walker {
-    reader: BufReader<File>,
+struct Walker<R> {
+    reader: BufReader<R>,
     pos: u64,
     len: u64,
 }
 
+/// Where a walk stopped.
+enum Walked {
+    /// At the end of the file: every length fits.
+    End,
+    /// At the start of a deflated data set (byte offset), after the file meta group.
+    Deflated(u64),
+}
+
 /// Checks that every defined element, item and fragment length in the file at `path` fits in the
-/// bytes that follow it. Deflated data sets are not walked (their lengths refer to inflated data).
-pub(super) fn check_element_lengths(path: &Path) -> Result<()> {
+/// bytes that follow it; a deflated data set is inflated (at most `max_inflated` bytes), its
+/// stream checked to its end, and its lengths checked against the inflated bytes.
+pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()> {
     let file = File::open(path).map_err(|e| ReadError::io(path, e))?;
     let len = file.metadata().map_err(|e| ReadError::io(path, e))?.len();
     let mut w = Walker {
@@ -61,17 +77,61 @@ pub(super) fn check_element_lengths(path: &Path) -> Result<()> {
             w.seek_to(0).map_err(io)?;
         }
     }
-    w.walk().map_err(|message| ReadError::format(path, message))
+    match w
+        .walk()
+        .map_err(|message| ReadError::format(path, message))?
+    {
+        Walked::End => Ok(()),
+        Walked::Deflated(start) => check_deflated(path, w.reader.into_inner(), start, max_inflated),
+    }
 }
 
-impl Walker {
-    fn seek_to(&mut self, pos: u64) -> std::io::Result<()> {
+/// Inflates the data set that starts at byte `start` of `file`, requires its stream to end with
+/// the file, and walks the inflated elements.
+fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) -> Result<()> {
+    file.seek(SeekFrom::Start(start))
+        .map_err(|e| ReadError::io(path, e))?;
+    let mut decoder = DeflateDecoder::new(BufReader::new(file));
+    let mut data = Vec::new();
+    (&mut decoder)
+        .take(max_inflated.saturating_add(1))
+        .read_to_end(&mut data)
+        .map_err(|e| compressed::corrupt(path, "deflate", e))?;
+    if data.len() as u64 > max_inflated {
+        return Err(ReadError::Limit {
+            path: path.to_path_buf(),
+            what: "the inflated data set (bytes)".into(),
+            requested: data.len() as u64,
+            limit: max_inflated,
+        });
+    }
+    let trailing =
+        io::copy(decoder.get_mut(), &mut io::sink()).map_err(|e| ReadError::io(path, e))?;
+    if trailing > 0 {
+        return Err(ReadError::format(
+            path,
+            format!("the deflate data are corrupt: {trailing} bytes follow the end of the stream"),
+        ));
+    }
+    let len = data.len() as u64;
+    let mut w = Walker {
+        reader: BufReader::with_capacity(4096, Cursor::new(data)),
+        pos: 0,
+        len,
+    };
+    w.walk()
+        .map(|_| ())
+        .map_err(|message| ReadError::format(path, format!("in the inflated data set: {message}")))
+}
+
+impl<R: Read + Seek> Walker<R> {
+    fn seek_to(&mut self, pos: u64) -> io::Result<()> {
         self.reader.seek(SeekFrom::Start(pos))?;
         self.pos = pos;
         Ok(())
     }
 
-    fn read_exact(&mut self, buf: &mut [u8]) -> std::io::Result<()> {
+    fn read_exact(&mut self, buf: &mut [u8]) -> io::Result<()> {
         self.reader.read_exact(buf)?;
         self.pos += buf.len() as u64;
         Ok(())
@@ -103,19 +163,21 @@ impl Walker {
         Ok(())
     }
 
-    /// Walks the meta group (always explicit little endian), then the data set.
-    fn walk(&mut self) -> Result<(), String> {
-        let mut encoding = Encoding::ExplicitLittle;
+    /// Walks the meta group (always explicit little endian), then the data set, unless it is
+    /// deflated.
+    fn walk(&mut self) -> Result<Walked, String> {
+        // `None` once the meta group has named the deflated transfer syntax.
+        let mut encoding = Some(Encoding::ExplicitLittle);
         let mut in_meta = true;
         let mut in_fragments = false;
         while self.pos + 8 <= self.len {
             let Some(head) = self.take::<8>() else { break };
             let group_le = u16::from_le_bytes([head[0], head[1]]);
             in_meta &= group_le == 0x0002;
-            let current = if in_meta {
-                Encoding::ExplicitLittle
-            } else {
-                encoding
+            let current = match (in_meta, encoding) {
+                (true, _) => Encoding::ExplicitLittle,
+                (false, Some(encoding)) => encoding,
+                (false, None) => return Ok(Walked::Deflated(self.pos - 8)),
             };
             let (tag, length, vr) = self.element_header(head, current)?;
             if tag.0 == 0xFFFE {
@@ -128,15 +190,16 @@ impl Walker {
             }
             self.check(tag, length)?;
             if tag == (0x0002, 0x0010) {
-                match self.transfer_syntax(length)? {
-                    Some(e) => encoding = e,
-                    None => return Ok(()),
-                }
+                encoding = self.transfer_syntax(length)?;
             } else if vr != Some(*b"SQ") && !self.starts_with_item(length, current)? {
                 self.skip(u64::from(length))?;
             }
         }
-        Ok(())
+        Ok(match encoding {
+            Some(_) => Walked::End,
+            // A deflated data set that is empty (or a meta group cut short): inflating it fails.
+            None => Walked::Deflated(self.pos),
+        })
     }
 
     /// Tag, length and (explicit VR only) the VR of the element whose first 8 bytes are `head`.
@@ -226,7 +289,8 @@ impl Walker {
         Ok(head == item)
     }
 
-    /// Reads the transfer syntax UID value; `None` for a deflated data set (not walked).
+    /// Reads the transfer syntax UID value; `None` for a deflated data set (walked once
+    /// inflated).
     fn transfer_syntax(&mut self, length: u32) -> Result<Option<Encoding>, String> {
         let mut value = vec![0u8; length as usize];
         self.read_exact(&mut value).map_err(|e| e.to_string())?;

@@ -6,14 +6,16 @@
 //! (`raw = stored + type_min`). The table is 128 KiB for 16-bit data and makes the inner loop
 //! one load per voxel.
 
+use super::jpegls;
 use super::scan::{chain, open_error, PixelLayout};
 use crate::error::{ReadError, Result};
+use crate::guard;
 use dicom_core::value::DicomValueType;
 use dicom_core::{DicomValue, PrimitiveValue};
 use dicom_dictionary_std::tags;
 use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
 use dicom_object::{DefaultDicomObject, OpenFileOptions};
-use dicom_pixeldata::{DecodedPixelData, PixelDecoder};
+use dicom_pixeldata::PixelDecoder;
 use dicom_transfer_syntax_registry::TransferSyntaxRegistry;
 use rayon::prelude::*;
 use std::path::Path;
@@ -27,7 +29,7 @@ pub(super) fn transfer_syntax_name(path: &Path, uid: &str) -> Result<&'static st
             format!("transfer syntax {uid} (not a transfer syntax this reader knows)"),
         ));
     };
-    if !ts.can_decode_all() {
+    if !ts.can_decode_all() && !jpegls::is_jpeg_ls(uid) {
         return Err(ReadError::unsupported(
             path,
             format!(
@@ -80,6 +82,11 @@ impl SampleMap {
             type_min,
             bytes_per_sample: usize::from(layout.bits_allocated / 8),
         })
+    }
+
+    /// The largest sample word the table maps (255 for 8-bit samples).
+    fn max_word(&self) -> u16 {
+        (self.table.len() - 1) as u16
     }
 
     /// Raw value of voxel value 0: `raw = stored + type_min`.
@@ -249,8 +256,8 @@ pub(super) fn decode_file(
     frames: Vec<(u32, &mut [u16])>,
     map: &SampleMap,
 ) -> Result<Vec<FrameStats>> {
-    let object = OpenFileOptions::new()
-        .open_file(path)
+    let object = guard::quietly(|| OpenFileOptions::new().open_file(path))
+        .map_err(|panicked| ReadError::format(path, panicked.to_string()))?
         .map_err(|e| open_error(path, &e))?;
     let pixel_data = object
         .get(tags::PIXEL_DATA)
@@ -260,23 +267,27 @@ pub(super) fn decode_file(
             .into_iter()
             .map(|(frame, out)| native_frame(path, value, frame, out, map))
             .collect(),
-        DicomValue::PixelSequence(_) => frames
-            .into_par_iter()
-            .map(|(frame, out)| {
-                let decoded = decode_frame_guarded(&object, frame).map_err(|cause| {
-                    ReadError::format(
-                        path,
-                        format!("cannot decode frame {frame} ({ts_name}): {cause}"),
-                    )
-                })?;
-                let bytes = decoded.data();
-                let needed = out.len() * map.bytes_per_sample;
-                if bytes.len() < needed {
-                    return Err(short_frame(path, frame, needed, bytes.len()));
-                }
-                Ok(map.convert_bytes(bytes, out))
-            })
-            .collect(),
+        DicomValue::PixelSequence(_) => {
+            let decode = if jpegls::is_jpeg_ls(object.meta().transfer_syntax()) {
+                jpeg_ls_frame
+            } else {
+                registry_frame
+            };
+            frames
+                .into_par_iter()
+                .map(|(frame, out)| {
+                    decode(&object, frame, out, map).map_err(|e| match e {
+                        FrameError::Decode(cause) => ReadError::format(
+                            path,
+                            format!("cannot decode frame {frame} ({ts_name}): {cause}"),
+                        ),
+                        FrameError::Short { needed, found } => {
+                            short_frame(path, frame, needed, found)
+                        }
+                    })
+                })
+                .collect()
+        }
         DicomValue::Sequence(_) => Err(ReadError::format(
             path,
             "expected PixelData to hold samples, found a sequence of items",
@@ -284,21 +295,59 @@ pub(super) fn decode_file(
     }
 }
 
-/// Decodes one compressed frame. Third-party decoders have been seen to panic on corrupt data
-/// (dicom-rs 0.10's RLE decoder indexes past its buffer), so a panic there is caught and becomes
-/// an error about the file instead of taking the program down.
-fn decode_frame_guarded(
+/// Why a compressed frame could not be converted.
+enum FrameError {
+    /// The decoder's message.
+    Decode(String),
+    /// The decoded frame has `found` bytes where `needed` are.
+    Short { needed: usize, found: usize },
+}
+
+/// Decodes frame `frame` through dicom-rs's registry of decoders into `out`.
+fn registry_frame(
     object: &DefaultDicomObject,
     frame: u32,
-) -> std::result::Result<DecodedPixelData<'_>, String> {
-    let attempt = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        object.decode_pixel_data_frame(frame)
-    }));
-    match attempt {
-        Ok(Ok(decoded)) => Ok(decoded),
-        Ok(Err(e)) => Err(chain(&e)),
-        Err(_) => Err("the decoder failed on corrupt data".into()),
+    out: &mut [u16],
+    map: &SampleMap,
+) -> std::result::Result<FrameStats, FrameError> {
+    let decoded = guarded(|| object.decode_pixel_data_frame(frame))
+        .and_then(|decoded| decoded.map_err(|e| chain(&e)))
+        .map_err(FrameError::Decode)?;
+    let bytes = decoded.data();
+    let needed = out.len() * map.bytes_per_sample;
+    if bytes.len() < needed {
+        return Err(FrameError::Short {
+            needed,
+            found: bytes.len(),
+        });
     }
+    Ok(map.convert_bytes(bytes, out))
+}
+
+/// Decodes JPEG-LS frame `frame` through the pure-Rust decoder into `out`.
+fn jpeg_ls_frame(
+    object: &DefaultDicomObject,
+    frame: u32,
+    out: &mut [u16],
+    map: &SampleMap,
+) -> std::result::Result<FrameStats, FrameError> {
+    let samples = guarded(|| jpegls::decode_frame(object, frame, map.max_word()))
+        .and_then(|decoded| decoded)
+        .map_err(FrameError::Decode)?;
+    if samples.len() < out.len() {
+        return Err(FrameError::Short {
+            needed: out.len() * map.bytes_per_sample,
+            found: samples.len() * map.bytes_per_sample,
+        });
+    }
+    Ok(map.convert(samples.into_iter(), out))
+}
+
+/// Runs a third-party decoder. Decoders have been seen to panic on corrupt data (dicom-rs
+/// 0.10's RLE decoder indexes past its buffer), so a panic there is caught, quietly (see
+/// [`guard`]), and becomes an error about the file instead of taking the program down.
+fn guarded<T>(decode: impl FnOnce() -> T) -> std::result::Result<T, String> {
+    guard::quietly(decode).map_err(|panicked| panicked.to_string())
 }
 
 /// Converts frame `frame` of uncompressed pixel data. dicom-rs has already put 16-bit words

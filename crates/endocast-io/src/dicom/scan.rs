@@ -3,6 +3,7 @@
 
 use super::lengths;
 use crate::error::{ReadError, Result};
+use crate::guard;
 use crate::limits::Limits;
 use crate::samples::Rescale;
 use dicom_core::Tag;
@@ -142,15 +143,20 @@ pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
         Ok(false) => return Scanned::NotDicom,
         Err(e) => return Scanned::Unreadable(e),
     }
-    if let Err(e) = lengths::check_element_lengths(path) {
+    // A deflated data set holds at most the largest volume's 16-bit samples and its header.
+    let max_inflated = limits.max_voxels.saturating_mul(2).saturating_add(1 << 26);
+    if let Err(e) = lengths::check_element_lengths(path, max_inflated) {
         return Scanned::Unreadable(e);
     }
-    let object = match OpenFileOptions::new()
-        .read_until(tags::PIXEL_DATA)
-        .open_file(path)
-    {
-        Ok(object) => object,
-        Err(e) => return Scanned::Unreadable(open_error(path, &e)),
+    let opened = guard::quietly(|| {
+        OpenFileOptions::new()
+            .read_until(tags::PIXEL_DATA)
+            .open_file(path)
+    });
+    let object = match opened {
+        Ok(Ok(object)) => object,
+        Ok(Err(e)) => return Scanned::Unreadable(open_error(path, &e)),
+        Err(panicked) => return Scanned::Unreadable(ReadError::format(path, panicked.to_string())),
     };
     match image_file(path, &object, &object.meta().transfer_syntax, limits) {
         Ok(Some(image)) => Scanned::Image(image),

@@ -60,9 +60,14 @@ pub(super) fn images(
             })
             .collect();
         warnings.push(format!(
-            "{}: skipped {} file(s) that are not DICOM images, e.g. {}",
+            "{}: skipped {} {} not DICOM images, e.g. {}",
             root.display(),
             skipped.len(),
+            if skipped.len() == 1 {
+                "file that is"
+            } else {
+                "files that are"
+            },
             examples.join(", ")
         ));
     }

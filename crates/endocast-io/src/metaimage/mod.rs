@@ -5,7 +5,9 @@
 //! origin, `ElementSpacing` the spacing and `TransformMatrix` the direction (see
 //! [`Header::direction_columns`] for how its nine numbers map onto the axes).
 //! `AnatomicalOrientation` is recorded in the header and checked against the matrix (a
-//! contradiction is a warning; the matrix wins). Compressed data are one zlib stream.
+//! contradiction is a warning; the matrix wins). Compressed data are one zlib stream, read to
+//! its end so that its Adler-32 checksum is checked; a stream that inflates to more bytes than
+//! the voxels, or that does not fill its CompressedDataSize, is corrupt.
 //! MetaImage names no modality, so volumes are [`Modality::Unknown`].
 
 mod header;
@@ -14,6 +16,7 @@ mod write;
 pub use header::{read_header, DataFile, DataStart, Header};
 pub use write::write;
 
+use crate::compressed;
 use crate::error::{ReadError, Result};
 use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::{read_voxels, Endian, Rescale};
@@ -21,7 +24,7 @@ use endocast_core::{Geometry, Modality, Volume};
 use flate2::bufread::ZlibDecoder;
 use glam::{DMat3, DVec3};
 use std::fs::File;
-use std::io::{BufReader, ErrorKind, Read, Seek, SeekFrom};
+use std::io::{self, BufReader, Read, Seek, SeekFrom, Take};
 use std::path::Path;
 
 /// Reads a MetaImage volume (`.mha`, or `.mhd` with its data file).
@@ -41,17 +44,21 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         DataFile::Local => path,
         DataFile::Detached(file) => file.as_path(),
     };
-    let mut reader = open_data(data_path, &header, count)?;
+    let mut data = open_data(data_path, &header, count, &mut warnings)?;
     let (voxels, map) = read_voxels(
         data_path,
-        &mut reader,
+        &mut data,
         header.element,
         header.endian,
         count,
         Rescale::IDENTITY,
         &mut warnings,
     )
-    .map_err(|e| corrupt_zlib_as_format(e, header.compressed))?;
+    .map_err(|e| match data {
+        Data::Zlib(_) => compressed::io_as_corrupt(e, "zlib"),
+        Data::Plain(_) => e,
+    })?;
+    data.finish(data_path)?;
     let volume = Volume::new(geometry, voxels, map, Modality::Unknown)
         .map_err(|e| ReadError::format(path, e.to_string()))?;
     Ok(Loaded {
@@ -141,9 +148,53 @@ fn check_orientation(
     }
 }
 
+/// The voxel bytes of the data file: the stored bytes, or the zlib stream inflating them.
+enum Data {
+    Plain(Take<BufReader<File>>),
+    Zlib(ZlibDecoder<Take<BufReader<File>>>),
+}
+
+impl Read for Data {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        match self {
+            Self::Plain(reader) => reader.read(buf),
+            Self::Zlib(reader) => reader.read(buf),
+        }
+    }
+}
+
+impl Data {
+    /// After the voxels: a zlib stream must end (checksum checked) without inflating more,
+    /// and exactly where its stored bytes end.
+    fn finish(self, path: &Path) -> Result<()> {
+        let Self::Zlib(mut decoder) = self else {
+            return Ok(());
+        };
+        compressed::finish(path, &mut decoder, "zlib", 0)?;
+        let trailing =
+            io::copy(decoder.get_mut(), &mut io::sink()).map_err(|e| ReadError::io(path, e))?;
+        if trailing > 0 {
+            return Err(ReadError::format(
+                path,
+                format!(
+                    "the zlib data are corrupt: {trailing} stored bytes follow the end of the \
+                     stream"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Opens the data file positioned at the voxels, bounded to the bytes they may occupy, and
-/// inflating when compressed. Lengths are checked before anything is read.
-fn open_data(data_path: &Path, header: &Header, count: usize) -> Result<Box<dyn Read>> {
+/// inflating when compressed. Lengths are checked before anything is read; bytes after the
+/// data are ignored with a warning.
+fn open_data(
+    data_path: &Path,
+    header: &Header,
+    count: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Data> {
     let file = File::open(data_path).map_err(|e| ReadError::io(data_path, e))?;
     let file_len = file
         .metadata()
@@ -184,32 +235,20 @@ fn open_data(data_path: &Path, header: &Header, count: usize) -> Result<Box<dyn 
     if start.saturating_add(stored_bytes) > file_len {
         return Err(ends_early(start, stored_bytes));
     }
+    let surplus = file_len - start - stored_bytes;
+    if surplus > 0 {
+        warnings.push(format!(
+            "{}: {surplus} bytes after the voxel data were ignored",
+            data_path.display()
+        ));
+    }
     let mut file = BufReader::new(file);
     file.seek(SeekFrom::Start(start))
         .map_err(|e| ReadError::io(data_path, e))?;
     let bounded = file.take(stored_bytes);
     Ok(if header.compressed {
-        Box::new(ZlibDecoder::new(bounded))
+        Data::Zlib(ZlibDecoder::new(bounded))
     } else {
-        Box::new(bounded)
+        Data::Plain(bounded)
     })
-}
-
-/// flate2 reports a corrupt stream as an I/O error; it is a fault of the file.
-fn corrupt_zlib_as_format(error: ReadError, compressed: bool) -> ReadError {
-    match error {
-        ReadError::Io { path, cause }
-            if compressed
-                && matches!(
-                    cause.kind(),
-                    ErrorKind::InvalidInput | ErrorKind::InvalidData
-                ) =>
-        {
-            ReadError::format(
-                &path,
-                format!("the zlib-compressed voxel data are corrupt: {cause}"),
-            )
-        }
-        other => other,
-    }
 }

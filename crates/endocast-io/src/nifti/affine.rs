@@ -141,12 +141,7 @@ fn decompose(path: &Path, dims: [usize; 3], lps: DAffine3, source: Source) -> Re
             "an axis has zero length (voxel sizes {spacing})"
         )));
     }
-    let direction = DMat3::from_cols(
-        cols[0] / spacing.x,
-        cols[1] / spacing.y,
-        cols[2] / spacing.z,
-    );
-    Geometry::new(dims, spacing, lps.translation, direction).map_err(|e| bad(e.to_string()))
+    Geometry::from_world_from_voxel(dims, lps).map_err(|e| bad(e.to_string()))
 }
 
 /// The NIfTI spatial fields of a geometry, in RAS.

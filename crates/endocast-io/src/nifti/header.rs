@@ -266,9 +266,14 @@ impl Header {
         ))
     }
 
-    /// The size of the first 3-D volume, validated: `dim[0]` must be 2 (one slice) to 7, every
-    /// used `dim[n]` positive. Extra dimensions (time, components) are dropped with a warning.
-    pub(super) fn volume_dims(&self, path: &Path, warnings: &mut Vec<String>) -> Result<[u64; 3]> {
+    /// The size of the first 3-D volume and the number of 3-D volumes the file holds,
+    /// validated: `dim[0]` must be 2 (one slice) to 7, every used `dim[n]` positive. Extra
+    /// dimensions (time, components) are dropped with a warning.
+    pub(super) fn volume_dims(
+        &self,
+        path: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<([u64; 3], u64)> {
         let rank = self.dim[0];
         if !(1..=7).contains(&rank) {
             return Err(ReadError::format(
@@ -302,7 +307,7 @@ impl Header {
                 &self.dim[1..=rank as usize]
             ));
         }
-        Ok([sizes[0], sizes[1], sizes[2]])
+        Ok(([sizes[0], sizes[1], sizes[2]], extra))
     }
 
     /// The byte offset of the first voxel, validated: a whole number, not inside the header.
@@ -416,10 +421,10 @@ mod tests {
         let mut w = Vec::new();
         let mut h = sample();
         h.dim = [4, 2, 3, 4, 5, 1, 1, 1];
-        assert_eq!(h.volume_dims(p, &mut w).unwrap(), [2, 3, 4]);
+        assert_eq!(h.volume_dims(p, &mut w).unwrap(), ([2, 3, 4], 5));
         assert_eq!(w.len(), 1);
         h.dim = [2, 7, 9, 0, 0, 0, 0, 0];
-        assert_eq!(h.volume_dims(p, &mut w).unwrap(), [7, 9, 1]);
+        assert_eq!(h.volume_dims(p, &mut w).unwrap(), ([7, 9, 1], 1));
         for bad in [
             [3, 2, 0, 4, 1, 1, 1, 1],
             [3, 2, -3, 4, 1, 1, 1, 1],

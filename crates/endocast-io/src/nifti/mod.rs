@@ -1,8 +1,9 @@
 //! NIfTI-1 and NIfTI-2 single-file images (`.nii`, `.nii.gz`): reader and NIfTI-1 writer.
 //!
 //! Reading streams the file (through a gzip decoder when it starts with the gzip magic, whatever
-//! its name) and never reads more than the header, the bytes up to `vox_offset` and the first
-//! 3-D volume's voxels. The version and byte order come from `sizeof_hdr` (348 or 540 in the
+//! its name) and keeps no more than the header and the first 3-D volume's voxels; a gzip stream
+//! is then read to its end (the other volumes of a 4-D image are inflated and dropped) so that
+//! its CRC and length are checked, and inflated bytes beyond the header's volumes are refused. The version and byte order come from `sizeof_hdr` (348 or 540 in the
 //! file's byte order). Geometry comes from the sform when `sform_code > 0`, else the qform
 //! when `qform_code > 0`, else the voxel sizes alone (with a warning); NIfTI's RAS world
 //! becomes endocast's LPS by negating x and y, and the 3×4 affine splits into spacing (column
@@ -20,6 +21,7 @@ mod write;
 
 pub use write::write;
 
+use crate::compressed;
 use crate::error::{ReadError, Result};
 use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::{read_voxels, Endian, Rescale};
@@ -62,7 +64,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
             element.name()
         ));
     }
-    let dims = header.volume_dims(path, &mut warnings)?;
+    let (dims, volumes) = header.volume_dims(path, &mut warnings)?;
     let count = options.limits.check_dims(path, &dims)?;
     let vox_offset = header.data_offset(path)?;
     if !gzip {
@@ -87,9 +89,18 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         count,
         rescale(path, &header, &mut warnings),
         &mut warnings,
-    )?;
+    )
+    .map_err(|e| {
+        if gzip {
+            compressed::io_as_corrupt(e, "gzip")
+        } else {
+            e
+        }
+    })?;
     if gzip {
-        verify_gzip_end(path, &mut reader)?;
+        let volume_bytes = count as u64 * element.size() as u64;
+        let rest = (volumes - 1).saturating_mul(volume_bytes);
+        compressed::finish(path, &mut reader, "gzip", rest)?;
     }
 
     // check_dims proved the product fits usize, so each factor does.
@@ -101,18 +112,6 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         volume,
         source: SourceInfo::new(Format::Nifti, stored_type(&header, element.name(), gzip)),
         warnings,
-    })
-}
-
-/// Reads one byte past the voxels: for a 3-D file this reaches the end of the gzip member, so
-/// the decoder checks its CRC and length and a truncated or corrupt file is refused rather than
-/// silently accepted.
-fn verify_gzip_end(path: &Path, reader: &mut dyn Read) -> Result<()> {
-    reader.read(&mut [0u8; 1]).map(|_| ()).map_err(|e| {
-        ReadError::format(
-            path,
-            format!("the gzip stream is corrupt or truncated: {e}"),
-        )
     })
 }
 

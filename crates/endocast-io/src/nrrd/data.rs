@@ -8,6 +8,7 @@
 
 use super::fields::{ByteSkip, DataFiles, Encoding};
 use super::header::Header;
+use crate::compressed;
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
 use crate::samples::{read_voxels, ElementType, Endian, Rescale};
@@ -48,6 +49,7 @@ pub(super) fn read_samples(
         next: 0,
         current: None,
         failure: None,
+        surplus: Vec::new(),
     };
     let result = read_voxels(
         header_path,
@@ -59,7 +61,7 @@ pub(super) fn read_samples(
         warnings,
     )
     .and_then(|voxels| {
-        // One more read finishes the last segment: a gzip member's CRC and length get checked.
+        // One more read finishes the last segment: a gzip stream is checked to its end.
         chain
             .read(&mut [0u8; 1])
             .map(|_| voxels)
@@ -68,7 +70,17 @@ pub(super) fn read_samples(
     match (result, chain.failure) {
         // The chain knows which file failed and why; read_voxels only saw an I/O error.
         (Err(_), Some(failure)) => Err(failure),
-        (result, _) => result,
+        (result, _) => {
+            for (path, bytes) in chain.surplus {
+                warnings.push(format!(
+                    "{}: {bytes} bytes of data beyond the samples that sizes {:?} describe \
+                     were ignored",
+                    path.display(),
+                    header.sizes
+                ));
+            }
+            result
+        }
     }
 }
 
@@ -133,6 +145,8 @@ struct Chain<'a> {
     current: Option<(Box<dyn Read>, u64)>,
     /// Why the stream stopped, naming the segment's file.
     failure: Option<ReadError>,
+    /// Files holding more (uncompressed) data than their share of the samples, and how much.
+    surplus: Vec<(PathBuf, u64)>,
 }
 
 impl Chain<'_> {
@@ -162,12 +176,10 @@ impl Read for Chain<'_> {
             };
             let remaining = segment.bytes - *delivered;
             if remaining == 0 {
-                if self.header.encoding == Encoding::Gzip {
-                    // Reading on to the end of the gzip member makes the decoder check its
-                    // CRC, which catches corruption that still inflates.
-                    if let Err(e) = reader.read(&mut [0u8; 1]) {
-                        return Err(self.fail(segment_error(segment, e)));
-                    }
+                match finish_segment(segment, self.header.encoding, reader.as_mut()) {
+                    Ok(0) => {}
+                    Ok(surplus) => self.surplus.push((segment.path.clone(), surplus)),
+                    Err(e) => return Err(self.fail(e)),
                 }
                 self.current = None;
                 self.next += 1;
@@ -194,6 +206,17 @@ impl Read for Chain<'_> {
             }
         }
     }
+}
+
+/// Reads what a segment holds after its share of the samples: a gzip stream must end there
+/// (its CRC and length checked; more inflated data is corruption), other encodings may carry
+/// surplus bytes, whose count is returned (to be warned about).
+fn finish_segment(segment: &Segment, encoding: Encoding, reader: &mut dyn Read) -> Result<u64> {
+    if encoding == Encoding::Gzip {
+        compressed::finish(&segment.path, reader, "gzip", 0)?;
+        return Ok(0);
+    }
+    io::copy(reader, &mut io::sink()).map_err(|e| segment_error(segment, e))
 }
 
 /// Operating-system errors stay I/O errors; anything else (a short file, a corrupt gzip

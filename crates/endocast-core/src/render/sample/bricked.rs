@@ -8,15 +8,9 @@
 
 use super::super::bricks::bricks_along;
 use super::super::simd::Avx2;
+use super::super::voxel_grid::{BRICK_LEN, EDGE, VOX};
 use crate::Volume;
 use rayon::prelude::*;
-
-/// Cells per brick edge (a power of two).
-pub(in crate::render) const VOX: usize = 16;
-/// Voxels per brick edge, with the apron.
-pub(in crate::render) const EDGE: usize = VOX + 1;
-/// Voxels per brick.
-pub(in crate::render) const BRICK_LEN: usize = EDGE * EDGE * EDGE;
 
 /// A volume's voxels brick by brick (x fastest inside a brick, bricks x fastest), each brick
 /// with a one-voxel apron on its upper faces (clamped to the volume).

@@ -40,9 +40,8 @@ mod unchecked;
 
 #[cfg(target_arch = "x86_64")]
 use super::{
-    crossing::Bracket,
-    ray_task::RayTask,
-    sample::{Lanes, SampleGrid, Sampler},
+    ray_task::{Bracket, RayTask},
+    voxel_grid::{Lanes, SampleGrid, VoxelGrid},
 };
 
 /// Proof that this CPU runs AVX2 (and so the AVX2 batches): zero-sized, `Copy`, and made only by
@@ -86,7 +85,7 @@ impl Avx2 {
     #[inline]
     pub(crate) fn search8(
         self,
-        sampler: &Sampler<'_>,
+        sampler: &VoxelGrid<'_>,
         active: Option<&[u64]>,
         iso: f32,
         tasks: &mut [RayTask],
@@ -100,7 +99,7 @@ impl Avx2 {
     #[inline]
     pub(crate) fn refine8(
         self,
-        sampler: &Sampler<'_>,
+        sampler: &VoxelGrid<'_>,
         iso: f32,
         tasks: &mut [RayTask],
         steps: u32,
@@ -111,21 +110,21 @@ impl Avx2 {
 
     /// Samples `n .. n + 8` of `grid`.
     #[inline]
-    pub(crate) fn grid8(self, sampler: &Sampler<'_>, grid: &SampleGrid, n: i32) -> Lanes {
+    pub(crate) fn grid8(self, sampler: &VoxelGrid<'_>, grid: &SampleGrid, n: i32) -> Lanes {
         // SAFETY: the token exists, so the CPU has AVX2.
         unsafe { sample::grid8(sampler, grid, n) }
     }
 
     /// The values at eight positions given as their x, y and z lanes.
     #[inline]
-    pub(crate) fn points8(self, sampler: &Sampler<'_>, xyz: [&Lanes; 3]) -> Lanes {
+    pub(crate) fn points8(self, sampler: &VoxelGrid<'_>, xyz: [&Lanes; 3]) -> Lanes {
         // SAFETY: the token exists, so the CPU has AVX2.
         unsafe { sample::points8(sampler, xyz) }
     }
 
     /// The values at `line.at(t[k])` for the eight distances `t`.
     #[inline]
-    pub(crate) fn along8(self, sampler: &Sampler<'_>, line: &SampleGrid, t: &Lanes) -> Lanes {
+    pub(crate) fn along8(self, sampler: &VoxelGrid<'_>, line: &SampleGrid, t: &Lanes) -> Lanes {
         // SAFETY: the token exists, so the CPU has AVX2.
         unsafe { sample::along8(sampler, line, t) }
     }

@@ -13,11 +13,10 @@
 //! brick it was found in pending.
 
 use super::sample::trilinear;
-use crate::render::crossing::Bracket;
 use crate::render::march::MarchStats;
-use crate::render::ray_task::RayTask;
-use crate::render::sample::Sampler;
+use crate::render::ray_task::{Bracket, RayTask};
 use crate::render::traverse::{BrickDda, Segment};
+use crate::render::voxel_grid::VoxelGrid;
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_andnot_si256,
     _mm256_blendv_epi8, _mm256_blendv_ps, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps,
@@ -38,13 +37,13 @@ type Mask = __m256i;
 /// brick bits (`None`: every brick is searched). Each march is left as that search leaves it.
 #[target_feature(enable = "avx2")]
 pub(super) fn search8(
-    sampler: &Sampler<'_>,
+    sampler: &VoxelGrid<'_>,
     active: Option<&[u64]>,
     iso: f32,
     tasks: &mut [RayTask],
     directions: [bool; 8],
 ) -> [Option<Bracket>; 8] {
-    debug_assert!(tasks.len() <= 8 && sampler.avx2().is_some());
+    debug_assert!(tasks.len() <= 8);
     let mut dda = Dda::load(tasks);
     let grid = Grid::load(tasks);
     let mut lanes = Lanes::new(tasks.len());
@@ -97,8 +96,8 @@ pub(super) fn search8(
 /// alone), all steps in registers: each midpoint computed, sampled and kept as
 /// [`crate::render::integrate::Integrator::refine`] keeps a single ray's.
 #[target_feature(enable = "avx2")]
-pub(super) fn refine8(sampler: &Sampler<'_>, iso: f32, tasks: &mut [RayTask], steps: u32) {
-    debug_assert!(tasks.len() <= 8 && sampler.avx2().is_some());
+pub(super) fn refine8(sampler: &VoxelGrid<'_>, iso: f32, tasks: &mut [RayTask], steps: u32) {
+    debug_assert!(tasks.len() <= 8);
     let grid = Grid::load(tasks);
     let bracket = |f: fn(&Bracket) -> f32| lanes_f32(tasks, |t| t.bracket.as_ref().map_or(0.0, f));
     let (mut t0, mut v0) = (bracket(|b| b.before.0), bracket(|b| b.before.1));
@@ -363,14 +362,14 @@ impl Grid {
     /// Sample `n` of each lane's grid.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn sample(&self, sampler: &Sampler<'_>, n: __m256i) -> __m256 {
+    fn sample(&self, sampler: &VoxelGrid<'_>, n: __m256i) -> __m256 {
         self.value_at(sampler, self.t_of(n))
     }
 
     /// The value at distance `t` along each lane's line, as `SampleGrid::at` places it.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn value_at(&self, sampler: &Sampler<'_>, t: __m256) -> __m256 {
+    fn value_at(&self, sampler: &VoxelGrid<'_>, t: __m256) -> __m256 {
         let at = |axis: usize| along(self.origin[axis], self.direction[axis], t);
         trilinear(sampler, at(0), at(1), at(2))
     }

@@ -4,8 +4,7 @@
 //! operation for operation — clamp, truncate, the same lerps in the same order, no fused
 //! multiply-add — so the lanes equal the scalar values bit for bit.
 
-use crate::render::sample::bricked::{BRICK_LEN, EDGE, VOX};
-use crate::render::sample::{Lanes, SampleGrid, Sampler};
+use crate::render::voxel_grid::{Lanes, SampleGrid, VoxelGrid, BRICK_LEN, EDGE, VOX};
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_cvtepi32_ps,
     _mm256_cvttps_epi32, _mm256_i32gather_epi32, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_epi32,
@@ -16,7 +15,7 @@ use std::arch::x86_64::{
 
 /// Samples `n .. n + 8` of `grid`.
 #[target_feature(enable = "avx2")]
-pub(super) fn grid8(sampler: &Sampler<'_>, grid: &SampleGrid, n: i32) -> Lanes {
+pub(super) fn grid8(sampler: &VoxelGrid<'_>, grid: &SampleGrid, n: i32) -> Lanes {
     let index = _mm256_add_epi32(
         _mm256_set1_epi32(n),
         _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
@@ -32,7 +31,7 @@ pub(super) fn grid8(sampler: &Sampler<'_>, grid: &SampleGrid, n: i32) -> Lanes {
 
 /// The values at `line.at(t[k])`.
 #[target_feature(enable = "avx2")]
-pub(super) fn along8(sampler: &Sampler<'_>, line: &SampleGrid, t: &Lanes) -> Lanes {
+pub(super) fn along8(sampler: &VoxelGrid<'_>, line: &SampleGrid, t: &Lanes) -> Lanes {
     // SAFETY: `t` holds exactly eight f32; unaligned loads are allowed.
     at_distances(sampler, line, unsafe { _mm256_loadu_ps(t.as_ptr()) })
 }
@@ -40,7 +39,7 @@ pub(super) fn along8(sampler: &Sampler<'_>, line: &SampleGrid, t: &Lanes) -> Lan
 /// The values at `line.at(t)` per lane.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn at_distances(sampler: &Sampler<'_>, line: &SampleGrid, t: __m256) -> Lanes {
+fn at_distances(sampler: &VoxelGrid<'_>, line: &SampleGrid, t: __m256) -> Lanes {
     let x = along(line.origin.x, line.direction.x, t);
     let y = along(line.origin.y, line.direction.y, t);
     let z = along(line.origin.z, line.direction.z, t);
@@ -49,7 +48,7 @@ fn at_distances(sampler: &Sampler<'_>, line: &SampleGrid, t: __m256) -> Lanes {
 
 /// The values at eight positions given as their x, y and z lanes.
 #[target_feature(enable = "avx2")]
-pub(super) fn points8(sampler: &Sampler<'_>, [x, y, z]: [&Lanes; 3]) -> Lanes {
+pub(super) fn points8(sampler: &VoxelGrid<'_>, [x, y, z]: [&Lanes; 3]) -> Lanes {
     // SAFETY: each array holds exactly eight f32; unaligned loads are allowed.
     let load = |lanes: &Lanes| unsafe { _mm256_loadu_ps(lanes.as_ptr()) };
     store(trilinear(sampler, load(x), load(y), load(z)))
@@ -89,7 +88,7 @@ fn cell(p: __m256, extent: f32, max_base: i32) -> (__m256i, __m256) {
 /// clamped to the volume).
 #[target_feature(enable = "avx2")]
 #[inline]
-pub(crate) fn trilinear(s: &Sampler<'_>, x: __m256, y: __m256, z: __m256) -> __m256 {
+pub(crate) fn trilinear(s: &VoxelGrid<'_>, x: __m256, y: __m256, z: __m256) -> __m256 {
     let (bx, fx) = cell(x, s.extent.x, s.max_base[0]);
     let (by, fy) = cell(y, s.extent.y, s.max_base[1]);
     let (bz, fz) = cell(z, s.extent.z, s.max_base[2]);

@@ -1,9 +1,9 @@
 //! The scalar sampler's unchecked reads: one bounds check for a whole 2×2×2 cell.
 
-use crate::render::sample::Sampler;
+use crate::render::voxel_grid::VoxelGrid;
 use glam::Vec4;
 
-impl Sampler<'_> {
+impl VoxelGrid<'_> {
     /// The 2×2×2 cell whose lowest corner is voxel `index`: the four corners at x and the four
     /// at x + 1, each ordered (y, z) = (0, 0), (1, 0), (0, 1), (1, 1).
     ///
@@ -17,7 +17,7 @@ impl Sampler<'_> {
         let at = |offset: usize| {
             debug_assert!(offset < cell.len());
             // SAFETY: every offset used below is a sum of a subset of {sx, sy, sz}, so it is at
-            // most sx + sy + sz = cell.len() − 1: `Sampler::new` makes each stride 0 or a
+            // most sx + sy + sz = cell.len() − 1: `VoxelGrid::new` makes each stride 0 or a
             // product of dimensions at most `voxels.len()`, so that sum cannot overflow (and an
             // `index` that makes the end overflow gives an empty range, refused above).
             f32::from(unsafe { *cell.get_unchecked(offset) })

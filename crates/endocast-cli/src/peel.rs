@@ -1,0 +1,99 @@
+//! The depth-peeling options (`--mode peel`), shared by every command that renders.
+
+use anyhow::{bail, Result};
+use clap::{Args, ValueEnum};
+use endocast_core::render::{PeelLayer, RenderSettings, Unpeeled};
+
+/// How `--mode peel` peels (Borland et al.'s volumetric depth peeling).
+#[derive(Args, Debug, Clone)]
+pub struct PeelArgs {
+    /// The peel shown: 1, 2, 3 … (the n-th crossing of the peel threshold) or last (default:
+    /// the preset's, else 1).
+    #[arg(long, value_name = "N|last", value_parser = parse_layer)]
+    peel: Option<PeelLayer>,
+    /// The peel threshold, physical units (default: the preset's, else --iso).
+    #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
+    peel_threshold: Option<f64>,
+    /// Count crossings into the darker material as peels (default: into the brighter).
+    #[arg(long)]
+    peel_falling: bool,
+    /// Share of what lies in front of the peel that stays visible, 0–1 (default 0: discarded).
+    #[arg(long, value_name = "0..1")]
+    peel_keep: Option<f32>,
+    /// Rays that never reach the wanted peel: discard (transparent) or context (drawn with
+    /// --tf). Default discard.
+    #[arg(long, value_enum)]
+    unpeeled: Option<UnpeeledArg>,
+    /// Transfer function behind the peel: a JSON file or a preset name (default: the
+    /// preset's, else as --tf).
+    #[arg(long, value_name = "FILE|NAME")]
+    tf_after: Option<String>,
+}
+
+/// `--unpeeled`'s values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum UnpeeledArg {
+    Discard,
+    Context,
+}
+
+impl PeelArgs {
+    /// The `--tf-after` given, a file or a preset name, for the caller to read.
+    pub fn tf_after(&self) -> Option<&str> {
+        self.tf_after.as_deref()
+    }
+
+    /// Applies the options given to `settings`, all but [`Self::tf_after`].
+    pub fn apply(&self, settings: &mut RenderSettings) -> Result<()> {
+        let peel = &mut settings.peel;
+        if let Some(layer) = self.peel {
+            peel.layer = layer;
+        }
+        if let Some(threshold) = self.peel_threshold {
+            if !threshold.is_finite() {
+                bail!("--peel-threshold must be a finite number, not {threshold}");
+            }
+            peel.threshold_hu = Some(threshold);
+        }
+        peel.falling |= self.peel_falling;
+        if let Some(keep) = self.peel_keep {
+            if !(0.0..=1.0).contains(&keep) {
+                bail!("--peel-keep must be between 0 and 1, not {keep}");
+            }
+            peel.keep = keep;
+        }
+        if let Some(unpeeled) = self.unpeeled {
+            peel.unpeeled = match unpeeled {
+                UnpeeledArg::Discard => Unpeeled::Discard,
+                UnpeeledArg::Context => Unpeeled::Context,
+            };
+        }
+        Ok(())
+    }
+}
+
+/// `N` (1, 2, 3 …) or `last`.
+fn parse_layer(text: &str) -> Result<PeelLayer, String> {
+    let text = text.trim();
+    if text.eq_ignore_ascii_case("last") {
+        return Ok(PeelLayer::Last);
+    }
+    match text.parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(PeelLayer::Nth(n)),
+        _ => Err(format!("expected 1, 2, 3 … or last, found {text:?}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layers_parse() {
+        assert_eq!(parse_layer("2"), Ok(PeelLayer::Nth(2)));
+        assert_eq!(parse_layer(" Last"), Ok(PeelLayer::Last));
+        assert!(parse_layer("0").is_err());
+        assert!(parse_layer("-1").is_err());
+        assert!(parse_layer("first").is_err());
+    }
+}

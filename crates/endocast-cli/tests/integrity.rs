@@ -1,0 +1,172 @@
+//! What the tool does with hostile sizes, names and signals: a frame too large for memory is a
+//! clear error before anything is allocated, an interrupted `fly` leaves no temporary file,
+//! `-o x.jpg` writes a JPEG (other endings are refused), and no control character from a file
+//! reaches the terminal.
+
+use crate::common::{endocast, fails_with};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The 48³ straight tube and a path along its axis, in `dir`.
+fn tube_and_path(dir: &Path) -> (String, String) {
+    let tube = dir.join("tube.nii.gz").to_str().unwrap().to_owned();
+    let path = dir.join("p.json").to_str().unwrap().to_owned();
+    let runs = [
+        vec!["phantom", "straight-tube", "--size", "48", "-o", &tube],
+        vec![
+            "path", &tube, "--iso", "-480", "--from", "0,0,-18", "--to", "0,0,18", "-o", &path,
+        ],
+    ];
+    for args in runs {
+        let out = endocast(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    (tube, path)
+}
+
+fn temporary_files(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".tmp"))
+        .collect()
+}
+
+#[test]
+fn a_huge_size_is_a_clear_error_before_reading_or_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tube, path) = tube_and_path(dir.path());
+    let view = dir.path().join("v.png");
+    let view = view.to_str().unwrap();
+    fails_with(
+        &["render", &tube, "--size", "100000x100000", "-o", view],
+        "rendering a frame of 100000×100000 pixels",
+    );
+    // 16384² is a valid camera, but 28 bytes a pixel is more than this limit allows.
+    fails_with(
+        &[
+            "render",
+            "/no/scan.nii",
+            "--size",
+            "16384x16384",
+            "--max-voxels",
+            "1000",
+            "-o",
+            view,
+        ],
+        "too large",
+    );
+    let film = dir.path().join("f.gif");
+    fails_with(
+        &[
+            "fly",
+            &tube,
+            "--path",
+            &path,
+            "--size",
+            "100000x100000",
+            "-o",
+            film.to_str().unwrap(),
+        ],
+        "use a smaller --size",
+    );
+}
+
+#[test]
+fn sigterm_during_fly_removes_the_temporary_film() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tube, path) = tube_and_path(dir.path());
+    let film = dir.path().join("f.gif");
+    // Thousands of frames: far longer than the test waits.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_endocast"))
+        .args([
+            "fly", &tube, "--path", &path, "--iso", "-480", "--size", "96x96",
+        ])
+        .args(["--frame-step", "0.01", "-o", film.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while temporary_files(dir.path()).is_empty() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no temporary film appeared"
+        );
+        assert!(child.try_wait().unwrap().is_none(), "fly ended early");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(128 + 15), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    assert_eq!(temporary_files(dir.path()), Vec::<String>::new());
+    assert!(!film.exists());
+}
+
+#[test]
+fn jpg_output_is_a_jpeg_and_unknown_endings_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tube, path) = tube_and_path(dir.path());
+    let jpg = dir.path().join("v.jpg");
+    let out = endocast(&[
+        "render",
+        &tube,
+        "--size",
+        "64x48",
+        "-o",
+        jpg.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(&jpg).unwrap();
+    assert_eq!(&bytes[..3], &[0xFF, 0xD8, 0xFF]);
+    let bmp = dir.path().join("v.bmp");
+    fails_with(
+        &[
+            "render",
+            &tube,
+            "--size",
+            "64x48",
+            "-o",
+            bmp.to_str().unwrap(),
+        ],
+        "image output .bmp: write .png or .jpg",
+    );
+    assert!(!bmp.exists());
+    let film = dir.path().join("f.jpg");
+    fails_with(
+        &["fly", &tube, "--path", &path, "-o", film.to_str().unwrap()],
+        "write .gif, .mp4, or a folder of PNGs",
+    );
+}
+
+#[test]
+fn header_text_reaches_the_terminal_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let nrrd = dir.path().join("evil.nrrd");
+    let header = "NRRD0004\ntype: \u{1b}[2J\u{1b}[31mshort\u{7}\ndimension: 3\nsizes: 2 2 2\n\
+                  encoding: raw\n\n";
+    std::fs::write(&nrrd, header).unwrap();
+    let out = endocast(&["info", nrrd.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("evil.nrrd"), "{stderr}");
+    assert!(
+        !stderr.contains('\u{1b}') && !stderr.contains('\u{7}'),
+        "raw control characters: {stderr:?}"
+    );
+}

@@ -1,0 +1,323 @@
+//! Geometry in the volume, ray by ray (Scharsach et al. 2006, §3.4), after the volume pass of
+//! a row: each pixel's ray is traced against the [`Scene`] up to where the volume's result
+//! became opaque, and what it meets joins the pixel in true depth order.
+//!
+//! - Opaque geometry ends the volume ray at its exact distance (the ray-length image of the
+//!   paper: [`RayMarch::limit`], the path of the per-pixel maximum distances).
+//! - Translucent geometry inside the part of the ray the volume samples splits the march: the
+//!   volume is walked up to the surface, the surface composited, and the walk goes on behind
+//!   it ([`RayMarch::part`]) — the exact order, not a two-pass approximation.
+//! - Geometry in front of where the volume is sampled or behind it is composited around the
+//!   volume's result without walking the ray again. So does any geometry in iso mode (the
+//!   result is one surface at a known depth) and in MIP/MinIP, whose projections have no depth:
+//!   there the geometry lies in front of the projection.
+//!
+//! Only rays that meet geometry inside the sampled part of the ray before it became opaque are
+//! walked again; the others cost one trace against the scene, pruned at the volume's end.
+
+use super::integrate::Integrator;
+use super::march::{MarchStats, RayMarch};
+use super::ray_task::{PixelOut, RayTask};
+use super::sample::Accum;
+use super::settings::Mode;
+use super::traverse::VoxelRay;
+use super::{adjust, Camera, Prepared, RenderOptions};
+use crate::scene::{Hit, PlacedScene, Scene};
+use glam::{Vec3, Vec3A};
+use std::ops::Range;
+use std::sync::Arc;
+
+/// One row's work: its rays (the columns that meet the volume, and their rendered tasks) and
+/// the scene placed for the frame's camera.
+pub(super) struct SceneRow<'r, 'a> {
+    pub scene: &'r PlacedScene<'a>,
+    pub camera: &'r Camera,
+    pub options: &'r RenderOptions<'r>,
+    pub y: usize,
+}
+
+impl Prepared {
+    /// The scene drawn with the volume (none by default).
+    pub fn scene(&self) -> Option<&Arc<Scene>> {
+        self.scene.as_ref()
+    }
+
+    /// Draws `scene` with the volume in every later frame (`None`: the volume alone). Opaque
+    /// surfaces end the rays; translucent ones are composited with the volume samples in depth
+    /// order. The depth layer is then the nearest of the isosurface and the geometry.
+    pub fn set_scene(&mut self, scene: Option<Arc<Scene>>) {
+        self.scene = scene;
+    }
+
+    /// Adds the scene to the rays of row `row.y`, columns `xs`: the rendered `tasks` of
+    /// `columns` in place, and for pixels whose ray misses the volume, their surfaces into
+    /// `others` as `(column, result)`.
+    pub(super) fn add_scene(
+        &self,
+        integrator: &Integrator<'_>,
+        row: &SceneRow<'_, '_>,
+        xs: Range<usize>,
+        (columns, tasks): (&[usize], &mut [RayTask]),
+        others: &mut Vec<(usize, PixelOut)>,
+    ) {
+        let mut hits = Vec::new();
+        let mut rendered = columns.iter().zip(tasks.iter_mut()).peekable();
+        let width = row.camera.size()[0];
+        for x in xs {
+            let task = rendered.next_if(|(&c, _)| c == x).map(|(_, task)| task);
+            let Some(ray) = row.camera.pixel_ray(x, row.y) else {
+                continue;
+            };
+            let near = row.camera.near_distance_along(ray.dir);
+            let mut bound = task
+                .as_ref()
+                .map_or(f64::INFINITY, |t| self.volume_bound(t));
+            if let Some(max) = row.options.max_distance_mm {
+                let limit = f64::from(max[x + width * row.y]);
+                bound = if limit < bound { limit } else { bound };
+            }
+            row.scene.trace(&ray, near, bound, &mut hits);
+            if hits.is_empty() {
+                continue;
+            }
+            match task {
+                Some(task) => self.with_hits(integrator, row, x, &hits, task),
+                None => {
+                    let mut out = PixelOut::default();
+                    for hit in &hits {
+                        add_hit(integrator, &mut out.accum, hit, ray.dir.as_vec3());
+                    }
+                    out.depth_mm = hits[0].t_mm;
+                    others.push((x, out));
+                }
+            }
+        }
+    }
+
+    /// Where the volume's result along `task`'s ray became opaque (geometry behind it cannot
+    /// show), mm; infinity where it did not.
+    fn volume_bound(&self, task: &RayTask) -> f64 {
+        let (out, params) = (&task.out, &self.params);
+        let stop = params.early_termination;
+        let surface_stops = params.lower.opacity >= stop && !out.depth_mm.is_nan();
+        let bound = match params.mode {
+            Mode::Iso | Mode::Hybrid | Mode::Peel if surface_stops => Some(out.depth_mm),
+            Mode::Mip | Mode::Minip | Mode::Iso => None,
+            _ if out.terminated => task.march.last_sample_t(),
+            _ => None,
+        };
+        bound.map_or(f64::INFINITY, f64::from)
+    }
+
+    /// Joins `hits` (in depth order) to the rendered ray `task` of column `x`.
+    fn with_hits(
+        &self,
+        integrator: &Integrator<'_>,
+        row: &SceneRow<'_, '_>,
+        x: usize,
+        hits: &[Hit],
+        task: &mut RayTask,
+    ) {
+        let dir = task.dir_world;
+        let (t_start, t_end) = task.march.span();
+        let out = &mut task.out;
+        let opaque_surface = self.params.lower.opacity >= self.params.early_termination;
+        match self.params.mode {
+            // Peel: hits join around the shown surface (what the peel keeps in front of it is
+            // not split at hits inside it).
+            Mode::Iso | Mode::Peel => {
+                let depth = out.depth_mm;
+                // Every hit where there is no surface (NaN depth).
+                let in_front = hits.partition_point(|h| h.t_mm < depth || depth.is_nan());
+                *out = around(integrator, out, hits, in_front, dir);
+            }
+            Mode::Mip | Mode::Minip => *out = around(integrator, out, hits, hits.len(), dir),
+            // Hybrid draws nothing in front of its surface: hits there, and any hit when the
+            // surface is opaque, join around it.
+            Mode::Hybrid
+                if !out.depth_mm.is_nan()
+                    && (opaque_surface || hits.iter().all(|h| h.t_mm < out.depth_mm)) =>
+            {
+                let in_front = hits.partition_point(|h| h.t_mm < out.depth_mm);
+                *out = around(integrator, out, hits, in_front, dir);
+            }
+            _ if hits.iter().all(|h| h.t_mm <= t_start || h.t_mm >= t_end) => {
+                let in_front = hits.partition_point(|h| h.t_mm <= t_start);
+                *out = around(integrator, out, hits, in_front, dir);
+            }
+            _ => {
+                if let Some(split) = self.split_task(integrator, row, x, hits) {
+                    *task = split;
+                }
+            }
+        }
+    }
+
+    /// Pixel `(x, row.y)`'s ray walked again, ended at the opaque hit and split at the
+    /// translucent ones.
+    fn split_task(
+        &self,
+        integrator: &Integrator<'_>,
+        row: &SceneRow<'_, '_>,
+        x: usize,
+        hits: &[Hit],
+    ) -> Option<RayTask> {
+        let ray = self.ray(row.camera, x, row.y)?;
+        let mut task = self.task_of(&ray, x, row.y)?;
+        adjust(
+            &mut task.march,
+            row.options,
+            x + row.camera.size()[0] * row.y,
+        );
+        let (translucent, opaque) = match hits.split_last() {
+            Some((last, rest)) if last.opacity >= 1.0 => (rest, Some(last)),
+            _ => (hits, None),
+        };
+        if let Some(opaque) = opaque {
+            task.march.limit(opaque.t_mm);
+        }
+        let split = Split {
+            ray: &ray.voxel,
+            bricks: self.renderer.grid.bricks(),
+            dir: task.dir_world,
+        };
+        task.out = integrator.run_split(&mut task.march, &split, translucent);
+        if let (Some(hit), false) = (opaque, task.out.terminated) {
+            add_hit(integrator, &mut task.out.accum, hit, task.dir_world);
+        }
+        task.out.depth_mm = nearest(task.out.depth_mm, hits[0].t_mm);
+        Some(task)
+    }
+}
+
+/// A split ray's voxel-space ray, brick counts and unit world direction.
+pub(super) struct Split<'a> {
+    ray: &'a VoxelRay,
+    bricks: [usize; 3],
+    dir: Vec3,
+}
+
+impl Integrator<'_> {
+    /// Renders `march` (ended at any opaque hit) in the configured mode with the translucent
+    /// `hits` (depth order) composited between its samples where they lie.
+    fn run_split(&self, march: &mut RayMarch, split: &Split<'_>, hits: &[Hit]) -> PixelOut {
+        let mut out = PixelOut::default();
+        let dir = split.dir;
+        let span = march.span();
+        match self.params.mode {
+            Mode::Hybrid => {
+                let iso = self.params.lower.iso;
+                let depth = self
+                    .search(march, iso, &mut ())
+                    .map(|bracket| self.refine(march.grid(), iso, bracket));
+                let Some(depth) = depth else {
+                    for hit in hits {
+                        add_hit(self, &mut out.accum, hit, dir);
+                    }
+                    return out;
+                };
+                let behind = hits.partition_point(|h| h.t_mm < depth);
+                for hit in &hits[..behind] {
+                    add_hit(self, &mut out.accum, hit, dir);
+                }
+                out.depth_mm = depth;
+                self.lit_surface(march, dir, &mut out);
+                let from = (depth, span.1);
+                self.parts(march, split, from, &hits[behind..], &mut out, |m, out| {
+                    self.composite(m, out, dir, false, &mut ());
+                });
+            }
+            Mode::TwoIso => {
+                let mut previous = (0.0, 0.0);
+                self.parts(march, split, span, hits, &mut out, |m, out| {
+                    self.two_iso_part(m, dir, out, &mut previous, &mut ());
+                });
+            }
+            _ => {
+                let shade = self.params.shade_dvr;
+                self.parts(march, split, span, hits, &mut out, |m, out| {
+                    self.composite(m, out, dir, shade, &mut ());
+                });
+            }
+        }
+        out
+    }
+
+    /// Walks `march` over `(from, to)` mm in parts split at `hits` (inside it, depth order):
+    /// `walk` each part onto `out`, then the hit's surface, until the ray is opaque.
+    fn parts(
+        &self,
+        march: &mut RayMarch,
+        split: &Split<'_>,
+        (from, to): (f32, f32),
+        hits: &[Hit],
+        out: &mut PixelOut,
+        mut walk: impl FnMut(&mut RayMarch, &mut PixelOut),
+    ) {
+        let mut previous = march.clone();
+        let mut start = from;
+        let ends = hits.iter().map(|h| (h.t_mm, Some(h))).chain([(to, None)]);
+        for (end, hit) in ends {
+            let end = end.clamp(start, to);
+            let mut part = previous.part(split.ray, (start, end), split.bricks);
+            walk(&mut part, out);
+            add_stats(&mut march.stats, &part.stats);
+            if out.terminated {
+                return;
+            }
+            if let Some(hit) = hit {
+                add_hit(self, &mut out.accum, hit, split.dir);
+            }
+            previous = part;
+            start = end;
+        }
+    }
+}
+
+/// `hits[..in_front]`, then the volume's result `out`, then the rest of `hits`; the depth the
+/// nearest of the volume's and the first hit's.
+fn around(
+    integrator: &Integrator<'_>,
+    out: &PixelOut,
+    hits: &[Hit],
+    in_front: usize,
+    dir: Vec3,
+) -> PixelOut {
+    let mut joined = PixelOut {
+        accum: Accum::default(),
+        ..*out
+    };
+    for hit in &hits[..in_front] {
+        add_hit(integrator, &mut joined.accum, hit, dir);
+    }
+    let volume = out.accum;
+    joined.accum.under(volume.rgb, 0.0);
+    joined.accum.transmittance *= volume.transmittance;
+    for hit in &hits[in_front..] {
+        add_hit(integrator, &mut joined.accum, hit, dir);
+    }
+    joined.depth_mm = nearest(out.depth_mm, hits[0].t_mm);
+    joined
+}
+
+/// The nearer of a volume depth (NaN: none) and a hit's distance.
+fn nearest(depth_mm: f32, hit_mm: f32) -> f32 {
+    if depth_mm <= hit_mm {
+        depth_mm
+    } else {
+        hit_mm
+    }
+}
+
+/// Composites the shaded surface of `hit`, seen along unit world `dir`, under `accum`.
+fn add_hit(integrator: &Integrator<'_>, accum: &mut Accum, hit: &Hit, dir: Vec3) {
+    let lit = integrator.shader.shade(hit.color, hit.normal, dir);
+    accum.under(Vec3A::from(lit) * hit.opacity, hit.opacity);
+}
+
+/// Adds a part's counters to the ray's.
+fn add_stats(total: &mut MarchStats, part: &MarchStats) {
+    total.samples += part.samples;
+    total.bricks_visited += part.bricks_visited;
+    total.bricks_skipped += part.bricks_skipped;
+}

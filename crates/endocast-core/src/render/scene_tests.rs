@@ -1,0 +1,342 @@
+//! Geometry in the volume (issue 19) against analytic answers: a plane through the sphere
+//! phantom meets its wall on the circle where it should (pinhole and fisheye), an opaque mesh
+//! hides the wall exactly where it covers it at the ray–triangle distance, a translucent
+//! sphere half inside tissue composites as a brute-force per-ray reference does, and the
+//! endoscope's instruments appear where their geometry says.
+
+use super::*;
+use crate::camera::Projection;
+use crate::phantom::{self, PhantomOptions, SphereShell};
+use crate::scene::{Endoscope, GridPlane, Marker, Material, Scene, TriangleMesh};
+use glam::{DVec3, Vec3A};
+
+/// The phantoms' air/tissue boundary value.
+const WALL_HU: f64 = -480.0;
+const SIZE: usize = 48;
+
+fn shell() -> (Arc<Renderer>, SphereShell) {
+    let (volume, shell) = phantom::sphere_shell(&PhantomOptions {
+        size: SIZE,
+        ..Default::default()
+    });
+    (Arc::new(Renderer::new(volume)), shell)
+}
+
+fn settings(mode: Mode) -> RenderSettings {
+    RenderSettings {
+        mode,
+        iso_hu: WALL_HU,
+        ..Default::default()
+    }
+}
+
+/// A camera at the shell's centre (1 mm voxels at the origin's grid) looking along +z.
+fn camera_at_centre(centre: DVec3, px: usize) -> Camera {
+    Camera::look_at(centre, centre + DVec3::Z, DVec3::Y, 90.0, [px, px]).unwrap()
+}
+
+fn render(renderer: &Arc<Renderer>, mode: Mode, scene: Option<Scene>, camera: &Camera) -> Frame {
+    let mut prepared = renderer.prepare(&settings(mode)).unwrap();
+    prepared.set_scene(scene.map(Arc::new));
+    prepared.render(camera)
+}
+
+/// How far pixel `(x, y)`'s centre lies from the image centre, pixels.
+fn radius_px(x: usize, y: usize, px: usize) -> f64 {
+    let c = px as f64 / 2.0;
+    (x as f64 + 0.5 - c).hypot(y as f64 + 0.5 - c)
+}
+
+/// A plane (a grid whose lines fill it) `d` mm ahead of the eye at the shell's centre: inside
+/// the circle where it meets the wall the plane is nearer, outside it the wall. Every pixel
+/// more than half a pixel from that circle's image shows the right one.
+fn check_plane_circle(projection: Projection, field: f64) {
+    let (renderer, shell) = shell();
+    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
+    let px = 96;
+    let camera = camera_at_centre(centre, px)
+        .with_projection(projection, field)
+        .unwrap();
+    let d = 0.5 * shell.inner_radius_vox;
+    let plane = GridPlane::new(centre + DVec3::Z * d, DVec3::Z, 4.0)
+        .unwrap()
+        .with_spacing(4.0, 4.0)
+        .unwrap();
+    let mut scene = Scene::new();
+    scene.add_grid(plane, Material::GRID);
+    let frame = render(&renderer, Mode::Iso, Some(scene), &camera);
+    // The wall's own radius as the renderer finds it (within 0.05 voxel of the truth).
+    let plain = render(&renderer, Mode::Iso, None, &camera);
+    let wall = f64::from(plain.depth_mm[px / 2 + px * (px / 2)]);
+    assert!((wall - shell.inner_radius_vox).abs() < 0.05);
+    let rho = (wall * wall - d * d).sqrt();
+    let (cx, cy) = camera.project(centre + DVec3::new(rho, 0.0, d)).unwrap();
+    let circle = (cx - px as f64 / 2.0).hypot(cy - px as f64 / 2.0);
+    let mut checked = 0;
+    for y in 0..px {
+        for x in 0..px {
+            let Some(ray) = camera.pixel_ray(x, y) else {
+                continue;
+            };
+            let r = radius_px(x, y, px);
+            let depth = f64::from(frame.depth_mm[x + px * y]);
+            let on_plane = d / ray.dir.dot(DVec3::Z);
+            if r < circle - 0.5 {
+                assert!(
+                    (depth - on_plane).abs() < 1e-3,
+                    "({x},{y}) r {r}: {depth} vs {on_plane}"
+                );
+                checked += 1;
+            } else if r > circle + 0.5 {
+                assert!(
+                    (depth - wall).abs() < 0.06,
+                    "({x},{y}) r {r} circle {circle}: {depth}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > px * px / 2, "{checked}");
+}
+
+#[test]
+fn a_plane_through_the_sphere_meets_the_wall_on_the_analytic_circle() {
+    check_plane_circle(Projection::Pinhole, 90.0);
+    check_plane_circle(Projection::Equidistant, 170.0);
+}
+
+/// The Möller–Trumbore distance in f64, the reference.
+fn ray_triangle(o: DVec3, d: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (b - a, c - a);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    let s = o - a;
+    let u = s.dot(p) / det;
+    let q = s.cross(e1);
+    let v = d.dot(q) / det;
+    let t = e2.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0).then_some(t)
+}
+
+#[test]
+fn an_opaque_mesh_hides_the_wall_exactly_where_it_covers_it() {
+    let (renderer, shell) = shell();
+    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
+    let px = 64;
+    let camera = camera_at_centre(centre, px);
+    // A tilted triangle in front of the wall, covering part of the view.
+    let corners = [
+        centre + DVec3::new(-3.0, -4.0, 6.0),
+        centre + DVec3::new(7.0, -1.0, 9.0),
+        centre + DVec3::new(-1.0, 6.0, 12.0),
+    ];
+    let mesh = TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2]]).unwrap();
+    for mode in [Mode::Iso, Mode::Dvr, Mode::Hybrid] {
+        let mut scene = Scene::new();
+        scene.add_mesh(mesh.clone(), Material::MESH);
+        let with = render(&renderer, mode, Some(scene), &camera);
+        let without = render(&renderer, mode, None, &camera);
+        let mut covered = 0;
+        for y in 0..px {
+            for x in 0..px {
+                let i = x + px * y;
+                let ray = camera.pixel_ray(x, y).unwrap();
+                match ray_triangle(ray.origin, ray.dir, corners) {
+                    Some(t) => {
+                        covered += 1;
+                        let depth = f64::from(with.depth_mm[i]);
+                        assert!(
+                            (depth - t).abs() < 1e-4,
+                            "{mode:?} ({x},{y}) {depth} vs {t}"
+                        );
+                        assert_eq!(with.color[i].transmittance, 0.0);
+                    }
+                    None => {
+                        assert_eq!(with.color[i], without.color[i], "{mode:?} ({x},{y})");
+                        let (a, b) = (with.depth_mm[i], without.depth_mm[i]);
+                        assert!(a == b || a.is_nan() && b.is_nan());
+                    }
+                }
+            }
+        }
+        assert!(covered > 200, "{covered}");
+    }
+}
+
+/// A translucent sphere centred on the wall (half in air, half in tissue) over DVR with a
+/// transfer function that leaves tissue translucent: each pixel equals compositing the same
+/// samples and the sphere's two surfaces, merged by distance, one at a time.
+#[test]
+fn a_translucent_sphere_half_inside_tissue_composites_in_depth_order() {
+    let (renderer, shell) = shell();
+    let g = *renderer.volume().geometry();
+    let centre = g.world_of(shell.centre_vox);
+    let px = 40;
+    let camera = camera_at_centre(centre, px);
+    let on_wall = centre + DVec3::Z * shell.inner_radius_vox;
+    let marker = Marker::new(on_wall, 6.0).unwrap();
+    let glass = Material::new([0.1, 0.9, 0.3], 0.4).unwrap();
+    let mut s = settings(Mode::Dvr);
+    s.tf = TransferFunction::ramp(-700.0, 400.0);
+    s.early_termination = 1.0;
+    let mut prepared = renderer.prepare(&s).unwrap();
+    let mut scene = Scene::new();
+    scene.add_marker(marker, glass);
+    prepared.set_scene(Some(Arc::new(scene)));
+    let frame = prepared.render(&camera);
+    let sampler = Sampler::new(renderer.volume());
+    let shader = Shader::new(g.world_from_voxel().matrix3, s.lighting);
+    let (mut inside, mut worst) = (0, 0.0f32);
+    for y in 0..px {
+        for x in 0..px {
+            let trace = prepared.trace_pixel(&camera, x, y);
+            let (Some(vray), Some((t0, t1))) = (trace.ray, trace.range_mm) else {
+                continue;
+            };
+            let ray = camera.pixel_ray(x, y).unwrap();
+            let grid = SampleGrid {
+                origin: vray.origin.as_vec3(),
+                direction: vray.direction.as_vec3(),
+                t_start: t0 as f32,
+                offset: trace.offset,
+                step: trace.step_mm as f32,
+            };
+            // Events: (t, premultiplied rgb, alpha).
+            let mut events: Vec<(f32, Vec3A, f32)> = Vec::new();
+            let mut n = 0;
+            while grid.t_of(n) < t1 as f32 {
+                let e = prepared
+                    .table()
+                    .lookup(sampler.value(grid.at(grid.t_of(n))));
+                events.push((grid.t_of(n), Vec3A::from_vec4(e), e.w));
+                n += 1;
+            }
+            if let Some((a, b)) = marker.crossings(ray.origin, ray.dir) {
+                inside += 1;
+                for t in [a, b] {
+                    let normal = ((ray.at(t) - on_wall) / 6.0).as_vec3();
+                    let lit = shader.shade(Vec3::from(glass.color), normal, ray.dir.as_vec3());
+                    events.push((t as f32, Vec3A::from(lit) * 0.4, 0.4));
+                }
+            }
+            events.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut acc = Accum::default();
+            for (_, rgb, alpha) in events {
+                acc.under(rgb, alpha);
+            }
+            let got = frame.color[x + px * y];
+            for c in 0..3 {
+                worst = worst.max((got.rgb[c] - acc.rgb[c]).abs());
+            }
+            worst = worst.max((got.transmittance - acc.transmittance).abs());
+        }
+    }
+    assert!(inside > 50, "{inside}");
+    assert!(
+        worst < 1e-4,
+        "largest difference from the reference {worst}"
+    );
+}
+
+#[test]
+fn the_instruments_appear_where_their_geometry_says_in_a_fisheye_view() {
+    let (renderer, shell) = shell();
+    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
+    let px = 80;
+    let camera = camera_at_centre(centre, px)
+        .with_projection(Projection::Equidistant, 170.0)
+        .unwrap();
+    let endoscope = Endoscope::new(2.0, 8.0)
+        .unwrap()
+        .with_second_instrument(true);
+    let mut scene = Scene::new();
+    scene.set_endoscope(Some(endoscope));
+    let frame = render(&renderer, Mode::Iso, Some(scene), &camera);
+    let axes = [camera.forward(), camera.right(), camera.up()];
+    for rod in endoscope.instruments(camera.eye_mm(), axes) {
+        // The middle of the shaft's side facing the eye, and a point just beside the rod.
+        let mid = 0.5 * (rod.a + rod.b);
+        let towards_axis = (camera.eye_mm() + camera.forward() * 4.0 - mid).normalize();
+        let side = mid + towards_axis * rod.radius;
+        let (x, y) = camera.project(side + towards_axis * 0.05).unwrap();
+        let i = x as usize + px * y as usize;
+        let depth = f64::from(frame.depth_mm[i]);
+        let expected = (side - camera.eye_mm()).length();
+        assert!((depth - expected).abs() < 0.5, "{depth} vs {expected}");
+        let tip = rod.b + camera.forward() * rod.radius;
+        let (x, y) = camera.project(tip).unwrap();
+        let i = x as usize + px * y as usize;
+        assert!(f64::from(frame.depth_mm[i]) < (tip - camera.eye_mm()).length() + 0.3);
+    }
+    // Straight up nothing is in the way: the wall.
+    let (x, y) = camera.project(centre + DVec3::new(0.0, 5.0, 5.0)).unwrap();
+    let up = f64::from(frame.depth_mm[x as usize + px * y as usize]);
+    assert!((up - shell.inner_radius_vox).abs() < 0.1, "{up}");
+}
+
+/// `endocast mesh` on the colon phantom: the lumen's surface is closed (every edge shared by
+/// two triangles), every vertex lies within 0.1 voxel of the isosurface, and drawn as a mesh
+/// (over a volume made invisible) it lies where iso mode finds the wall: depth within 0.2 voxel
+/// at 99 % of the pixels (a handful of pixels at thin folds differ by more; not yet explained).
+#[test]
+fn the_colon_mesh_is_watertight_on_the_isosurface_and_drawn_where_the_wall_is() {
+    use crate::isosurface::lumen_surface;
+    use crate::navigate::{Lumen, LumenSide};
+    let (volume, colon) = phantom::colon(&PhantomOptions {
+        size: 192,
+        ..Default::default()
+    });
+    let line = &colon.centreline;
+    let s = 0.4 * line.length_vox();
+    let (eye_vox, ahead) = (line.point_at(s), line.tangent_at(s));
+    let seed = eye_vox.round();
+    let seed = [seed.x as usize, seed.y as usize, seed.z as usize];
+    let lumen = Lumen::from_seed(&volume, seed, WALL_HU, LumenSide::Below).unwrap();
+    let mesh = lumen_surface(&volume, &lumen).unwrap();
+    assert_eq!(mesh.open_edges(), 0);
+    let g = *volume.geometry();
+    let value = |p: DVec3| volume.sample_physical(p).unwrap_or(f64::NAN);
+    let mut worst = 0.0f64;
+    for v in mesh.vertices() {
+        let p = g.voxel_from_world().transform_point3(*v);
+        let h = 0.25;
+        let grad = DVec3::new(
+            value(p + DVec3::X * h) - value(p - DVec3::X * h),
+            value(p + DVec3::Y * h) - value(p - DVec3::Y * h),
+            value(p + DVec3::Z * h) - value(p - DVec3::Z * h),
+        ) / (2.0 * h);
+        let off = (value(p) - WALL_HU).abs() / grad.length();
+        if off.is_finite() {
+            worst = worst.max(off);
+        }
+    }
+    assert!(
+        worst < 0.1,
+        "a vertex lies {worst} voxel off the isosurface"
+    );
+    let renderer = Arc::new(Renderer::new(volume));
+    let eye = g.world_of(eye_vox);
+    let camera = Camera::look_at(eye, g.world_of(eye_vox + ahead), DVec3::Z, 90.0, [64, 64]);
+    let camera = camera.unwrap();
+    let wall = render(&renderer, Mode::Iso, None, &camera);
+    let mut invisible = settings(Mode::Dvr);
+    invisible.tf = TransferFunction::ramp(5000.0, 6000.0);
+    let mut prepared = renderer.prepare(&invisible).unwrap();
+    let mut scene = Scene::new();
+    scene.add_mesh(mesh, Material::MESH);
+    prepared.set_scene(Some(Arc::new(scene)));
+    let drawn = prepared.render(&camera);
+    let (mut compared, mut off) = (0, 0);
+    for (a, b) in drawn.depth_mm.iter().zip(&wall.depth_mm) {
+        assert_eq!(a.is_nan(), b.is_nan());
+        if !b.is_nan() {
+            compared += 1;
+            off += usize::from((a - b).abs() >= 0.2);
+        }
+    }
+    assert!(compared > 3000, "{compared}");
+    assert!(
+        off * 100 <= compared,
+        "{off} of {compared} pixels off by 0.2 voxel or more"
+    );
+}

@@ -1,0 +1,422 @@
+//! A bounding-volume hierarchy over a mesh's triangles: binned surface-area-heuristic build
+//! (12 bins, leaves of up to four triangles), flat nodes, a stack traversal nearer child first.
+//!
+//! Our own rather than a crate's: the tracer needs *every* hit along a ray up to a distance
+//! that shrinks as opaque hits are found (translucent meshes are composited in depth order),
+//! in `f32` on precomputed triangle edges. The `bvh` crate answers "which shapes' boxes does
+//! the ray meet" (the nearest hit, let alone all hits, is left to the caller) and brings
+//! nalgebra with it; this file is about 250 lines.
+
+use super::mesh::TriangleMesh;
+use glam::Vec3;
+
+/// Triangles per leaf at most.
+const LEAF_SIZE: usize = 4;
+/// Bins of the surface-area heuristic per split.
+const BINS: usize = 12;
+/// How far outside a triangle (in barycentric units) a hit still counts: rays through a shared
+/// edge or corner then meet at least one of the triangles around it in `f32` (no cracks in a
+/// closed mesh), at the price of a rare double hit there.
+const EDGE_SLACK: f32 = 1e-5;
+/// Cost of a node visit against one triangle test, in the heuristic.
+const TRAVERSAL_COST: f32 = 1.0;
+
+/// A box, world mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Aabb {
+    lo: Vec3,
+    hi: Vec3,
+}
+
+impl Aabb {
+    const EMPTY: Self = Self {
+        lo: Vec3::splat(f32::INFINITY),
+        hi: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    fn grow(&mut self, p: Vec3) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+
+    fn union(self, other: Self) -> Self {
+        Self {
+            lo: self.lo.min(other.lo),
+            hi: self.hi.max(other.hi),
+        }
+    }
+
+    fn half_area(&self) -> f32 {
+        let d = (self.hi - self.lo).max(Vec3::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+
+    /// Where the ray enters the box, if it meets it within `(t_min, t_max)`.
+    #[inline]
+    fn entry(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
+        let a = (self.lo - origin) * inv_dir;
+        let b = (self.hi - origin) * inv_dir;
+        let near = a.min(b).max_element().max(t_min);
+        let far = a.max(b).min_element().min(t_max);
+        (near <= far).then_some(near)
+    }
+}
+
+/// A node: its box, and either two children (`count == 0`: the left child is `index`, the
+/// right one `index + 1`) or a leaf of `count` triangles from `index` on.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    bounds: Aabb,
+    index: u32,
+    count: u32,
+}
+
+/// A triangle ready for the Möller–Trumbore test: a corner and the two edges from it.
+#[derive(Debug, Clone, Copy)]
+struct Tri {
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+}
+
+impl Tri {
+    /// The distance along the ray to the triangle, if it lies in `(t_min, t_max)`.
+    #[inline]
+    fn hit(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
+        let p = dir.cross(self.e2);
+        let det = self.e1.dot(p);
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let s = origin - self.v0;
+        let u = s.dot(p) * inv;
+        if !(-EDGE_SLACK..=1.0 + EDGE_SLACK).contains(&u) {
+            return None;
+        }
+        let q = s.cross(self.e1);
+        let v = dir.dot(q) * inv;
+        if v < -EDGE_SLACK || u + v > 1.0 + EDGE_SLACK {
+            return None;
+        }
+        let t = self.e2.dot(q) * inv;
+        (t > t_min && t < t_max).then_some(t)
+    }
+}
+
+/// The hierarchy over one mesh (triangles reordered; the original index kept).
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    tris: Vec<Tri>,
+    /// Original triangle index of each reordered triangle.
+    order: Vec<u32>,
+}
+
+impl Bvh {
+    /// Builds the hierarchy over `mesh`'s triangles.
+    pub fn new(mesh: &TriangleMesh) -> Self {
+        let n = mesh.triangles().len();
+        let corners: Vec<[Vec3; 3]> = (0..n)
+            .map(|i| mesh.corners(i).map(|c| c.as_vec3()))
+            .collect();
+        let centroids: Vec<Vec3> = corners.iter().map(|c| (c[0] + c[1] + c[2]) / 3.0).collect();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * n.div_ceil(LEAF_SIZE));
+        nodes.push(Node {
+            bounds: Aabb::EMPTY,
+            index: 0,
+            count: 0,
+        });
+        let mut builder = Builder {
+            corners: &corners,
+            centroids: &centroids,
+            order: &mut order,
+            nodes: &mut nodes,
+        };
+        builder.build(0, 0, n);
+        let tris = order
+            .iter()
+            .map(|&i| {
+                let [a, b, c] = corners[i as usize];
+                Tri {
+                    v0: a,
+                    e1: b - a,
+                    e2: c - a,
+                }
+            })
+            .collect();
+        Self { nodes, tris, order }
+    }
+
+    /// Calls `on_hit(t, triangle)` for every triangle the ray `origin + t·dir` meets with
+    /// `t_min < t < t_max`, nearer subtrees first; `on_hit` returns the new `t_max` (return the
+    /// hit's `t` to look only for nearer hits, or the old bound to collect every hit).
+    pub fn traverse(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        mut t_max: f32,
+        mut on_hit: impl FnMut(f32, u32) -> f32,
+    ) {
+        let inv_dir = dir.recip();
+        let mut stack = [0u32; 64];
+        let mut top = 0usize;
+        let mut node = 0usize;
+        if self.nodes[0]
+            .bounds
+            .entry(origin, inv_dir, t_min, t_max)
+            .is_none()
+        {
+            return;
+        }
+        loop {
+            let n = self.nodes[node];
+            if n.count > 0 {
+                let first = n.index as usize;
+                for k in first..first + n.count as usize {
+                    if let Some(t) = self.tris[k].hit(origin, dir, t_min, t_max) {
+                        t_max = on_hit(t, self.order[k]);
+                    }
+                }
+            } else {
+                let (l, r) = (n.index as usize, n.index as usize + 1);
+                let tl = self.nodes[l].bounds.entry(origin, inv_dir, t_min, t_max);
+                let tr = self.nodes[r].bounds.entry(origin, inv_dir, t_min, t_max);
+                match (tl, tr) {
+                    (Some(a), Some(b)) => {
+                        let (near, far) = if a <= b { (l, r) } else { (r, l) };
+                        if top < stack.len() {
+                            stack[top] = far as u32;
+                            top += 1;
+                        }
+                        node = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        node = l;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        node = r;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            }
+            // Pop the next subtree still in reach.
+            loop {
+                if top == 0 {
+                    return;
+                }
+                top -= 1;
+                let next = stack[top] as usize;
+                if self.nodes[next]
+                    .bounds
+                    .entry(origin, inv_dir, t_min, t_max)
+                    .is_some()
+                {
+                    node = next;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// The nearest hit in `(t_min, t_max)`: distance and triangle.
+    pub fn nearest(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
+        let mut best = None;
+        self.traverse(origin, dir, t_min, t_max, |t, tri| {
+            best = Some((t, tri));
+            t
+        });
+        best
+    }
+
+    /// The geometric unit normal of (original) triangle `tri` (right-handed corner order).
+    pub fn normal(&self, mesh: &TriangleMesh, tri: u32) -> Vec3 {
+        let [a, b, c] = mesh.corners(tri as usize);
+        (b - a).cross(c - a).normalize_or_zero().as_vec3()
+    }
+}
+
+/// The recursive build's shared state.
+struct Builder<'a> {
+    corners: &'a [[Vec3; 3]],
+    centroids: &'a [Vec3],
+    order: &'a mut [u32],
+    nodes: &'a mut Vec<Node>,
+}
+
+impl Builder<'_> {
+    fn bounds(&self, first: usize, end: usize) -> (Aabb, Aabb) {
+        let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
+        for &i in &self.order[first..end] {
+            for p in self.corners[i as usize] {
+                b.grow(p);
+            }
+            c.grow(self.centroids[i as usize]);
+        }
+        (b, c)
+    }
+
+    /// Fills node `node` with triangles `first..end` of the order (depth-first; an explicit
+    /// depth is not needed: SAH splits of up to millions of triangles stay far below the
+    /// traversal's stack of 64).
+    fn build(&mut self, node: usize, first: usize, end: usize) {
+        let (bounds, centres) = self.bounds(first, end);
+        self.nodes[node].bounds = bounds;
+        let count = end - first;
+        let split = if count <= LEAF_SIZE {
+            None
+        } else {
+            self.best_split(first, end, &bounds, &centres)
+        };
+        let Some((axis, position)) = split else {
+            self.nodes[node].index = first as u32;
+            self.nodes[node].count = count as u32;
+            return;
+        };
+        let centroids = self.centroids;
+        let slice = &mut self.order[first..end];
+        let mut mid = 0;
+        for k in 0..slice.len() {
+            if centroids[slice[k] as usize][axis] < position {
+                slice.swap(k, mid);
+                mid += 1;
+            }
+        }
+        if mid == 0 || mid == count {
+            mid = count / 2;
+        }
+        let left = self.nodes.len();
+        let empty = Node {
+            bounds: Aabb::EMPTY,
+            index: 0,
+            count: 0,
+        };
+        self.nodes.extend([empty, empty]);
+        self.nodes[node].index = left as u32;
+        self.nodes[node].count = 0;
+        self.build(left, first, first + mid);
+        self.build(left + 1, first + mid, end);
+    }
+
+    /// The axis and position of the cheapest binned split, or `None` when a leaf is cheaper.
+    fn best_split(
+        &self,
+        first: usize,
+        end: usize,
+        bounds: &Aabb,
+        centres: &Aabb,
+    ) -> Option<(usize, f32)> {
+        let mut best: Option<(f32, usize, f32)> = None;
+        for axis in 0..3 {
+            let (lo, hi) = (centres.lo[axis], centres.hi[axis]);
+            if hi <= lo || hi.is_nan() || lo.is_nan() {
+                continue;
+            }
+            let scale = BINS as f32 / (hi - lo);
+            let mut boxes = [Aabb::EMPTY; BINS];
+            let mut counts = [0usize; BINS];
+            for &i in &self.order[first..end] {
+                let c = self.centroids[i as usize][axis];
+                let b = (((c - lo) * scale) as usize).min(BINS - 1);
+                counts[b] += 1;
+                for p in self.corners[i as usize] {
+                    boxes[b].grow(p);
+                }
+            }
+            // Sweep from the right, then from the left.
+            let mut right_area = [0.0f32; BINS];
+            let (mut acc, mut n) = (Aabb::EMPTY, 0);
+            let mut right_count = [0usize; BINS];
+            for b in (1..BINS).rev() {
+                acc = acc.union(boxes[b]);
+                n += counts[b];
+                right_area[b] = acc.half_area();
+                right_count[b] = n;
+            }
+            let (mut acc, mut n) = (Aabb::EMPTY, 0);
+            for b in 0..BINS - 1 {
+                acc = acc.union(boxes[b]);
+                n += counts[b];
+                let (nr, ar) = (right_count[b + 1], right_area[b + 1]);
+                if n == 0 || nr == 0 {
+                    continue;
+                }
+                let cost = acc.half_area() * n as f32 + ar * nr as f32;
+                if best.is_none_or(|(c, _, _)| cost < c) {
+                    best = Some((cost, axis, lo + (b + 1) as f32 / scale));
+                }
+            }
+        }
+        let (cost, axis, position) = best?;
+        let leaf = (end - first) as f32 * bounds.half_area();
+        (cost + TRAVERSAL_COST * bounds.half_area() < leaf).then_some((axis, position))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// Splitmix64 in [0, 1).
+    fn random(state: &mut u64) -> f64 {
+        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn every_hit_equals_brute_force() {
+        let mut s = 11;
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for k in 0..500u32 {
+            let c = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) * 40.0;
+            for _ in 0..3 {
+                let d = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) - 0.5;
+                vertices.push(c + d * 6.0);
+            }
+            triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        let mesh = TriangleMesh::new(vertices, triangles).unwrap();
+        let bvh = Bvh::new(&mesh);
+        let tris: Vec<Tri> = (0..mesh.triangles().len())
+            .map(|i| {
+                let [a, b, c] = mesh.corners(i).map(|p| p.as_vec3());
+                Tri {
+                    v0: a,
+                    e1: b - a,
+                    e2: c - a,
+                }
+            })
+            .collect();
+        for _ in 0..300 {
+            let o = (DVec3::new(random(&mut s), random(&mut s), random(&mut s)) * 60.0 - 10.0)
+                .as_vec3();
+            let d = (DVec3::new(random(&mut s), random(&mut s), random(&mut s)) - 0.5)
+                .normalize()
+                .as_vec3();
+            let mut expected: Vec<(f32, u32)> = tris
+                .iter()
+                .enumerate()
+                .filter_map(|(i, t)| t.hit(o, d, 0.0, 1e9).map(|t| (t, i as u32)))
+                .collect();
+            expected.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut all = Vec::new();
+            bvh.traverse(o, d, 0.0, 1e9, |t, i| {
+                all.push((t, i));
+                1e9
+            });
+            all.sort_by(|a, b| a.0.total_cmp(&b.0));
+            assert_eq!(all, expected);
+            assert_eq!(bvh.nearest(o, d, 0.0, 1e9), expected.first().copied());
+        }
+    }
+}

@@ -1,0 +1,313 @@
+//! Geometry in the volume: triangle meshes, a grid of lines, marker spheres and an endoscope's
+//! instruments, each with a colour and an opacity, placed in world millimetres (LPS), and
+//! traced per ray so that they work with every projection.
+//!
+//! A [`Scene`] holds the objects; [`Scene::placed`] fixes the camera-bound ones (the
+//! instruments) for one camera, and [`PlacedScene::trace`] lists what a ray meets in depth
+//! order: every translucent surface in front of the nearest opaque one, then that one. The
+//! renderer ends the volume ray at the opaque hit (Scharsach et al. 2006, §3.4: the ray length
+//! image) and composites the translucent ones between the volume samples in their true order.
+//!
+//! ```
+//! use endocast_core::scene::{GridPlane, Material, Marker, Scene};
+//! use endocast_core::camera::Ray;
+//! use glam::DVec3;
+//!
+//! let mut scene = Scene::new();
+//! scene.add_grid(GridPlane::new(DVec3::ZERO, DVec3::Z, 10.0).unwrap(), Material::GRID);
+//! let glass = Material::new([0.2, 0.6, 1.0], 0.5).unwrap();
+//! scene.add_marker(Marker::new(DVec3::new(0.0, 0.0, 20.0), 5.0).unwrap(), glass);
+//! let ray = Ray { origin: DVec3::new(0.0, 0.0, 40.0), dir: -DVec3::Z };
+//! let mut hits = Vec::new();
+//! scene.trace(&ray, 0.0, f64::INFINITY, &mut hits);
+//! // Into and out of the glass sphere, then the opaque grid line at z = 0.
+//! let depths: Vec<f32> = hits.iter().map(|h| h.t_mm).collect();
+//! assert_eq!(depths, [15.0, 25.0, 40.0]);
+//! ```
+
+mod aids;
+pub mod bvh;
+mod mesh;
+
+pub use aids::{Capsule, Endoscope, GridPlane, Marker, DEFAULT_INSTRUMENT_LENGTH_MM};
+pub use mesh::{MeshError, TriangleMesh};
+
+use crate::camera::{Camera, Ray};
+use bvh::Bvh;
+use glam::{DVec3, Vec3};
+use std::sync::Arc;
+use thiserror::Error;
+
+/// A scene object that cannot be made.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// A colour channel outside 0–1 or an opacity outside 0–1.
+    #[error("colour {0:?} and opacity {1} must lie in 0–1")]
+    BadMaterial([f32; 3], f32),
+    /// A grid's origin, normal, spacing or line width is unusable.
+    #[error("grid: {0}")]
+    BadGrid(String),
+    /// A marker's centre is not finite or its radius not positive.
+    #[error("marker at {0:?} of radius {1} mm: the centre must be finite, the radius positive")]
+    BadMarker([f64; 3], f64),
+    /// An endoscope's diameter or length is not positive.
+    #[error("endoscope of diameter {0} mm and length {1} mm: both must be positive")]
+    BadEndoscope(f64, f64),
+}
+
+/// How a surface looks: its colour (before shading, linear 0–1) and opacity (1: opaque).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    /// Colour, 0–1 per channel.
+    pub color: [f32; 3],
+    /// Opacity, 0–1.
+    pub opacity: f32,
+}
+
+impl Material {
+    /// Opaque white lines: the grid's default.
+    pub const GRID: Self = Self {
+        color: [1.0, 1.0, 1.0],
+        opacity: 1.0,
+    };
+    /// Opaque yellow: a marker's default.
+    pub const MARKER: Self = Self {
+        color: [1.0, 0.85, 0.1],
+        opacity: 1.0,
+    };
+    /// Opaque light blue: a mesh's default.
+    pub const MESH: Self = Self {
+        color: [0.55, 0.75, 1.0],
+        opacity: 1.0,
+    };
+    /// Brushed steel: the instruments.
+    pub const STEEL: Self = Self {
+        color: [0.72, 0.74, 0.78],
+        opacity: 1.0,
+    };
+
+    /// A material, every channel and the opacity in 0–1.
+    pub fn new(color: [f32; 3], opacity: f32) -> Result<Self, SceneError> {
+        let unit = |v: f32| (0.0..=1.0).contains(&v);
+        if !color.iter().all(|&c| unit(c)) || !unit(opacity) {
+            return Err(SceneError::BadMaterial(color, opacity));
+        }
+        Ok(Self { color, opacity })
+    }
+
+    /// Whether nothing behind it shows.
+    pub fn is_opaque(&self) -> bool {
+        self.opacity >= 1.0
+    }
+}
+
+/// Where a ray meets a surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Distance from the ray's start, mm.
+    pub t_mm: f32,
+    /// Unit world normal of the surface (either side).
+    pub normal: Vec3,
+    /// Colour before shading.
+    pub color: Vec3,
+    /// Opacity, 0–1.
+    pub opacity: f32,
+}
+
+/// A mesh with its hierarchy, shared between copies of a scene.
+#[derive(Debug)]
+struct TracedMesh {
+    mesh: TriangleMesh,
+    bvh: Bvh,
+}
+
+#[derive(Debug, Clone)]
+enum Shape {
+    Mesh(Arc<TracedMesh>),
+    Grid(GridPlane),
+    Marker(Marker),
+}
+
+#[derive(Debug, Clone)]
+struct Object {
+    shape: Shape,
+    material: Material,
+}
+
+/// Geometry to draw in the volume (cheap to clone: meshes are shared).
+#[derive(Debug, Clone, Default)]
+pub struct Scene {
+    objects: Vec<Object>,
+    endoscope: Option<Endoscope>,
+}
+
+impl Scene {
+    /// An empty scene.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether the scene draws nothing.
+    pub fn is_empty(&self) -> bool {
+        self.endoscope.is_none() && self.objects.iter().all(|o| o.material.opacity <= 0.0)
+    }
+
+    /// Adds a mesh (its hierarchy is built here: about a second per million triangles).
+    pub fn add_mesh(&mut self, mesh: TriangleMesh, material: Material) {
+        let bvh = Bvh::new(&mesh);
+        let shape = Shape::Mesh(Arc::new(TracedMesh { mesh, bvh }));
+        self.objects.push(Object { shape, material });
+    }
+
+    /// Adds a grid of lines.
+    pub fn add_grid(&mut self, grid: GridPlane, material: Material) {
+        let shape = Shape::Grid(grid);
+        self.objects.push(Object { shape, material });
+    }
+
+    /// Adds a marker sphere.
+    pub fn add_marker(&mut self, marker: Marker, material: Material) {
+        let shape = Shape::Marker(marker);
+        self.objects.push(Object { shape, material });
+    }
+
+    /// Shows the instruments of `endoscope` in front of every camera (`None`: no instruments).
+    pub fn set_endoscope(&mut self, endoscope: Option<Endoscope>) {
+        self.endoscope = endoscope;
+    }
+
+    /// The endoscope, if one is shown.
+    pub fn endoscope(&self) -> Option<&Endoscope> {
+        self.endoscope.as_ref()
+    }
+
+    /// The scene as `camera` sees it: the instruments placed in front of it.
+    pub fn placed(&self, camera: &Camera) -> PlacedScene<'_> {
+        let axes = [camera.forward(), camera.right(), camera.up()];
+        let instruments = self
+            .endoscope
+            .map(|e| e.instruments(camera.eye_mm(), axes))
+            .unwrap_or_default();
+        PlacedScene {
+            scene: self,
+            instruments,
+        }
+    }
+
+    /// [`PlacedScene::trace`] for a scene without an endoscope (the instruments need a camera).
+    pub fn trace(&self, ray: &Ray, t_min: f64, t_max: f64, hits: &mut Vec<Hit>) {
+        let placed = PlacedScene {
+            scene: self,
+            instruments: Vec::new(),
+        };
+        placed.trace(ray, t_min, t_max, hits);
+    }
+}
+
+/// A scene with its camera-bound objects placed for one camera.
+#[derive(Debug, Clone)]
+pub struct PlacedScene<'a> {
+    scene: &'a Scene,
+    instruments: Vec<Capsule>,
+}
+
+impl PlacedScene<'_> {
+    /// The surfaces `ray` meets with `t_min < t < t_max` (mm), into `hits` (cleared first) in
+    /// depth order: every translucent one in front of the nearest opaque one, then that one
+    /// (where there is one: then it is the last hit). Surfaces of opacity 0 are left out.
+    pub fn trace(&self, ray: &Ray, t_min: f64, t_max: f64, hits: &mut Vec<Hit>) {
+        hits.clear();
+        let (o, d) = (ray.origin, ray.dir);
+        let mut opaque: Option<Hit> = None;
+        let mut bound = t_max;
+        for capsule in &self.instruments {
+            if let Some(t) = capsule.hit(o, d, t_min, bound) {
+                bound = t;
+                opaque = Some(hit(t, capsule.normal(ray.at(t)), &Material::STEEL));
+            }
+        }
+        let objects = &self.scene.objects;
+        for object in objects.iter().filter(|o| o.material.is_opaque()) {
+            if let Some((t, normal)) = nearest(&object.shape, ray, t_min, bound) {
+                bound = t;
+                opaque = Some(hit(t, normal, &object.material));
+            }
+        }
+        for object in objects
+            .iter()
+            .filter(|o| !o.material.is_opaque() && o.material.opacity > 0.0)
+        {
+            every_hit(&object.shape, ray, t_min, bound, &object.material, hits);
+        }
+        hits.sort_by(|a, b| a.t_mm.total_cmp(&b.t_mm));
+        hits.extend(opaque);
+    }
+}
+
+fn hit(t: f64, normal: DVec3, m: &Material) -> Hit {
+    Hit {
+        t_mm: t as f32,
+        normal: normal.as_vec3(),
+        color: Vec3::from(m.color),
+        opacity: m.opacity,
+    }
+}
+
+/// The nearest hit of `shape` in `(t_min, t_max)`: distance and unit normal.
+fn nearest(shape: &Shape, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64, DVec3)> {
+    let (o, d) = (ray.origin, ray.dir);
+    match shape {
+        Shape::Mesh(m) => {
+            let (t, tri) = m
+                .bvh
+                .nearest(o.as_vec3(), d.as_vec3(), t_min as f32, t_max as f32)?;
+            Some((f64::from(t), m.bvh.normal(&m.mesh, tri).as_dvec3()))
+        }
+        Shape::Grid(g) => g.hit(o, d, t_min, t_max).map(|t| (t, g.normal())),
+        Shape::Marker(s) => {
+            let (t0, t1) = s.crossings(o, d)?;
+            let t = [t0, t1].into_iter().find(|&t| t > t_min && t < t_max)?;
+            Some((t, (ray.at(t) - s.centre_mm) / s.radius_mm))
+        }
+    }
+}
+
+/// Every hit of `shape` in `(t_min, t_max)`, appended to `hits` unsorted.
+fn every_hit(
+    shape: &Shape,
+    ray: &Ray,
+    t_min: f64,
+    t_max: f64,
+    material: &Material,
+    hits: &mut Vec<Hit>,
+) {
+    let (o, d) = (ray.origin, ray.dir);
+    match shape {
+        Shape::Mesh(m) => {
+            m.bvh.traverse(
+                o.as_vec3(),
+                d.as_vec3(),
+                t_min as f32,
+                t_max as f32,
+                |t, tri| {
+                    let normal = m.bvh.normal(&m.mesh, tri).as_dvec3();
+                    hits.push(hit(f64::from(t), normal, material));
+                    t_max as f32
+                },
+            );
+        }
+        Shape::Grid(_) => {
+            if let Some((t, normal)) = nearest(shape, ray, t_min, t_max) {
+                hits.push(hit(t, normal, material));
+            }
+        }
+        Shape::Marker(s) => {
+            if let Some((t0, t1)) = s.crossings(o, d) {
+                for t in [t0, t1].into_iter().filter(|&t| t > t_min && t < t_max) {
+                    hits.push(hit(t, (ray.at(t) - s.centre_mm) / s.radius_mm, material));
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,184 @@
+"""Type stubs of the native module (re-exported by ``endocast``)."""
+
+import os
+import pathlib
+from typing import Literal, Optional, Sequence, Tuple, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+_Vec3 = Tuple[float, float, float]
+_Point = Union[_Vec3, Sequence[float], npt.NDArray[np.floating]]
+_Path = Union[str, "os.PathLike[str]"]
+_Mode = Literal["iso", "dvr", "hybrid", "two-iso", "mip", "minip"]
+_Lens = Literal["pinhole", "equidistant", "equisolid", "orthographic"]
+_Stereo = Literal["anaglyph", "red-cyan", "dubois", "side-by-side", "top-bottom", "pair"]
+
+class EndocastError(ValueError):
+    """An error from endocast; the message is the library's, naming the file and the problem."""
+
+class Volume:
+    """A scan: voxels, their geometry in the patient (LPS mm) and their physical values."""
+
+    @staticmethod
+    def from_array(
+        array: npt.ArrayLike,
+        affine: npt.ArrayLike,
+        space: Literal["RAS", "LPS"] = "RAS",
+        modality: Optional[str] = None,
+    ) -> Volume:
+        """A volume from a 3-D array indexed [i, j, k] and its 4x4 voxel-to-world affine.
+
+        ``space="RAS"`` for nibabel (``img.get_fdata(), img.affine``); ``"LPS"`` for DICOM
+        and SimpleITK (``sitk.GetArrayFromImage(img).T`` with the affine built from
+        ``GetDirection``, ``GetSpacing`` and ``GetOrigin``). Integer arrays of 8 and 16 bits
+        are kept exactly; wider and float arrays exactly when they hold at most 65 536
+        integer values, otherwise quantised to 16 bits (a warning says so)."""
+
+    @property
+    def voxels(self) -> npt.NDArray[np.float32]:
+        """Physical values (HU for CT), read-only float32 (i, j, k), Fortran order; made once."""
+    @property
+    def shape(self) -> Tuple[int, int, int]: ...
+    @property
+    def affine(self) -> npt.NDArray[np.float64]:
+        """4x4 affine from voxel index to LPS mm."""
+    @property
+    def affine_ras(self) -> npt.NDArray[np.float64]:
+        """4x4 affine from voxel index to RAS mm (nibabel's world)."""
+    @property
+    def spacing(self) -> npt.NDArray[np.float64]:
+        """Voxel spacing along i, j, k, mm."""
+    @property
+    def origin(self) -> npt.NDArray[np.float64]:
+        """LPS position of the centre of voxel (0, 0, 0), mm."""
+    @property
+    def modality(self) -> str:
+        """"CT", "MR", another DICOM code, or "unknown"."""
+    @property
+    def warnings(self) -> list[str]:
+        """What the reader noted without stopping."""
+    @property
+    def source(self) -> str:
+        """The format read ("NIfTI", "DICOM", ...), or "array"."""
+    @property
+    def value_range(self) -> Tuple[float, float]: ...
+
+def open(
+    path: _Path,
+    series: Optional[str] = None,
+    *,
+    max_voxels: Optional[int] = None,
+    orientation: Optional[str] = None,
+) -> Volume:
+    """Read a DICOM directory or file, NIfTI, NRRD or MetaImage scan."""
+
+def render(
+    volume: Volume,
+    *,
+    preset: Optional[str] = None,
+    mode: Optional[_Mode] = None,
+    iso: Optional[float] = None,
+    iso2: Optional[float] = None,
+    iso_opacity: Optional[float] = None,
+    tf: Optional[str] = None,
+    step: Optional[float] = None,
+    jitter: bool = False,
+    skip_empty: bool = True,
+    shade_dvr: Optional[bool] = None,
+    background: Optional[_Vec3] = None,
+    eye: Optional[_Point] = None,
+    look_at: Optional[_Point] = None,
+    up: Optional[_Point] = None,
+    fov: Optional[float] = None,
+    near: float = 0.0,
+    size: Tuple[int, int] = (512, 512),
+    lens: Optional[_Lens] = None,
+    distortion: Optional[Tuple[float, float]] = None,
+    vignetting: float = 0.0,
+    stereo: Optional[_Stereo] = None,
+    eye_separation: Optional[float] = None,
+    focus: Optional[float] = None,
+    lumen_threshold: Optional[float] = None,
+    bright_lumen: bool = False,
+    threads: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32]]:
+    """Render one view as ``endocast render`` does: (rgba, depth).
+
+    rgba is uint8 (height, width, 4), the colour over the background with alpha 255; depth is
+    float32 (height, width), mm from the eye to the first isosurface hit, NaN where none.
+    ``size`` is (width, height). ``stereo="pair"`` gives (2, height, width, 4) and
+    (2, height, width). Without ``eye``/``look_at`` the camera is ``default_view``'s."""
+
+def default_view(
+    volume: Volume,
+    *,
+    preset: Optional[str] = None,
+    iso: Optional[float] = None,
+    fov: Optional[float] = None,
+    lumen_threshold: Optional[float] = None,
+    bright_lumen: bool = False,
+) -> Tuple[_Vec3, _Vec3, _Vec3]:
+    """The camera ``render`` uses without ``eye``: (eye, look_at, up), LPS mm."""
+
+def path(
+    volume: Volume,
+    start: Optional[_Point] = None,
+    end: Optional[_Point] = None,
+    *,
+    start_voxel: Optional[_Point] = None,
+    end_voxel: Optional[_Point] = None,
+    preset: Optional[str] = None,
+    iso: Optional[float] = None,
+    lumen_threshold: Optional[float] = None,
+    bright_lumen: bool = False,
+    smoothing: float = 5.0,
+    step: float = 2.0,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The centred path through the lumen as ``endocast path`` writes it: (points, radii).
+
+    points is (N, 3) LPS mm, every ``step`` mm and the end; radii (N,) the distance to the
+    wall, mm. Without ``end`` the path runs to the farthest point of the lumen."""
+
+@overload
+def fly(
+    volume: Volume,
+    route: Union[_Path, npt.ArrayLike],
+    out: None = None,
+    *,
+    preset: Optional[str] = None,
+    mode: Optional[_Mode] = None,
+    iso: Optional[float] = None,
+    iso2: Optional[float] = None,
+    iso_opacity: Optional[float] = None,
+    tf: Optional[str] = None,
+    step: Optional[float] = None,
+    jitter: bool = False,
+    skip_empty: bool = True,
+    shade_dvr: Optional[bool] = None,
+    background: Optional[_Vec3] = None,
+    fov: Optional[float] = None,
+    near: float = 0.0,
+    lens: Optional[_Lens] = None,
+    distortion: Optional[Tuple[float, float]] = None,
+    vignetting: float = 0.0,
+    size: Tuple[int, int] = (384, 384),
+    frame_step: float = 1.0,
+    look_ahead: float = 10.0,
+    fps: float = 25.0,
+    threads: Optional[int] = None,
+) -> npt.NDArray[np.uint8]:
+    """Fly along ``route`` (an (N, 3) array of LPS points or a path file) as ``endocast fly``
+    films the endoscopic view: without ``out`` the frames, RGB uint8 (frames, height, width, 3)."""
+@overload
+def fly(
+    volume: Volume,
+    route: Union[_Path, npt.ArrayLike],
+    out: _Path,
+    **options: object,
+) -> pathlib.Path:
+    """The same flight written to ``out`` (.gif, .mp4 or a folder of PNGs); returns its path."""
+def presets() -> list[str]:
+    """The preset names."""
+def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:
+    """Write an RGB or RGBA uint8 image (height, width, 3 or 4) as an 8-bit PNG."""

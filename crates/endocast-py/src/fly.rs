@@ -1,0 +1,98 @@
+//! `endocast.fly`: a flight along a path, as `endocast fly` films it (the endoscopic view), to
+//! a video file or as frames.
+
+use crate::errors::{error, to_py};
+use crate::kwargs::Kwargs;
+use crate::look::{optics, Look};
+use crate::volume::Volume;
+use endocast_core::flight::{Flight, FlightOptions, Layout, Route, ShotSettings};
+use endocast_core::views::slices::Window;
+use endocast_io::route_file::read_route;
+use endocast_io::transfer_json::transfer_function;
+use endocast_io::video::{open_sink, VideoOptions};
+use glam::DVec3;
+use numpy::ndarray::Array4;
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+
+/// Flies along `route` — an (N, 3) array of points (LPS mm), or a path file as `endocast path`
+/// or 3D Slicer writes it (points or key frames) — one frame every `frame_step` mm (default
+/// 1) looking `look_ahead` mm ahead (default 10). With `out` (a `.gif`, an `.mp4` or a folder
+/// of PNGs) writes the film and returns its path (a `pathlib.Path`); without, returns the frames as an RGB uint8
+/// array (frames, height, width, 3).
+#[pyfunction]
+#[pyo3(signature = (volume, route, out = None, **options))]
+pub fn fly<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, Volume>,
+    route: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kw = Kwargs::new(py, "fly", options)?;
+    let volume = volume.get();
+    let look = Look::take(&kw)?;
+    let fov = kw.take::<f64>("fov")?;
+    let optics = optics(&kw, look.preset, volume.volume(), fov)?;
+    let size = kw.take::<[usize; 2]>("size")?.unwrap_or([384, 384]);
+    let frame_step = kw.take::<f64>("frame_step")?.unwrap_or(1.0);
+    let look_ahead = kw.take::<f64>("look_ahead")?.unwrap_or(10.0);
+    let fps = kw.take::<f64>("fps")?.unwrap_or(25.0);
+    kw.finish()?;
+    let route = read(py, route)?;
+    let shots = route.shots(frame_step, look_ahead).map_err(to_py)?;
+    let options = FlightOptions {
+        size,
+        optics,
+        stereo: None,
+        layout: Layout::Endoscope,
+        window: look.preset.map_or(Window::AIR_TISSUE, |p| p.window),
+    };
+    let mut flight = Flight::new(volume.renderer().clone(), options);
+    let mut looks = ShotSettings::new(look.settings.clone(), transfer_function);
+    let mut frame = |n: usize| {
+        py.detach(|| {
+            let settings = looks.for_shot(&shots[n]).map_err(to_py)?;
+            let (image, _) = look
+                .in_pool(|| flight.frame(n, &shots[n], &settings))
+                .map_err(to_py)?;
+            PyResult::Ok(image)
+        })
+    };
+    if let Some(out) = out {
+        let mut video = VideoOptions::default();
+        video.fps = fps;
+        let mut sink = open_sink(&out, &video).map_err(to_py)?;
+        for n in 0..shots.len() {
+            sink.push_image(&frame(n)?).map_err(to_py)?;
+        }
+        let written = sink.finish().map_err(to_py)?;
+        return Ok(written.into_pyobject(py)?.into_any());
+    }
+    let mut rgb = Vec::new();
+    let mut shape = (shots.len(), 0, 0, 3);
+    for n in 0..shots.len() {
+        let image = frame(n)?;
+        (shape.1, shape.2) = (image.height(), image.width());
+        rgb.extend_from_slice(image.rgb());
+    }
+    let frames = Array4::from_shape_vec(shape, rgb).map_err(to_py)?;
+    Ok(frames.into_pyarray(py).into_any())
+}
+
+/// The route `value` gives: a path file's name, or an (N, 3) array of points.
+fn read(py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<Route> {
+    if let Ok(file) = value.extract::<PathBuf>() {
+        return read_route(&file).map_err(to_py);
+    }
+    let np = py.import("numpy")?;
+    let points: Vec<[f64; 3]> = np
+        .call_method1("asarray", (value, "float64"))?
+        .call_method0("tolist")?
+        .extract()
+        .map_err(|_| error("the route is neither a path file nor an (N, 3) array of points"))?;
+    let points: Vec<DVec3> = points.into_iter().map(DVec3::from).collect();
+    Route::through_points(&points).map_err(to_py)
+}

@@ -1,0 +1,98 @@
+//! `endocast.path` (the centred flight path through a lumen, as `endocast path` plans it) and
+//! `endocast.default_view` (the camera `render` takes when none is given).
+
+use crate::errors::{error, to_py};
+use crate::kwargs::Kwargs;
+use crate::look::{default_pose, find_preset, lumen_choice, Look};
+use crate::volume::Volume;
+use endocast_core::navigate::{plan_path, PathEnd};
+use endocast_core::path::SmoothOptions;
+use glam::DVec3;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A point in LPS mm, as (x, y, z).
+type Point = (f64, f64, f64);
+
+/// A path's points (N, 3) and radii (N,).
+type PathArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// The centred path through the lumen from `start` (LPS mm; or `start_voxel`, an index) to
+/// `end` (or `end_voxel`; neither: the farthest lumen point), as `endocast path` plans it and
+/// writes it: points every `step` mm (default 2) and the last, as an (N, 3) array in LPS mm,
+/// and each point's distance to the lumen wall (N,), mm.
+#[pyfunction]
+#[pyo3(signature = (volume, start = None, end = None, **options))]
+pub fn path<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, Volume>,
+    start: Option<[f64; 3]>,
+    end: Option<[f64; 3]>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<PathArrays<'py>> {
+    let kw = Kwargs::new(py, "path", options)?;
+    let volume = volume.get().volume();
+    let start_voxel = kw.take::<[f64; 3]>("start_voxel")?;
+    let end_voxel = kw.take::<[f64; 3]>("end_voxel")?;
+    let preset = kw
+        .take::<String>("preset")?
+        .map(|n| find_preset(&n))
+        .transpose()?;
+    let iso = kw.take::<f64>("iso")?;
+    let choice = lumen_choice(&kw, preset, iso)?;
+    let smoothing = kw.take::<f64>("smoothing")?.unwrap_or(5.0);
+    let step = kw.take::<f64>("step")?.unwrap_or(2.0);
+    kw.finish()?;
+    let (threshold, side) = choice.resolve().map_err(to_py)?;
+    let world = |p: Option<[f64; 3]>, v: Option<[f64; 3]>, name: &str| match (p, v) {
+        (Some(_), Some(_)) => Err(error(format!("give {name} or {name}_voxel, not both"))),
+        (Some(p), None) => Ok(Some(DVec3::from(p))),
+        (None, Some(v)) => Ok(Some(volume.geometry().world_of(DVec3::from(v)))),
+        (None, None) => Ok(None),
+    };
+    let start = world(start, start_voxel, "start")?
+        .ok_or_else(|| error("give the start (LPS mm) or start_voxel (an index)"))?;
+    let end = world(end, end_voxel, "end")?.map_or(PathEnd::Farthest, PathEnd::Point);
+    let options = SmoothOptions {
+        control_spacing_mm: smoothing,
+        step_mm: 0.5,
+        ..SmoothOptions::default()
+    };
+    let (points, radii) = py.detach(|| -> PyResult<_> {
+        let (_, field, planned) = plan_path(volume, threshold, side, start, end, &options)
+            .map_err(|e| error(format!("no path in the lumen {side} {threshold}: {e}")))?;
+        let points = planned.path.points_every(step).map_err(to_py)?;
+        let radii: Vec<f64> = points.iter().map(|&p| field.distance_mm(p)).collect();
+        Ok((points, radii))
+    })?;
+    let flat: Vec<f64> = points.iter().flat_map(|p| p.to_array()).collect();
+    let points = Array2::from_shape_vec((points.len(), 3), flat).map_err(to_py)?;
+    Ok((points.into_pyarray(py), PyArray1::from_vec(py, radii)))
+}
+
+/// The camera `render` takes when given no `eye`: for an endoscopic preset inside the largest
+/// lumen, looking along it, else framing the whole volume from the front. Returns
+/// `(eye, look_at, up)`, LPS mm.
+#[pyfunction]
+#[pyo3(signature = (volume, **options))]
+pub fn default_view<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, Volume>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<(Point, Point, Point)> {
+    let kw = Kwargs::new(py, "default_view", options)?;
+    let volume = volume.get().volume();
+    let look = Look::take(&kw)?;
+    let fov = kw.take::<f64>("fov")?;
+    let lumen = lumen_choice(&kw, look.preset, Some(look.settings.iso_hu))?;
+    kw.finish()?;
+    let pose = py.detach(|| default_pose(volume, &look, &lumen, fov));
+    let triple = |v: DVec3| (v.x, v.y, v.z);
+    Ok((
+        triple(pose.eye_mm),
+        triple(pose.look_at_mm),
+        triple(pose.up),
+    ))
+}

@@ -1,0 +1,157 @@
+//! `endocast.render`: one view of a volume, as `endocast render` makes it.
+
+use crate::errors::{error, to_py};
+use crate::kwargs::Kwargs;
+use crate::look::{camera, Look};
+use crate::volume::Volume;
+use endocast_core::camera::StereoRig;
+use endocast_core::render::{Camera, Frame, Prepared};
+use endocast_core::views::stereo::{self, StereoOutput};
+use endocast_core::views::Image;
+use numpy::ndarray::{Array, IxDyn};
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Stereo options: how the eyes are combined, their distance and the focus distance (mm).
+struct Stereo {
+    output: StereoOutput,
+    eye_separation_mm: Option<f64>,
+    focus_mm: Option<f64>,
+}
+
+/// A rendered view: RGBA rows (or two, for a stereo pair) and depth images.
+struct View {
+    /// `[images, height, width]` of the colour.
+    rgba_shape: [usize; 3],
+    rgba: Vec<u8>,
+    /// `[images, height, width]` of the depth.
+    depth_shape: [usize; 3],
+    depth: Vec<f32>,
+}
+
+/// Renders `volume` as `endocast render` does and returns `(rgba, depth)`: RGBA uint8
+/// (height, width, 4; the colour over the background, alpha 255) and the depth of the first
+/// isosurface hit, float32 mm from the eye (height, width; NaN where none). A stereo pair
+/// (`stereo="pair"`) gives (2, height, width, 4) and (2, height, width); a combined stereo
+/// image gives the left eye's depth.
+#[pyfunction]
+#[pyo3(signature = (volume, **options))]
+pub fn render<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, Volume>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let kw = Kwargs::new(py, "render", options)?;
+    let volume = volume.get();
+    let look = Look::take(&kw)?;
+    let camera = camera(&kw, &look, volume.volume())?;
+    let stereo = stereo_options(&kw)?;
+    kw.finish()?;
+    let renderer = volume.renderer().clone();
+    let view = py.detach(|| -> PyResult<View> {
+        let prepared = renderer.prepare(&look.settings).map_err(to_py)?;
+        match &stereo {
+            None => {
+                let frame = look.in_pool(|| prepared.render(&camera));
+                Ok(single(&frame, look.settings.background))
+            }
+            Some(stereo) => look.in_pool(|| render_stereo(&prepared, &camera, stereo)),
+        }
+    })?;
+    let (rgba_dims, depth_dims) = (rgba_dims(&view), depth_dims(&view));
+    let rgba = Array::from_shape_vec(IxDyn(&rgba_dims), view.rgba).map_err(to_py)?;
+    let depth = Array::from_shape_vec(IxDyn(&depth_dims), view.depth).map_err(to_py)?;
+    Ok((
+        rgba.into_pyarray(py).into_any(),
+        depth.into_pyarray(py).into_any(),
+    ))
+}
+
+/// The colour array's shape: one image (h, w, 4) or a pair (2, h, w, 4).
+fn rgba_dims(view: &View) -> Vec<usize> {
+    let [n, h, w] = view.rgba_shape;
+    if n == 1 {
+        vec![h, w, 4]
+    } else {
+        vec![n, h, w, 4]
+    }
+}
+
+/// The depth array's shape: one image (h, w) or a pair (2, h, w).
+fn depth_dims(view: &View) -> Vec<usize> {
+    let [n, h, w] = view.depth_shape;
+    if n == 1 {
+        vec![h, w]
+    } else {
+        vec![n, h, w]
+    }
+}
+
+/// Takes `stereo`, `eye_separation` and `focus`.
+fn stereo_options(kw: &Kwargs<'_>) -> PyResult<Option<Stereo>> {
+    let output = kw.take::<String>("stereo")?;
+    let eye_separation_mm = kw.take("eye_separation")?;
+    let focus_mm = kw.take("focus")?;
+    let Some(name) = output else {
+        if eye_separation_mm.is_some() || focus_mm.is_some() {
+            return Err(error("eye_separation and focus need stereo"));
+        }
+        return Ok(None);
+    };
+    let output = StereoOutput::from_name(&name).ok_or_else(|| {
+        error(format!(
+            "unknown stereo output {name:?}: use anaglyph, red-cyan, dubois, side-by-side, \
+             top-bottom or pair"
+        ))
+    })?;
+    Ok(Some(Stereo {
+        output,
+        eye_separation_mm,
+        focus_mm,
+    }))
+}
+
+/// One frame as a view.
+fn single(frame: &Frame, background: [f32; 3]) -> View {
+    let [w, h] = [frame.width, frame.height];
+    View {
+        rgba_shape: [1, h, w],
+        rgba: frame.to_rgba8(background),
+        depth_shape: [1, h, w],
+        depth: frame.depth_mm.clone(),
+    }
+}
+
+/// Both eyes of `camera`, combined as `stereo.output` says (a pair stays two images).
+fn render_stereo(prepared: &Prepared, camera: &Camera, stereo: &Stereo) -> PyResult<View> {
+    let nearest = || prepared.nearest_surface_mm(camera);
+    let rig =
+        StereoRig::for_view(stereo.eye_separation_mm, stereo.focus_mm, nearest).map_err(to_py)?;
+    let [left, right] = prepared.render_stereo(camera, &rig).map_err(to_py)?;
+    let background = prepared.settings().background;
+    if stereo.output == StereoOutput::Pair {
+        let (l, r) = (single(&left, background), single(&right, background));
+        let [_, h, w] = l.rgba_shape;
+        return Ok(View {
+            rgba_shape: [2, h, w],
+            rgba: [l.rgba, r.rgba].concat(),
+            depth_shape: [2, h, w],
+            depth: [l.depth, r.depth].concat(),
+        });
+    }
+    let image = |frame: &Frame| Image::from_frame(frame, background).map_err(to_py);
+    let combined =
+        stereo::combine(&image(&left)?, &image(&right)?, stereo.output).map_err(to_py)?;
+    let [w, h] = [combined.width(), combined.height()];
+    Ok(View {
+        rgba_shape: [1, h, w],
+        rgba: combined
+            .rgb()
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect(),
+        depth_shape: [1, left.height, left.width],
+        depth: left.depth_mm,
+    })
+}

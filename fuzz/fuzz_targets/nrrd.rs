@@ -1,0 +1,11 @@
+//! The nrrd reader on arbitrary bytes: `Ok` or a clean `Err`, never a panic or a runaway
+//! allocation.
+
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let path = endocast_fuzz::file_with("input.nrrd", data);
+    let _ = endocast_io::nrrd::read(&path, &endocast_fuzz::options());
+});
