@@ -42,6 +42,9 @@ enum Command {
     Mesh(Box<commands::mesh::MeshArgs>),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
+    /// The interactive workstation: fly through a scan with the slices, the controls, key
+    /// frames, marks and cases (a window; `--screenshot` grabs it and quits).
+    View(Box<commands::view::ViewArgs>),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Command::Presets(args) => commands::presets::run(&args),
         Command::Path(args) => commands::path::run(&args),
         Command::Fly(args) => commands::fly::run(&args),
+        Command::View(args) => commands::view::run(&args),
         Command::Mesh(args) => commands::mesh::run(&args),
     };
     match result {

@@ -13,3 +13,4 @@ mod presets;
 mod real_scans;
 mod render;
 mod scene;
+mod view;

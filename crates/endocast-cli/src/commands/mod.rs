@@ -10,3 +10,4 @@ pub mod path;
 pub mod phantom;
 pub mod presets;
 pub mod render;
+pub mod view;

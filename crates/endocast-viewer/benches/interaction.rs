@@ -1,0 +1,98 @@
+//! The interaction loop's latency (issue 21): from an input (a new camera pose) to the first
+//! updated frame the UI can show, at moving quality, and to the full-quality frame, at 512×512
+//! on the colon phantom, through the viewer's own session and render worker.
+//!
+//! `cargo bench -p endocast-viewer --bench interaction [-- SIZE [POSES]]` (defaults 512, 40).
+
+use endocast_core::phantom::{self, PhantomOptions};
+use endocast_core::pose::Pose;
+use endocast_core::presets::Preset;
+use endocast_core::render::progressive::Stage;
+use endocast_viewer::controller::FlyCamera;
+use endocast_viewer::scene::{ScanSource, Scene};
+use endocast_viewer::session::Session;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+fn main() {
+    let mut args = std::env::args().skip(1).filter(|a| !a.starts_with("--"));
+    let size: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(512);
+    let poses: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(40);
+    let options = PhantomOptions {
+        size,
+        ..PhantomOptions::default()
+    };
+    let (volume, colon) = phantom::colon(&options);
+    let geometry = *volume.geometry();
+    let line = &colon.centreline;
+    let source = ScanSource::Phantom {
+        name: "colon".into(),
+        size,
+    };
+    let scene = Arc::new(Scene::new(source, volume));
+    let preset = Preset::find("colonoscopy").expect("a preset");
+    let at = |s: f64| geometry.world_of(line.point_at(s));
+    let pose = |s: f64| {
+        let (eye_mm, look_at_mm) = (at(s), at(s + 10.0));
+        let forward = (look_at_mm - eye_mm).normalize_or_zero();
+        let up = if forward.y.abs() < 0.9 {
+            glam::DVec3::NEG_Y
+        } else {
+            glam::DVec3::Z
+        };
+        Pose {
+            eye_mm,
+            look_at_mm,
+            up,
+        }
+    };
+    let mut session = Session::new(scene, preset, Some(pose(20.0)), || {});
+    session.set_view_size([512, 512]);
+    let (mut first, mut full) = (Vec::new(), Vec::new());
+    let length = line.length_vox();
+    let wait = Duration::from_secs(60);
+    for k in 0..poses {
+        let s = 20.0 + (length - 40.0) * k as f64 / poses as f64;
+        let Some(camera) = FlyCamera::from_pose(&pose(s)) else {
+            continue;
+        };
+        session.set_camera(camera);
+        let input = Instant::now();
+        let generation = session.sync(true).expect("a new view");
+        let preview = session
+            .worker()
+            .wait_for(generation, wait, |_| true)
+            .expect("a frame");
+        first.push((input.elapsed(), preview.stage));
+        // The camera stops: the same view, refined.
+        session.sync(false);
+        let still = session.worker().generation();
+        session
+            .worker()
+            .wait_for(still, wait, |f| f.stage == Stage::Full)
+            .expect("the full frame");
+        full.push(input.elapsed());
+    }
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let mut first_ms: Vec<f64> = first.iter().map(|(d, _)| ms(*d)).collect();
+    let mut full_ms: Vec<f64> = full.iter().map(|d| ms(*d)).collect();
+    println!(
+        "colon phantom {size}, 512x512, {} poses along the centreline, first stage {:?}",
+        first.len(),
+        first.first().map(|f| f.1)
+    );
+    report("input -> first frame (moving quality)", &mut first_ms);
+    report("input -> full-quality frame", &mut full_ms);
+}
+
+fn report(what: &str, values: &mut [f64]) {
+    values.sort_by(f64::total_cmp);
+    let q = |p: f64| values[((values.len() - 1) as f64 * p).round() as usize];
+    println!(
+        "{what}: median {:.1} ms, p10 {:.1} ms, p90 {:.1} ms, max {:.1} ms",
+        q(0.5),
+        q(0.1),
+        q(0.9),
+        q(1.0)
+    );
+}

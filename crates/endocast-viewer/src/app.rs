@@ -1,0 +1,384 @@
+//! The window: the endoscopic view large in the middle, the three slices through the camera on
+//! the right, the control panel on the left and the frame time and quality at the bottom.
+//! [`ViewerApp::frame_ui`] draws one UI frame on any [`egui::Context`], so tests run it headlessly
+//! with synthetic input; [`run`] puts it in a native window (eframe, OpenGL).
+
+use crate::case::{Autosave, Case};
+use crate::panel::controls_ui;
+use crate::scene::{ScanSource, Scene};
+use crate::session::Session;
+use crate::slices::SlicesView;
+use crate::state::{Action, Ready};
+use crate::view::view_ui;
+use endocast_core::pose::Pose;
+use endocast_core::presets::Preset;
+use endocast_core::render::progressive::Stage;
+use endocast_core::render::Quality;
+use std::path::PathBuf;
+use std::sync::mpsc::{channel, Receiver, TryRecvError};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// How often the case is autosaved when it changed.
+pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(10);
+
+/// What to open and how.
+#[derive(Debug, Clone)]
+pub struct ViewerOptions {
+    /// The scan.
+    pub source: ScanSource,
+    /// The procedure's defaults.
+    pub preset: &'static Preset,
+    /// The starting camera; `None`: inside the preset's largest lumen.
+    pub pose: Option<Pose>,
+    /// A case file to reopen (its scan replaces `source`) and to save to.
+    pub case: Option<PathBuf>,
+    /// Write a screenshot of the window here once the view has refined, then quit.
+    pub screenshot: Option<PathBuf>,
+}
+
+/// A scan being read in the background.
+struct Loading {
+    what: String,
+    started: Instant,
+    result: Receiver<Result<(Session, Option<PathBuf>), String>>,
+}
+
+/// The application.
+pub struct ViewerApp {
+    ctx: egui::Context,
+    options: ViewerOptions,
+    loading: Option<Loading>,
+    ready: Option<Ready>,
+    /// One line for the status bar: the last error or what was saved.
+    message: String,
+    /// The path typed in "Open".
+    open_path: String,
+    screenshot_requested: bool,
+}
+
+impl ViewerApp {
+    /// The application on `ctx`, starting to load `options`' scan (or case).
+    pub fn new(ctx: egui::Context, options: ViewerOptions) -> Self {
+        let mut app = Self {
+            ctx,
+            open_path: String::new(),
+            loading: None,
+            ready: None,
+            message: String::new(),
+            screenshot_requested: false,
+            options: options.clone(),
+        };
+        app.start_loading(options.source, options.case);
+        app
+    }
+
+    /// Starts reading `source` (or the scan of the case file `case`) in the background; the
+    /// current session stays usable meanwhile and if it fails.
+    pub fn start_loading(&mut self, source: ScanSource, case: Option<PathBuf>) {
+        let (send, result) = channel();
+        let ctx = self.ctx.clone();
+        let preset = self.options.preset;
+        let pose = self.options.pose;
+        let what = match &case {
+            Some(path) => format!("case {}", path.display()),
+            None => source.label(),
+        };
+        std::thread::spawn(move || {
+            let loaded = load(source, case, preset, pose, &ctx);
+            let _ = send.send(loaded);
+            ctx.request_repaint();
+        });
+        self.loading = Some(Loading {
+            what,
+            started: Instant::now(),
+            result,
+        });
+    }
+
+    /// The open session, once loaded.
+    pub fn session(&self) -> Option<&Session> {
+        self.ready.as_ref().map(|r| &r.session)
+    }
+
+    /// The open session, mutably.
+    pub fn session_mut(&mut self) -> Option<&mut Session> {
+        self.ready.as_mut().map(|r| &mut r.session)
+    }
+
+    /// Whether a scan is being read.
+    pub fn is_loading(&self) -> bool {
+        self.loading.is_some()
+    }
+
+    /// The status line's message (the last error, or what was saved).
+    pub fn message(&self) -> &str {
+        &self.message
+    }
+
+    /// Where the case is (auto)saved.
+    pub fn case_path(&self) -> Option<PathBuf> {
+        self.ready.as_ref().map(|r| r.autosave.path().to_owned())
+    }
+
+    /// Draws one frame of the UI on `ctx` and acts on its input.
+    pub fn frame_ui(&mut self, ctx: &egui::Context) {
+        self.poll_loading();
+        egui::TopBottomPanel::bottom("status").show(ctx, |ui| self.status_ui(ui));
+        if let Some(ready) = &mut self.ready {
+            let mut action = None;
+            egui::SidePanel::left("controls")
+                .resizable(false)
+                .exact_width(290.0)
+                .show(ctx, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        action = controls_ui(ui, ready, &mut self.open_path);
+                    });
+                });
+            egui::SidePanel::right("slices")
+                .resizable(false)
+                .exact_width(250.0)
+                .show(ctx, |ui| ready.slices.slices_ui(ui, &mut ready.session));
+            egui::CentralPanel::default()
+                .frame(egui::Frame::NONE.fill(egui::Color32::BLACK))
+                .show(ctx, |ui| view_ui(ui, ready));
+            if let Some(action) = action {
+                self.act(action);
+            }
+            self.autosave(false);
+        } else {
+            egui::CentralPanel::default().show(ctx, |ui| {
+                ui.heading("endocast");
+                ui.label(&self.message);
+            });
+        }
+        self.screenshot(ctx);
+    }
+
+    fn poll_loading(&mut self) {
+        let Some(loading) = &self.loading else {
+            return;
+        };
+        match loading.result.try_recv() {
+            Err(TryRecvError::Empty) => {
+                self.ctx.request_repaint_after(Duration::from_millis(200));
+            }
+            Err(TryRecvError::Disconnected) => {
+                self.message = format!("reading {} failed", loading.what);
+                self.loading = None;
+            }
+            Ok(Err(e)) => {
+                self.message = e;
+                self.loading = None;
+            }
+            Ok(Ok((session, case))) => {
+                self.message = format!("opened {}", loading.what);
+                let path = case.unwrap_or_else(|| default_case_path(&session.scene().source));
+                self.ready = Some(Ready {
+                    session,
+                    slices: SlicesView::default(),
+                    autosave: Autosave::new(path, AUTOSAVE_INTERVAL),
+                    view_texture: None,
+                    shown: None,
+                    marking: false,
+                    label: "mark".into(),
+                    last_input: None,
+                });
+                self.loading = None;
+            }
+        }
+    }
+
+    fn status_ui(&self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            if let Some(loading) = &self.loading {
+                ui.spinner();
+                ui.label(format!(
+                    "reading {} … {:.1} s",
+                    loading.what,
+                    loading.started.elapsed().as_secs_f64()
+                ));
+            }
+            if let Some(ready) = &self.ready {
+                ui.label(frame_status(ready));
+            }
+            ui.separator();
+            ui.label(&self.message);
+        });
+    }
+
+    fn act(&mut self, action: Action) {
+        match action {
+            Action::Open => {
+                let path = PathBuf::from(self.open_path.trim());
+                if path.extension().is_some_and(|e| e == "json") {
+                    self.start_loading(self.options.source.clone(), Some(path));
+                } else {
+                    let source = ScanSource::File { path, series: None };
+                    self.start_loading(source, None);
+                }
+            }
+            Action::SaveCase => self.autosave(true),
+            Action::Message(m) => self.message = m,
+        }
+    }
+
+    fn autosave(&mut self, force: bool) {
+        let Some(ready) = &mut self.ready else {
+            return;
+        };
+        match ready.autosave.tick(&ready.session, force) {
+            Ok(true) if force => {
+                self.message = format!("saved {}", ready.autosave.path().display());
+            }
+            Ok(_) => {}
+            Err(e) => self.message = e.to_string(),
+        }
+    }
+
+    /// With `--screenshot`: once the view has refined to its still, grab the window and quit.
+    fn screenshot(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.options.screenshot.clone() else {
+            return;
+        };
+        let refined = self
+            .ready
+            .as_ref()
+            .is_some_and(|r| matches!(r.shown, Some((_, Stage::Still(n)))  if n >= 4));
+        if refined && !self.screenshot_requested {
+            self.screenshot_requested = true;
+            ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::default()));
+        }
+        let image = ctx.input(|i| {
+            i.raw.events.iter().find_map(|e| match e {
+                egui::Event::Screenshot { image, .. } => Some(Arc::clone(image)),
+                _ => None,
+            })
+        });
+        if let Some(image) = image {
+            let [w, h] = image.size;
+            let rgba: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
+            if let Err(e) = endocast_io::write_png_rgba8(&path, w as u32, h as u32, &rgba) {
+                eprintln!("error: {e}");
+            }
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        } else if self.screenshot_requested || self.loading.is_some() || self.ready.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(50));
+        }
+        if self.ready.is_none() && self.loading.is_none() {
+            // Nothing will ever be shown: report and quit.
+            eprintln!("error: {}", self.message);
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+    }
+}
+
+/// "Frame 12.3 ms · quarter → 41 ms after input · eye … · wall 4.1 mm".
+fn frame_status(ready: &Ready) -> String {
+    let session = &ready.session;
+    let frame = session.worker().with_latest(|f| {
+        f.map(|f| {
+            let stage = match f.stage {
+                Stage::Preview(Quality::Quarter) => "quarter".to_owned(),
+                Stage::Preview(q) => q.name().to_owned(),
+                Stage::Full => "full".to_owned(),
+                Stage::Still(n) => format!("still ×{n}"),
+            };
+            format!(
+                "frame {:.1} ms · {stage} · {:.0} ms after the request",
+                f.render_time.as_secs_f64() * 1e3,
+                f.since_request.as_secs_f64() * 1e3
+            )
+        })
+    });
+    let eye = session.fly_camera().eye_mm();
+    let wall = session
+        .navigation()
+        .map(|n| format!(" · wall {:.1} mm", n.distance_mm(eye)))
+        .unwrap_or_default();
+    format!(
+        "{} · eye ({:.1}, {:.1}, {:.1}) mm{wall}",
+        frame.unwrap_or_else(|| "rendering…".into()),
+        eye.x,
+        eye.y,
+        eye.z
+    )
+}
+
+/// Where a scan's case is saved until the user saves elsewhere: beside the scan for a file,
+/// in the temporary folder for a phantom.
+pub fn default_case_path(source: &ScanSource) -> PathBuf {
+    match source {
+        ScanSource::File { path, .. } => {
+            let name = path
+                .file_name()
+                .map_or_else(|| "scan".into(), |n| n.to_string_lossy().into_owned());
+            let dir = path.parent().map(PathBuf::from).unwrap_or_default();
+            let candidate = dir.join(format!("{name}.endocast-case.json"));
+            // A read-only data folder: fall back to the working directory.
+            if dir.as_os_str().is_empty() || writable(&dir) {
+                candidate
+            } else {
+                PathBuf::from(format!("{name}.endocast-case.json"))
+            }
+        }
+        ScanSource::Phantom { name, .. } => {
+            std::env::temp_dir().join(format!("endocast-{name}.endocast-case.json"))
+        }
+    }
+}
+
+fn writable(dir: &std::path::Path) -> bool {
+    std::fs::metadata(dir).is_ok_and(|m| !m.permissions().readonly())
+        && tempfile::tempfile_in(dir).is_ok()
+}
+
+/// Reads the scan (or the case and its scan) and opens a session on it.
+fn load(
+    source: ScanSource,
+    case: Option<PathBuf>,
+    preset: &'static Preset,
+    pose: Option<Pose>,
+    ctx: &egui::Context,
+) -> Result<(Session, Option<PathBuf>), String> {
+    let case_file = match &case {
+        Some(path) => Some(Case::read(path).map_err(|e| e.to_string())?),
+        None => None,
+    };
+    let source = case_file.as_ref().map_or(source, |c| c.scan.clone());
+    let volume = source.load()?;
+    let scene = Arc::new(Scene::new(source, volume));
+    let repaint = ctx.clone();
+    let mut session = Session::new(scene, preset, pose, move || repaint.request_repaint());
+    if let (Some(file), Some(path)) = (&case_file, &case) {
+        file.apply(&mut session, path).map_err(|e| e.to_string())?;
+    }
+    Ok((session, case))
+}
+
+/// Opens the window and runs until it is closed.
+pub fn run(options: ViewerOptions) -> Result<(), String> {
+    let native = eframe::NativeOptions {
+        renderer: eframe::Renderer::Glow,
+        viewport: egui::ViewportBuilder::default()
+            .with_title("endocast")
+            .with_inner_size([1360.0, 820.0]),
+        ..eframe::NativeOptions::default()
+    };
+    eframe::run_native(
+        "endocast",
+        native,
+        Box::new(|cc| Ok(Box::new(ViewerApp::new(cc.egui_ctx.clone(), options)))),
+    )
+    .map_err(|e| format!("cannot open the window: {e}"))
+}
+
+impl eframe::App for ViewerApp {
+    fn update(&mut self, ctx: &egui::Context, _frame: &mut eframe::Frame) {
+        self.frame_ui(ctx);
+    }
+
+    fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
+        self.autosave(true);
+    }
+}

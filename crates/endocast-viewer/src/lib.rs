@@ -1,0 +1,50 @@
+//! The interactive virtual endoscopy workstation behind `endocast view`: fly through a scan in
+//! real time with the slices through the camera, the controls, key frames, marks and cases.
+//!
+//! The parts and who owns what:
+//! - [`scene`]: the scan, where it came from, its renderer and value histogram, and the lumen
+//!   the camera flies in (the collider's distance field);
+//! - [`controller`]: the flying camera (mouse-look, keys, roll, sliding along the wall);
+//! - [`worker`]: the render thread, which owns the prepared renderer and draws the newest view
+//!   through the library's progressive driver (a quick preview while moving, refinement to
+//!   the full frame and an accumulated still when the view stands; new input supersedes the
+//!   frame in flight);
+//! - [`session`]: the state of one open scan — every user action is a method, so tests drive it
+//!   without a window;
+//! - [`case`]: case files, written atomically and autosaved;
+//! - [`app`]: the window (egui), which maps input to the session and draws what it has.
+//!
+//! ```no_run
+//! # #[cfg(feature = "window")] {
+//! use endocast_viewer::app::{run, ViewerOptions};
+//! use endocast_viewer::scene::ScanSource;
+//! use endocast_core::presets::Preset;
+//!
+//! run(ViewerOptions {
+//!     source: ScanSource::Phantom { name: "colon".into(), size: 128 },
+//!     preset: Preset::find("colonoscopy").unwrap(),
+//!     pose: None,
+//!     case: None,
+//!     screenshot: None,
+//! })
+//! .unwrap();
+//! # }
+//! ```
+
+#[cfg(feature = "window")]
+pub mod app;
+pub mod case;
+pub mod controller;
+#[cfg(feature = "window")]
+pub mod keys;
+#[cfg(feature = "window")]
+mod panel;
+pub mod scene;
+pub mod session;
+#[cfg(feature = "window")]
+mod slices;
+#[cfg(feature = "window")]
+mod state;
+#[cfg(feature = "window")]
+mod view;
+pub mod worker;

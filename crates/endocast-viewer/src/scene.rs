@@ -1,0 +1,179 @@
+//! What the viewer shows: a scan, where it came from, its renderer, its histogram and the lumen
+//! the camera flies through (the distance field the collider reads).
+
+use endocast_core::navigate::{seed_voxel, Collider, DistanceField, Lumen, LumenSide};
+use endocast_core::phantom::{Phantom, PhantomOptions};
+use endocast_core::render::Renderer;
+use endocast_core::Volume;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Bins of the value histogram under the isovalue slider.
+pub const HISTOGRAM_BINS: usize = 128;
+
+/// Where a scan comes from, as a case file records it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ScanSource {
+    /// A file or DICOM folder, and the DICOM series when not the largest.
+    File {
+        /// The file or folder.
+        path: PathBuf,
+        /// SeriesInstanceUID, DICOM only.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        series: Option<String>,
+    },
+    /// A generated phantom (see `endocast phantom`).
+    Phantom {
+        /// Its name (`colon`, `straight-tube`, ...).
+        name: String,
+        /// Its largest dimension, voxels.
+        size: usize,
+    },
+}
+
+impl ScanSource {
+    /// Reads or generates the volume; the error is one line naming the file and the problem.
+    pub fn load(&self) -> Result<Volume, String> {
+        match self {
+            Self::File { path, series } => {
+                let mut options = endocast_io::OpenOptions::default();
+                options.series.clone_from(series);
+                endocast_io::open(path, &options)
+                    .map(|loaded| loaded.volume)
+                    .map_err(|e| format!("cannot read the scan: {e}"))
+            }
+            Self::Phantom { name, size } => {
+                let phantom = Phantom::from_name(name)
+                    .ok_or_else(|| format!("no phantom called {name:?}"))?;
+                let options = PhantomOptions {
+                    size: *size,
+                    ..PhantomOptions::default()
+                };
+                Ok(phantom.build(&options))
+            }
+        }
+    }
+
+    /// A short name for the title bar.
+    pub fn label(&self) -> String {
+        match self {
+            Self::File { path, .. } => path.display().to_string(),
+            Self::Phantom { name, size } => format!("{name} phantom ({size})"),
+        }
+    }
+}
+
+/// The lumen the camera is in: its distance field and the camera's radius.
+#[derive(Debug)]
+pub struct Navigation {
+    field: DistanceField,
+    radius_mm: f64,
+}
+
+impl Navigation {
+    /// The lumen 6-connected to the voxel nearest `eye_mm` on `side` of `threshold`; `None`
+    /// when the eye is outside the volume or in the wall. The camera's radius is two voxels (the
+    /// collider's bound holds against the wall to within about a voxel), or half the lumen's
+    /// widest radius in a lumen narrower than that.
+    pub fn around(volume: &Volume, eye_mm: DVec3, threshold: f64, side: LumenSide) -> Option<Self> {
+        let seed = seed_voxel(volume, eye_mm).ok()?;
+        let lumen = Lumen::from_seed(volume, seed, threshold, side).ok()?;
+        let field = DistanceField::new(&lumen, volume.geometry());
+        let radius_mm = (2.0 * field.min_spacing_mm()).min(0.5 * field.max_mm());
+        Some(Self { field, radius_mm })
+    }
+
+    /// The collider for a camera at `eye_mm`: the camera's radius, shrunk to fit where the eye
+    /// already is nearer the wall than that (a jump, a reopened case), so it can always move
+    /// on; `None` outside the lumen.
+    pub fn collider_at(&self, eye_mm: DVec3) -> Option<Collider<'_>> {
+        let room = 0.9 * self.field.distance_mm(eye_mm);
+        Collider::new(&self.field, self.radius_mm.min(room)).ok()
+    }
+
+    /// Distance from `p_mm` to the wall, mm (0 outside the lumen).
+    pub fn distance_mm(&self, p_mm: DVec3) -> f64 {
+        self.field.distance_mm(p_mm)
+    }
+
+    /// The camera's radius, mm.
+    pub fn radius_mm(&self) -> f64 {
+        self.radius_mm
+    }
+}
+
+/// A loaded scan ready to fly through.
+#[derive(Debug)]
+pub struct Scene {
+    /// Where it came from.
+    pub source: ScanSource,
+    /// The renderer (the volume and its brick grid).
+    pub renderer: Arc<Renderer>,
+    /// Voxel counts of the physical values in [`HISTOGRAM_BINS`] equal bins over
+    /// [`Scene::value_range`].
+    pub histogram: Vec<u64>,
+    /// Lowest and highest physical value.
+    pub value_range: (f64, f64),
+}
+
+impl Scene {
+    /// The scene of `volume` read from `source`.
+    pub fn new(source: ScanSource, volume: Volume) -> Self {
+        let value_range = volume.physical_range();
+        let histogram = histogram(&volume);
+        Self {
+            source,
+            renderer: Arc::new(Renderer::for_many_frames(volume)),
+            histogram,
+            value_range,
+        }
+    }
+
+    /// The volume.
+    pub fn volume(&self) -> &Volume {
+        self.renderer.volume()
+    }
+}
+
+/// Voxel counts in [`HISTOGRAM_BINS`] bins of the stored range (a linear map of the physical).
+fn histogram(volume: &Volume) -> Vec<u64> {
+    let (lo, hi) = volume.stored_range();
+    let span = f64::from(hi - lo).max(1.0);
+    let mut counts = vec![0u64; HISTOGRAM_BINS];
+    let last = HISTOGRAM_BINS - 1;
+    for &v in volume.voxels() {
+        let bin = (f64::from(v - lo) / span * last as f64).round() as usize;
+        counts[bin.min(last)] += 1;
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn histogram_counts_every_voxel_and_bad_sources_say_why() {
+        let source = ScanSource::Phantom {
+            name: "straight-tube".into(),
+            size: 16,
+        };
+        let scene = Scene::new(source.clone(), source.load().unwrap());
+        let total: u64 = scene.histogram.iter().sum();
+        assert_eq!(total as usize, scene.volume().voxels().len());
+        let missing = ScanSource::File {
+            path: "/nonexistent/scan.nii".into(),
+            series: None,
+        };
+        let error = missing.load().unwrap_err();
+        assert!(error.contains("/nonexistent/scan.nii"), "{error}");
+        let unknown = ScanSource::Phantom {
+            name: "teapot".into(),
+            size: 16,
+        };
+        assert!(unknown.load().unwrap_err().contains("teapot"));
+    }
+}

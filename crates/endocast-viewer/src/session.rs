@@ -1,0 +1,509 @@
+//! The viewer's state without a window: the scene, the flying camera, the controls, the key
+//! frames and their playback, the annotations, and the render worker that draws the view.
+//! Every user action is a method here; the UI ([`crate::app`]) only maps input to them, so
+//! tests drive a session exactly as the window does.
+
+use crate::controller::{FlyCamera, LocalMove};
+use crate::scene::{Navigation, Scene};
+use crate::worker::{RenderWorker, View};
+use endocast_core::animation::{Animation, KeyFrame};
+use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
+use endocast_core::navigate::{default_view, LumenChoice};
+use endocast_core::pose::Pose;
+use endocast_core::presets::Preset;
+use endocast_core::render::{Mode, RenderSettings};
+use endocast_core::views::slices::Window;
+use glam::DVec3;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// The default size of the endoscopic view, pixels.
+pub const DEFAULT_VIEW_SIZE: [usize; 2] = [512, 512];
+
+/// How long a moving view waits for the last one's first frame before superseding it anyway.
+const MAX_WAIT_FOR_FRAME: Duration = Duration::from_millis(150);
+
+/// Everything the control panel sets.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Controls {
+    /// The procedure preset whose defaults the rest started from.
+    pub preset: &'static Preset,
+    /// Render mode.
+    pub mode: Mode,
+    /// Wall isovalue, physical units.
+    pub iso_hu: f64,
+    /// Opacity of the wall, 0–1.
+    pub iso_opacity: f32,
+    /// The lens.
+    pub projection: Projection,
+    /// Field of view, degrees across the image height.
+    pub fov_deg: f64,
+    /// Red/cyan anaglyph stereo.
+    pub stereo: bool,
+    /// The camera slides along the wall instead of entering it.
+    pub collision: bool,
+    /// Flying speed, mm/s.
+    pub speed_mm_s: f64,
+    /// Window of the slices.
+    pub window: Window,
+}
+
+impl Controls {
+    /// The clinical defaults of `preset`, collision on, 20 mm/s.
+    pub fn of_preset(preset: &'static Preset) -> Self {
+        Self {
+            preset,
+            mode: preset.mode,
+            iso_hu: preset.iso,
+            iso_opacity: preset.iso_opacity,
+            projection: preset.projection,
+            fov_deg: preset.fov_deg,
+            stereo: false,
+            collision: true,
+            speed_mm_s: 20.0,
+            window: preset.window,
+        }
+    }
+
+    /// The render settings: the preset's with the mode and the wall as set here.
+    pub fn settings(&self) -> RenderSettings {
+        let mut settings = self.preset.settings();
+        settings.mode = self.mode;
+        settings.iso_hu = self.iso_hu;
+        settings.iso_opacity = self.iso_opacity;
+        settings
+    }
+
+    /// The optics: lens and field of view.
+    pub fn optics(&self) -> Optics {
+        Optics {
+            projection: self.projection,
+            field: self.fov_deg,
+            ..Optics::default()
+        }
+    }
+}
+
+/// A placed label on the tissue, world mm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Annotation {
+    /// What the user called it.
+    pub label: String,
+    /// Where, world mm (LPS).
+    pub point_mm: DVec3,
+}
+
+/// A flight along the recorded key frames.
+#[derive(Debug, Clone)]
+pub struct Playback {
+    animation: Animation,
+    /// Arc length flown, mm.
+    pub s_mm: f64,
+    /// Playing (not paused).
+    pub playing: bool,
+}
+
+impl Playback {
+    /// Length of the flight, mm.
+    pub fn len_mm(&self) -> f64 {
+        self.animation.len_mm()
+    }
+
+    /// Whether the flight has reached its end.
+    pub fn finished(&self) -> bool {
+        self.s_mm >= self.animation.len_mm()
+    }
+}
+
+/// One open scan and everything done to it.
+#[derive(Debug)]
+pub struct Session {
+    scene: Arc<Scene>,
+    navigation: Option<Navigation>,
+    camera: FlyCamera,
+    home: FlyCamera,
+    /// The control panel's values.
+    pub controls: Controls,
+    view_size: [usize; 2],
+    worker: RenderWorker,
+    last_view: Option<View>,
+    last_submit: Option<(u64, Instant)>,
+    key_frames: Vec<KeyFrame>,
+    playback: Option<Playback>,
+    annotations: Vec<Annotation>,
+}
+
+impl Session {
+    /// A session on `scene` with `preset`'s defaults, starting at `pose` or, without one,
+    /// inside the preset's largest lumen (else framing the volume); `on_frame` is called from
+    /// the render thread after each delivered frame.
+    pub fn new(
+        scene: Arc<Scene>,
+        preset: &'static Preset,
+        pose: Option<Pose>,
+        on_frame: impl Fn() + Send + Sync + 'static,
+    ) -> Self {
+        let controls = Controls::of_preset(preset);
+        let pose = pose.unwrap_or_else(|| {
+            let choice = LumenChoice {
+                preset: Some(preset),
+                ..LumenChoice::default()
+            };
+            default_view(scene.volume(), Some(&choice), controls.fov_deg).pose()
+        });
+        let camera = FlyCamera::from_pose(&pose)
+            .or_else(|| FlyCamera::new(pose.eye_mm, DVec3::Z, DVec3::NEG_Y))
+            .unwrap_or_else(|| {
+                FlyCamera::new(DVec3::ZERO, DVec3::Z, DVec3::NEG_Y).expect("a valid frame")
+            });
+        let worker = RenderWorker::start(Arc::clone(&scene.renderer), on_frame);
+        let mut session = Self {
+            scene,
+            navigation: None,
+            camera,
+            home: camera,
+            controls,
+            view_size: DEFAULT_VIEW_SIZE,
+            worker,
+            last_view: None,
+            last_submit: None,
+            key_frames: Vec::new(),
+            playback: None,
+            annotations: Vec::new(),
+        };
+        session.find_lumen();
+        session
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// The flying camera.
+    pub fn fly_camera(&self) -> &FlyCamera {
+        &self.camera
+    }
+
+    /// The render worker.
+    pub fn worker(&self) -> &RenderWorker {
+        &self.worker
+    }
+
+    /// The lumen the camera is in, if it is in one of the preset's.
+    pub fn navigation(&self) -> Option<&Navigation> {
+        self.navigation.as_ref()
+    }
+
+    /// The size of the endoscopic view, pixels.
+    pub fn view_size(&self) -> [usize; 2] {
+        self.view_size
+    }
+
+    /// Renders the view at `size` pixels from now on (clamped to 16–4096).
+    pub fn set_view_size(&mut self, size: [usize; 2]) {
+        self.view_size = size.map(|n| n.clamp(16, 4096));
+    }
+
+    /// The endoscope camera now.
+    pub fn camera(&self) -> Result<Camera, CameraError> {
+        let c = &self.camera;
+        self.controls
+            .optics()
+            .camera(c.eye_mm(), c.eye_mm() + c.forward(), c.up(), self.view_size)
+    }
+
+    /// Sends the current view to the worker when it differs from the last one sent (or when the
+    /// camera has just stopped, so the view refines); returns the new request's generation.
+    pub fn sync(&mut self, moving: bool) -> Option<u64> {
+        let camera = self.camera().ok()?;
+        let stereo = self
+            .controls
+            .stereo
+            .then(|| StereoRig::focused_at(self.focus_mm()));
+        let view = View {
+            camera,
+            settings: self.controls.settings(),
+            stereo,
+            moving,
+        };
+        if self.last_view.as_ref() == Some(&view) {
+            return None;
+        }
+        // While moving, a new view waits until the last one has shown a frame (or is overdue):
+        // superseding every frame before it finishes would show none at all.
+        if moving && self.awaiting_first_frame() {
+            return None;
+        }
+        self.last_view = Some(view.clone());
+        let generation = self.worker.submit(view);
+        self.last_submit = Some((generation, Instant::now()));
+        Some(generation)
+    }
+
+    fn awaiting_first_frame(&self) -> bool {
+        let Some((generation, at)) = self.last_submit else {
+            return false;
+        };
+        let shown = self.worker.with_latest(|f| f.map_or(0, |f| f.generation));
+        shown < generation && at.elapsed() < MAX_WAIT_FOR_FRAME
+    }
+
+    /// The stereo focus: the distance to the wall ahead in the last frame (its centre pixel),
+    /// else 10 mm.
+    fn focus_mm(&self) -> f64 {
+        self.worker
+            .with_latest(|f| {
+                f.and_then(|f| {
+                    let [w, h] = f.camera.size();
+                    let d = *f.depth_mm.get(w / 2 + w * (h / 2))?;
+                    (d.is_finite() && d > 1.0).then_some(f64::from(d))
+                })
+            })
+            .unwrap_or(10.0)
+    }
+
+    /// Flies by `step` (sliding along the wall when collision is on); returns the distance
+    /// travelled, mm.
+    pub fn fly(&mut self, step: LocalMove) -> f64 {
+        let eye = self.camera.eye_mm();
+        let collider = self
+            .navigation
+            .as_ref()
+            .filter(|_| self.controls.collision)
+            .and_then(|n| n.collider_at(eye));
+        self.camera.translate(step, collider.as_ref())
+    }
+
+    /// Mouse-look: turns right by `yaw_rad` and up by `pitch_rad`.
+    pub fn turn(&mut self, yaw_rad: f64, pitch_rad: f64) {
+        self.camera.turn(yaw_rad, pitch_rad);
+    }
+
+    /// Rolls the image clockwise by `rad`.
+    pub fn roll(&mut self, rad: f64) {
+        self.camera.roll(rad);
+    }
+
+    /// Turns toward the surface seen at pixel `(x, y)` of the shown frame; false when that
+    /// pixel shows no surface.
+    pub fn look_at_pixel(&mut self, x: usize, y: usize) -> bool {
+        match self.surface_point(x, y) {
+            Some(p) => {
+                self.camera.look_toward(p);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The surface point seen at pixel `(x, y)` of the last delivered frame, world mm.
+    pub fn surface_point(&self, x: usize, y: usize) -> Option<DVec3> {
+        self.worker.with_latest(|f| {
+            let f = f?;
+            let [w, h] = f.camera.size();
+            if x >= w || y >= h {
+                return None;
+            }
+            let depth = f.depth_mm[x + w * y];
+            depth
+                .is_finite()
+                .then(|| f.camera.point_at(x, y, f64::from(depth)))
+                .flatten()
+        })
+    }
+
+    /// Jumps the eye to `p_mm` (a click in a slice), keeping the view direction, and finds the
+    /// lumen there for collision.
+    pub fn jump_to(&mut self, p_mm: DVec3) {
+        self.camera.jump_to(p_mm);
+        self.find_lumen();
+    }
+
+    /// Back to the starting view.
+    pub fn reset(&mut self) {
+        self.camera = self.home;
+        self.find_lumen();
+    }
+
+    /// Moves the camera to `camera` (a reopened case), finding its lumen.
+    pub fn set_camera(&mut self, camera: FlyCamera) {
+        self.camera = camera;
+        self.find_lumen();
+    }
+
+    /// Applies `preset`'s clinical defaults (mode, wall, lens, window), keeping the pose.
+    pub fn apply_preset(&mut self, preset: &'static Preset) {
+        let kept = (self.controls.collision, self.controls.speed_mm_s);
+        self.controls = Controls::of_preset(preset);
+        (self.controls.collision, self.controls.speed_mm_s) = kept;
+        self.find_lumen();
+    }
+
+    /// Finds the lumen around the eye for the preset's lumen threshold (the wall isovalue for a
+    /// preset without one); none when the eye is in the wall or outside.
+    pub fn find_lumen(&mut self) {
+        let eye = self.camera.eye_mm();
+        if let Some(nav) = &self.navigation {
+            if nav.distance_mm(eye) > 0.0 {
+                return;
+            }
+        }
+        let choice = LumenChoice {
+            preset: Some(self.controls.preset).filter(|p| p.lumen.is_some()),
+            iso: Some(self.controls.iso_hu),
+            ..LumenChoice::default()
+        };
+        self.navigation = choice
+            .resolve()
+            .ok()
+            .and_then(|(t, side)| Navigation::around(self.scene.volume(), eye, t, side));
+    }
+
+    /// Records the current view as a key frame (after the last).
+    pub fn record_key_frame(&mut self) -> Result<(), String> {
+        let c = &self.camera;
+        let key = KeyFrame::new(
+            c.eye_mm(),
+            c.forward(),
+            c.up(),
+            self.controls.fov_deg,
+            self.controls.iso_hu,
+            f64::from(self.controls.iso_opacity),
+        )
+        .map_err(|e| e.to_string())?;
+        self.key_frames.push(key);
+        Ok(())
+    }
+
+    /// The recorded key frames.
+    pub fn key_frames(&self) -> &[KeyFrame] {
+        &self.key_frames
+    }
+
+    /// Replaces the key frames (a reopened case, an imported path).
+    pub fn set_key_frames(&mut self, keys: Vec<KeyFrame>) {
+        self.key_frames = keys;
+        self.playback = None;
+    }
+
+    /// Deletes key frame `index`.
+    pub fn delete_key_frame(&mut self, index: usize) {
+        if index < self.key_frames.len() {
+            self.key_frames.remove(index);
+            self.playback = None;
+        }
+    }
+
+    /// Moves to key frame `index` (its pose, field of view and wall).
+    pub fn go_to_key_frame(&mut self, index: usize) {
+        if let Some(key) = self.key_frames.get(index).cloned() {
+            self.apply_key_frame(&key);
+        }
+    }
+
+    /// Starts playing the key frames from the first; fails with fewer than two distinct ones.
+    pub fn play(&mut self) -> Result<(), String> {
+        let animation = Animation::new(self.key_frames.clone()).map_err(|e| e.to_string())?;
+        self.playback = Some(Playback {
+            animation,
+            s_mm: 0.0,
+            playing: true,
+        });
+        self.advance_playback(0.0);
+        Ok(())
+    }
+
+    /// The flight being played, if any.
+    pub fn playback(&self) -> Option<&Playback> {
+        self.playback.as_ref()
+    }
+
+    /// Pauses or resumes the flight.
+    pub fn toggle_pause(&mut self) {
+        if let Some(p) = &mut self.playback {
+            p.playing = !p.playing;
+        }
+    }
+
+    /// Stops the flight (the camera stays where it is).
+    pub fn stop(&mut self) {
+        self.playback = None;
+    }
+
+    /// Moves the flight to arc length `s_mm` (scrubbing).
+    pub fn scrub(&mut self, s_mm: f64) {
+        if let Some(p) = &mut self.playback {
+            p.s_mm = s_mm.clamp(0.0, p.len_mm());
+        }
+        self.advance_playback(0.0);
+    }
+
+    /// Advances a playing flight by `dt_s` seconds at the flying speed and puts the camera
+    /// there; true while it is playing.
+    pub fn advance_playback(&mut self, dt_s: f64) -> bool {
+        let speed = self.controls.speed_mm_s;
+        let Some(p) = &mut self.playback else {
+            return false;
+        };
+        if p.playing {
+            p.s_mm = (p.s_mm + dt_s * speed).min(p.len_mm());
+        }
+        let key = p.animation.sample_at_arc(p.s_mm);
+        if p.finished() {
+            p.playing = false;
+        }
+        let playing = p.playing;
+        self.apply_key_frame(&key);
+        playing
+    }
+
+    fn apply_key_frame(&mut self, key: &KeyFrame) {
+        if let Some(camera) = FlyCamera::new(key.eye_mm, key.forward(), key.up()) {
+            self.camera = camera;
+        }
+        self.controls.fov_deg = key.fov_deg;
+        self.controls.iso_hu = key.iso_hu;
+        self.controls.iso_opacity = key.iso_opacity as f32;
+        self.find_lumen();
+    }
+
+    /// Labels the surface point seen at pixel `(x, y)`; false when no surface is seen there.
+    pub fn annotate_pixel(&mut self, x: usize, y: usize, label: &str) -> bool {
+        match self.surface_point(x, y) {
+            Some(point_mm) => {
+                self.annotations.push(Annotation {
+                    label: label.to_owned(),
+                    point_mm,
+                });
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The annotations, oldest first.
+    pub fn annotations(&self) -> &[Annotation] {
+        &self.annotations
+    }
+
+    /// Replaces the annotations (a reopened case).
+    pub fn set_annotations(&mut self, annotations: Vec<Annotation>) {
+        self.annotations = annotations;
+    }
+
+    /// Deletes annotation `index`.
+    pub fn delete_annotation(&mut self, index: usize) {
+        if index < self.annotations.len() {
+            self.annotations.remove(index);
+        }
+    }
+
+    /// The distance between the last two annotations, mm (a measurement).
+    pub fn measurement_mm(&self) -> Option<f64> {
+        match self.annotations.as_slice() {
+            [.., a, b] => Some(a.point_mm.distance(b.point_mm)),
+            _ => None,
+        }
+    }
+}

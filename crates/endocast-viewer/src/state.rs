@@ -1,0 +1,32 @@
+//! What the window keeps beside the session, shared by the window's parts.
+
+use crate::case::Autosave;
+use crate::session::Session;
+use crate::slices::SlicesView;
+use endocast_core::render::progressive::Stage;
+use std::time::Instant;
+
+/// The open session and what the window keeps beside it.
+pub(crate) struct Ready {
+    pub session: Session,
+    pub slices: SlicesView,
+    pub autosave: Autosave,
+    pub view_texture: Option<egui::TextureHandle>,
+    pub shown: Option<(u64, Stage)>,
+    /// Clicks in the view place marks instead of turning the camera.
+    pub marking: bool,
+    /// The label of the next mark.
+    pub label: String,
+    /// The last time the camera was moved by input.
+    pub last_input: Option<Instant>,
+}
+
+/// What the control panel asks of the application.
+pub(crate) enum Action {
+    /// Open the path typed in the panel (a scan, or a case file `.json`).
+    Open,
+    /// Save the case now.
+    SaveCase,
+    /// Show a line in the status bar.
+    Message(String),
+}

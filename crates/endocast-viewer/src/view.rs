@@ -1,0 +1,203 @@
+//! The endoscopic view: shows the newest delivered frame, flies with the keys and the mouse,
+//! and sends every change of view to the render worker.
+
+use crate::keys::{held_motion, Commands};
+use crate::session::Session;
+use crate::state::Ready;
+use egui::{Color32, Pos2, Rect, Sense, Stroke, TextureOptions, Vec2};
+use std::time::Instant;
+
+/// The longest UI frame step the flight integrates, seconds (a stalled frame never jumps the
+/// camera far).
+const MAX_DT_S: f64 = 0.1;
+
+/// Draws the view and flies the camera by this frame's input.
+pub(crate) fn view_ui(ui: &mut egui::Ui, ready: &mut Ready) {
+    let rect = ui.available_rect_before_wrap();
+    let ppp = f64::from(ui.ctx().pixels_per_point());
+    let size = [
+        (f64::from(rect.width()) * ppp).round() as usize,
+        (f64::from(rect.height()) * ppp).round() as usize,
+    ];
+    ready.session.set_view_size(size);
+    let response = ui.allocate_rect(rect, Sense::click_and_drag());
+    let mut moved = false;
+    if response.dragged() {
+        let d = response.drag_delta();
+        let fov = ready.session.controls.fov_deg.to_radians();
+        let rad_per_point = fov / f64::from(rect.height().max(1.0));
+        ready.session.turn(
+            f64::from(d.x) * rad_per_point,
+            -f64::from(d.y) * rad_per_point,
+        );
+        moved |= d != Vec2::ZERO;
+    }
+    if response.clicked() {
+        if let Some(pos) = response.interact_pointer_pos() {
+            moved |= click(ready, rect, pos, ppp);
+        }
+    }
+    moved |= keyboard(ui, &mut ready.session);
+    if moved {
+        ready.last_input = Some(Instant::now());
+    }
+    ready.session.sync(moved);
+    show_frame(ui, ready, rect);
+    draw_annotations(ui, &ready.session, rect, ppp);
+}
+
+/// A click in the view: turn toward the surface point there, or mark it.
+fn click(ready: &mut Ready, rect: Rect, pos: Pos2, ppp: f64) -> bool {
+    let x = (f64::from(pos.x - rect.min.x) * ppp) as usize;
+    let y = (f64::from(pos.y - rect.min.y) * ppp) as usize;
+    if ready.marking {
+        let label = ready.label.clone();
+        ready.session.annotate_pixel(x, y, &label);
+        false
+    } else {
+        ready.session.look_at_pixel(x, y)
+    }
+}
+
+/// Flies by the held keys and runs the pressed commands; true when the camera moved.
+fn keyboard(ui: &egui::Ui, session: &mut Session) -> bool {
+    if ui.ctx().wants_keyboard_input() {
+        return false;
+    }
+    let (dt, commands) = ui.input(|i| (f64::from(i.stable_dt).min(MAX_DT_S), Commands::pressed(i)));
+    let (step, roll) = ui.input(|i| held_motion(i, session.controls.speed_mm_s, dt));
+    let mut moved = false;
+    if step != Default::default() {
+        session.stop();
+        session.fly(step);
+        moved = true;
+    }
+    if roll != 0.0 {
+        session.roll(roll);
+        moved = true;
+    }
+    moved |= run_commands(session, commands);
+    if session.advance_playback(dt) {
+        ui.ctx().request_repaint();
+        moved = true;
+    }
+    if moved {
+        ui.ctx().request_repaint();
+    }
+    moved
+}
+
+/// Acts on the command keys; true when the camera moved.
+fn run_commands(session: &mut Session, c: Commands) -> bool {
+    if c.record_key_frame {
+        let _ = session.record_key_frame();
+    }
+    if c.toggle_collision {
+        session.controls.collision = !session.controls.collision;
+    }
+    if c.faster {
+        session.controls.speed_mm_s = (session.controls.speed_mm_s * 2.0).min(400.0);
+    }
+    if c.slower {
+        session.controls.speed_mm_s = (session.controls.speed_mm_s / 2.0).max(0.5);
+    }
+    if c.play_pause {
+        match session.playback() {
+            Some(p) if !p.finished() => session.toggle_pause(),
+            _ => {
+                let _ = session.play();
+            }
+        }
+    }
+    if c.reset {
+        session.reset();
+    }
+    c.reset || c.play_pause
+}
+
+/// Uploads the newest frame when it is new and draws it, aspect kept, in `rect`.
+fn show_frame(ui: &egui::Ui, ready: &mut Ready, rect: Rect) {
+    let worker = ready.session.worker();
+    let update = worker.with_latest(|f| {
+        let f = f?;
+        if ready.shown == Some((f.generation, f.stage)) {
+            return None;
+        }
+        let image = egui::ColorImage::from_rgb([f.image.width(), f.image.height()], f.image.rgb());
+        Some((f.generation, f.stage, image))
+    });
+    if let Some((generation, stage, image)) = update {
+        ready.shown = Some((generation, stage));
+        match &mut ready.view_texture {
+            Some(t) => t.set(image, TextureOptions::LINEAR),
+            None => {
+                ready.view_texture = Some(ui.ctx().load_texture(
+                    "endoscope",
+                    image,
+                    TextureOptions::LINEAR,
+                ));
+            }
+        }
+    }
+    if let Some(texture) = &ready.view_texture {
+        let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+        ui.painter().image(
+            texture.id(),
+            fit(rect, texture.aspect_ratio()),
+            uv,
+            Color32::WHITE,
+        );
+    }
+    if let Some(error) = worker.error() {
+        ui.painter().text(
+            rect.left_top() + Vec2::splat(8.0),
+            egui::Align2::LEFT_TOP,
+            error,
+            egui::FontId::proportional(14.0),
+            Color32::LIGHT_RED,
+        );
+    }
+}
+
+/// The largest rectangle of `aspect` (width / height) centred in `rect`.
+fn fit(rect: Rect, aspect: f32) -> Rect {
+    let size = if rect.width() / rect.height().max(1.0) > aspect {
+        Vec2::new(rect.height() * aspect, rect.height())
+    } else {
+        Vec2::new(rect.width(), rect.width() / aspect.max(1e-3))
+    };
+    Rect::from_center_size(rect.center(), size)
+}
+
+/// The marks, projected into the view, and the measurement between the last two.
+fn draw_annotations(ui: &egui::Ui, session: &Session, rect: Rect, ppp: f64) {
+    let Ok(camera) = session.camera() else {
+        return;
+    };
+    let painter = ui.painter_at(rect);
+    let to_screen = |(x, y): (f64, f64)| rect.min + Vec2::new((x / ppp) as f32, (y / ppp) as f32);
+    let mut last = Vec::new();
+    for a in session.annotations() {
+        if let Some(p) = camera.project(a.point_mm).map(to_screen) {
+            painter.circle_stroke(p, 5.0, Stroke::new(2.0, Color32::YELLOW));
+            painter.text(
+                p + Vec2::new(8.0, -8.0),
+                egui::Align2::LEFT_BOTTOM,
+                &a.label,
+                egui::FontId::proportional(14.0),
+                Color32::YELLOW,
+            );
+            last.push(p);
+        }
+    }
+    if let (Some(mm), [.., a, b]) = (session.measurement_mm(), last.as_slice()) {
+        painter.line_segment([*a, *b], Stroke::new(1.5, Color32::YELLOW));
+        painter.text(
+            a.lerp(*b, 0.5),
+            egui::Align2::CENTER_BOTTOM,
+            format!("{mm:.1} mm"),
+            egui::FontId::proportional(14.0),
+            Color32::YELLOW,
+        );
+    }
+}

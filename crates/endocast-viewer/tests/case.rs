@@ -1,0 +1,165 @@
+//! Case files: reopened exactly, strict on reading, and never lost to a kill during a save.
+
+use crate::common::{settled, tube_session};
+use endocast_core::presets::Preset;
+use endocast_viewer::case::{Autosave, Case};
+use endocast_viewer::controller::LocalMove;
+use endocast_viewer::scene::Scene;
+use endocast_viewer::session::Session;
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Opens the case at `path` as the application does: its scan, its preset, then its state.
+fn reopen(path: &std::path::Path) -> Session {
+    let case = Case::read(path).unwrap();
+    let volume = case.scan.load().unwrap();
+    let scene = Arc::new(Scene::new(case.scan.clone(), volume));
+    let preset = Preset::find(&case.controls.preset).unwrap();
+    let mut session = Session::new(scene, preset, None, || {});
+    session.set_view_size([64, 64]);
+    case.apply(&mut session, path).unwrap();
+    session
+}
+
+#[test]
+fn a_saved_case_reopens_to_the_same_view_with_its_marks_and_key_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tube.endocast-case.json");
+    let (mut session, _) = tube_session();
+    session.turn(0.4, 0.2);
+    session.fly(LocalMove {
+        forward_mm: 2.0,
+        ..LocalMove::default()
+    });
+    session.controls.iso_hu = -450.0;
+    session.controls.iso_opacity = 0.8;
+    session.controls.fov_deg = 70.0;
+    session.record_key_frame().unwrap();
+    settled(&mut session);
+    assert!(session.annotate_pixel(30, 34, "lesion"));
+    let shown = settled(&mut session);
+    Autosave::new(path.clone(), Duration::ZERO)
+        .tick(&session, true)
+        .unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.contains("\"lesion\"") && text.contains("endocast-case"),
+        "{text}"
+    );
+
+    let mut reopened = reopen(&path);
+    assert_eq!(reopened.controls, session.controls);
+    assert_eq!(reopened.annotations(), session.annotations());
+    assert_eq!(reopened.key_frames().len(), 1);
+    let again = settled(&mut reopened);
+    assert_eq!(again.camera, shown.camera);
+    assert!(
+        again.image.rgb() == shown.image.rgb(),
+        "the reopened view differs"
+    );
+}
+
+#[test]
+fn bad_case_files_are_refused_with_the_file_and_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let (session, _) = tube_session();
+    let good = dir.path().join("good.json");
+    Case::of(&session, 1).write(&good).unwrap();
+    let text = std::fs::read_to_string(&good).unwrap();
+    for (name, content, expect) in [
+        ("garbage.json", "{not json".to_owned(), "garbage.json"),
+        (
+            "format.json",
+            text.replace("endocast-case", "other"),
+            "format",
+        ),
+        (
+            "preset.json",
+            text.replace("colonoscopy", "gastroscopy"),
+            "gastroscopy",
+        ),
+        (
+            "key.json",
+            text.replace("\"revision\"", "\"surprise\""),
+            "surprise",
+        ),
+    ] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, content).unwrap();
+        let error = Case::read(&path)
+            .and_then(|case| case.controls(&path).map(|_| ()))
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains(name) && error.contains(expect), "{error}");
+    }
+    let missing = Case::read(&dir.path().join("missing.json")).unwrap_err();
+    assert!(missing.to_string().contains("missing.json"));
+}
+
+/// The child of the kill test: saves a changing case as fast as it can, saying which revision
+/// each finished save holds.
+fn autosave_forever(path: &std::path::Path) {
+    let (mut session, _) = tube_session();
+    let mut autosave = Autosave::new(path.to_owned(), Duration::ZERO);
+    let mut revision = 0;
+    loop {
+        session.turn(0.01, 0.0);
+        if autosave.tick(&session, true).unwrap() {
+            revision += 1;
+            println!("saved {revision}");
+        }
+    }
+}
+
+#[test]
+fn killing_during_autosave_loses_nothing_saved_before() {
+    if let Some(path) = std::env::var_os("ENDOCAST_AUTOSAVE_CHILD") {
+        autosave_forever(std::path::Path::new(&path));
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    for delay_ms in [150, 400, 900] {
+        let mut child = Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "case::killing_during_autosave_loses_nothing_saved_before",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env("ENDOCAST_AUTOSAVE_CHILD", &path)
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let stdout = child.stdout.take().unwrap();
+        let lines = std::thread::spawn(move || {
+            let mut confirmed = Vec::new();
+            for line in BufReader::new(stdout).lines() {
+                let Ok(line) = line else { break };
+                if let Some(n) = line.strip_prefix("saved ") {
+                    confirmed.push(n.parse::<u64>().unwrap());
+                }
+            }
+            confirmed
+        });
+        // Wait for the first save, then let it run and kill it in the middle of a save.
+        let start = Instant::now();
+        while !path.exists() && start.elapsed() < Duration::from_secs(60) {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        child.kill().unwrap();
+        child.wait().unwrap();
+        let confirmed = lines.join().unwrap();
+        let last = *confirmed.last().expect("the child saved");
+        let case = Case::read(&path).expect("the case file is whole after the kill");
+        assert!(
+            case.revision >= last,
+            "saved {last}, the file holds {}",
+            case.revision
+        );
+        assert!(confirmed.len() > 3, "only {} saves", confirmed.len());
+    }
+}

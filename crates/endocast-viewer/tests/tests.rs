@@ -1,0 +1,9 @@
+//! The viewer's tests, in one binary (one link step): the session driven as the window drives
+//! it, the case files, and the window itself on a headless egui context.
+
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
+
+mod case;
+mod common;
+mod flight;
+mod ui;
