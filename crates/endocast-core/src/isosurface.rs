@@ -43,6 +43,7 @@ pub fn isosurface(volume: &Volume, iso: f64, side: LumenSide) -> Result<Triangle
 }
 
 /// The surface between the voxels for which `inside(voxel, value)` holds and the others.
+/// Slabs of cubes list their triangles as grid-edge ids; each edge's vertex is then solved once.
 fn extract(
     volume: &Volume,
     iso: f64,
@@ -61,28 +62,27 @@ fn extract(
         iso,
         inside,
     };
-    let slabs: Vec<Slab> = (0..dims[2] - 1)
+    let slabs: Vec<Vec<[u64; 3]>> = (0..dims[2] - 1)
         .into_par_iter()
         .map(|k| field.slab(k))
         .collect();
-    let mut edges: Vec<(u64, DVec3)> = slabs.iter().flat_map(|s| s.edges.iter().copied()).collect();
-    edges.par_sort_unstable_by_key(|e| e.0);
-    edges.dedup_by_key(|e| e.0);
-    let index = |id: u64| edges.binary_search_by_key(&id, |e| e.0).unwrap_or(0) as u32;
+    let mut edges: Vec<u64> = slabs
+        .par_iter()
+        .flat_map_iter(|s| s.iter().flatten().copied())
+        .collect();
+    edges.par_sort_unstable();
+    edges.dedup();
+    let index = |id: u64| edges.binary_search(&id).unwrap_or(0) as u32;
     let triangles: Vec<[u32; 3]> = slabs
         .par_iter()
-        .flat_map_iter(|s| s.triangles.iter().map(|t| t.map(index)))
+        .flat_map_iter(|s| s.iter().map(|t| t.map(index)))
         .collect();
     let g = volume.geometry();
-    let vertices = edges.iter().map(|e| g.world_of(e.1)).collect();
+    let vertices = edges
+        .par_iter()
+        .map(|&id| g.world_of(field.edge_vertex(id)))
+        .collect();
     TriangleMesh::new(vertices, triangles)
-}
-
-/// One slab's share: the edges it put vertices on (id, voxel position) and its triangles as
-/// edge ids.
-struct Slab {
-    edges: Vec<(u64, DVec3)>,
-    triangles: Vec<[u64; 3]>,
 }
 
 /// The sampled field and the inside test.
@@ -103,12 +103,10 @@ impl Field<'_> {
         self.table[usize::from(self.voxels[self.linear(v)])]
     }
 
-    /// The cubes `(·, ·, k)`.
-    fn slab(&self, k: usize) -> Slab {
-        let mut slab = Slab {
-            edges: Vec::new(),
-            triangles: Vec::new(),
-        };
+    /// The triangles of the cubes `(·, ·, k)`, as the ids of the grid edges their vertices lie
+    /// on.
+    fn slab(&self, k: usize) -> Vec<[u64; 3]> {
+        let mut triangles = Vec::new();
         let [nx, ny, _] = self.dims;
         // The inside flags of planes k and k + 1, computed once.
         let plane = |k: usize| -> Vec<bool> {
@@ -132,51 +130,50 @@ impl Field<'_> {
                     }
                 }
                 if flags != 0 && flags != 0xff {
-                    self.cube([i, j, k], flags, &mut slab);
+                    self.cube([i, j, k], flags, &mut triangles);
                 }
             }
         }
-        slab
+        triangles
     }
 
     /// The triangles of the cube at `base` whose inside corners are the bits of `flags`.
-    fn cube(&self, base: [usize; 3], flags: u8, slab: &mut Slab) {
-        let values: [f64; 8] = std::array::from_fn(|c| self.value(corner(base, c as u8)));
-        let cube = Cube {
-            field: self,
-            base,
-            values,
-        };
+    fn cube(&self, base: [usize; 3], flags: u8, triangles: &mut Vec<[u64; 3]>) {
         for tet in TETRAHEDRA {
-            let (ins, outs): (Vec<u8>, Vec<u8>) = tet.iter().partition(|&&c| flags >> c & 1 == 1);
-            match (ins.as_slice(), outs.as_slice()) {
-                ([a], [b, c, d]) | ([b, c, d], [a]) => {
-                    let edges = [(*a, *b), (*a, *c), (*a, *d)];
-                    cube.triangle(edges, &ins, &outs, slab);
+            let mut split = ([0u8; 4], 0, [0u8; 4], 0);
+            for c in tet {
+                if flags >> c & 1 == 1 {
+                    split.0[split.1] = c;
+                    split.1 += 1;
+                } else {
+                    split.2[split.3] = c;
+                    split.3 += 1;
                 }
-                ([a, b], [c, d]) => {
-                    let (ac, ad, bd, bc) = ((*a, *c), (*a, *d), (*b, *d), (*b, *c));
-                    cube.triangle([ac, ad, bd], &ins, &outs, slab);
-                    cube.triangle([ac, bd, bc], &ins, &outs, slab);
+            }
+            let (ins, outs) = (&split.0[..split.1], &split.2[..split.3]);
+            let mut add = |edges| triangles.push(self.triangle(base, edges, ins, outs));
+            match (ins, outs) {
+                (&[a], &[b, c, d]) | (&[b, c, d], &[a]) => add([(a, b), (a, c), (a, d)]),
+                (&[a, b], &[c, d]) => {
+                    add([(a, c), (a, d), (b, d)]);
+                    add([(a, c), (b, d), (b, c)]);
                 }
                 _ => {}
             }
         }
     }
-}
 
-/// One cube being cut: its lowest voxel and its corners' values.
-struct Cube<'a> {
-    field: &'a Field<'a>,
-    base: [usize; 3],
-    values: [f64; 8],
-}
-
-impl Cube<'_> {
-    /// Adds the triangle on the corner-pair `edges`, turned to face from the `ins` corners to
-    /// the `outs`.
-    fn triangle(&self, edges: [(u8, u8); 3], ins: &[u8], outs: &[u8], slab: &mut Slab) {
-        let points = edges.map(|(p, q)| self.vertex(p, q));
+    /// The triangle of the cube at `base` on the corner-pair `edges`, turned to face from the
+    /// `ins` corners to the `outs`. The turn is decided on the edges' midpoints: the vertices
+    /// lie strictly inside their edges, where a tetrahedron's cut never changes its side.
+    fn triangle(
+        &self,
+        base: [usize; 3],
+        edges: [(u8, u8); 3],
+        ins: &[u8],
+        outs: &[u8],
+    ) -> [u64; 3] {
+        let points = edges.map(|(p, q)| (local(p) + local(q)) * 0.5);
         let centre = |cs: &[u8]| cs.iter().map(|&c| local(c)).sum::<DVec3>() / cs.len() as f64;
         let outward = centre(outs) - centre(ins);
         let normal = (points[1] - points[0]).cross(points[2] - points[0]);
@@ -185,48 +182,70 @@ impl Cube<'_> {
         } else {
             [0, 2, 1]
         };
-        let base = DVec3::from(self.base.map(|v| v as f64));
-        let mut ids = [0u64; 3];
-        for (slot, &k) in ids.iter_mut().zip(&order) {
-            let (p, q) = edges[k];
-            let id = self.edge_id(p, q);
-            slab.edges.push((id, base + points[k]));
-            *slot = id;
-        }
-        slab.triangles.push(ids);
+        order.map(|k| self.edge_id(base, edges[k]))
     }
 
-    /// The global id of the grid edge between corners `p` and `q`: its lower voxel's index
-    /// and the direction bits (Kuhn's edges all run from a corner to one with more bits set).
-    fn edge_id(&self, p: u8, q: u8) -> u64 {
+    /// The global id of the grid edge between corners `p` and `q` of the cube at `base`: its
+    /// lower voxel's index and the direction bits (Kuhn's edges all run from a corner to one
+    /// with more bits set).
+    fn edge_id(&self, base: [usize; 3], (p, q): (u8, u8)) -> u64 {
         let (lo, hi) = if p & q == p { (p, q) } else { (q, p) };
-        let v = self.field.linear(corner(self.base, lo)) as u64;
+        let v = self.linear(corner(base, lo)) as u64;
         v * 8 + u64::from(hi ^ lo)
     }
 
-    /// Where the trilinear field crosses the isovalue between corners `p` and `q`, in the
-    /// cube's local coordinates (0–1). A pair with no crossing (a neighbour on the lumen's
-    /// side outside the lumen) gives the midpoint.
-    fn vertex(&self, p: u8, q: u8) -> DVec3 {
-        let (a, b) = (local(p), local(q));
-        let iso = self.field.iso;
-        let f = |s: f64| self.trilinear(a + (b - a) * s) - iso;
+    /// The voxel position where the trilinear field crosses the isovalue on the grid edge `id`
+    /// (from its lower voxel along its direction bits). An edge with no crossing (a neighbour
+    /// on the lumen's side outside the lumen) gives its midpoint.
+    fn edge_vertex(&self, id: u64) -> DVec3 {
+        let (linear, dir) = ((id / 8) as usize, (id % 8) as u8);
+        let [nx, ny, _] = self.dims;
+        let lo = [linear % nx, linear / nx % ny, linear / (nx * ny)];
+        // Only the corners on the edge's face (or cube) enter the field along it.
+        let values = std::array::from_fn(|c| {
+            let c = c as u8;
+            if c & !dir == 0 {
+                self.value(corner(lo, c))
+            } else {
+                0.0
+            }
+        });
+        let cube = Cube {
+            values,
+            iso: self.iso,
+        };
+        DVec3::from(lo.map(|v| v as f64)) + cube.crossing(local(dir))
+    }
+}
+
+/// The field of one cube (its corners' values) and the isovalue.
+struct Cube {
+    values: [f64; 8],
+    iso: f64,
+}
+
+impl Cube {
+    /// Where the trilinear field crosses the isovalue between corner 0 and the corner at local
+    /// position `b` (0–1 per axis), in local coordinates: exact on an axis edge, safeguarded
+    /// (Illinois) regula falsi on a diagonal. No crossing gives the midpoint.
+    fn crossing(&self, b: DVec3) -> DVec3 {
+        let f = |s: f64| self.trilinear(b * s) - self.iso;
         let (mut s0, mut s1) = (0.0, 1.0);
-        let (mut f0, mut f1) = (self.values[p as usize] - iso, self.values[q as usize] - iso);
+        let far = self.values[(b.x + 2.0 * b.y + 4.0 * b.z) as usize];
+        let (mut f0, mut f1) = (self.values[0] - self.iso, far - self.iso);
         if (f0 < 0.0) == (f1 < 0.0) {
-            return a + (b - a) * 0.5;
+            return b * 0.5;
         }
         let linear = |f0: f64, f1: f64| if f1 != f0 { f0 / (f0 - f1) } else { 0.5 };
-        if (p ^ q).count_ones() == 1 {
-            return a + (b - a) * linear(f0, f1);
+        if b.element_sum() == 1.0 {
+            return b * linear(f0, f1);
         }
-        // Illinois regula falsi: the bracket always holds the crossing.
         let mut side = 0i8;
         for _ in 0..ROOT_STEPS {
             let s = s0 + (s1 - s0) * linear(f0, f1);
             let fs = f(s);
             if fs == 0.0 || (s1 - s0) < 1e-9 {
-                return a + (b - a) * s;
+                return b * s;
             }
             if (fs < 0.0) == (f0 < 0.0) {
                 (s0, f0) = (s, fs);
@@ -242,7 +261,7 @@ impl Cube<'_> {
                 side = 1;
             }
         }
-        a + (b - a) * (s0 + (s1 - s0) * linear(f0, f1))
+        b * (s0 + (s1 - s0) * linear(f0, f1))
     }
 
     /// The trilinear field at local position `x` (0–1 per axis).

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# `endocast mesh` against VTK's flying edges (issue 19, item 4) on the same volumes and
+# isovalues: the whole volume's isosurface, and the connected lumen around a point
+# (endocast: --from; VTK: flying edges + vtkPolyDataConnectivityFilter, closest region).
+# Prints one line per run: wall and CPU seconds (median of RUNS), triangles, vertices.
+#
+# Usage (repository root, VTK from ../shared/peers/install_vtk.sh):
+#   bench/mesh_vs_vtk.sh [RUNS]
+set -euo pipefail
+runs=${1:-3}
+out=${OUT:-bench/out}
+py=${VTK_PYTHON:-/opt/peers-venv/bin/python}
+mkdir -p "$out"
+cargo build --release -p endocast-cli >/dev/null
+bin=target/release/endocast
+colon=$out/colon256.nii.gz
+[ -f "$colon" ] || $bin phantom colon --size 256 -o "$colon" >/dev/null
+cthead=$out/cthead.nii.gz
+[ -f "$cthead" ] || $bin convert ../shared/data/head-ct-stanford-cthead -o "$cthead" >/dev/null
+
+# endocast_runs VOLUME ISO [X,Y,Z]: median wall and CPU seconds of `endocast mesh`.
+endocast_runs() {
+  local from=() walls=() cpus=()
+  [ -n "${3:-}" ] && from=(--from "$3")
+  for _ in $(seq "$runs"); do
+    /usr/bin/time -f "%e %U %S" -o "$out/time.txt" \
+      $bin mesh "$1" --iso "$2" "${from[@]}" -o "$out/mesh.stl" >"$out/mesh.txt"
+    read -r wall user sys <"$out/time.txt"
+    walls+=("$wall"); cpus+=("$(echo "$user + $sys" | bc)")
+  done
+  printf 'endocast mesh %s --iso %s %s: wall %s s, CPU %s s (medians of %s); %s\n' "$1" "$2" \
+    "${from[*]}" "$(printf '%s\n' "${walls[@]}" | sort -n | sed -n "$(((runs + 1) / 2))p")" \
+    "$(printf '%s\n' "${cpus[@]}" | sort -n | sed -n "$(((runs + 1) / 2))p")" "$runs" \
+    "$(cat "$out/mesh.txt")"
+}
+
+echo "== colon phantom 256 (256×256×239, 1 mm), −500 HU"
+endocast_runs "$colon" -500
+"$py" bench/vtk_mesh.py "$colon" --iso -500 --runs "$runs"
+endocast_runs "$colon" -500 56.5,-11.5,-18
+"$py" bench/vtk_mesh.py "$colon" --iso -500 --runs "$runs" --from-ijk 184 116 101
+echo "== CThead (256×256×99), skin/air −500 HU (stored HU + 1024)"
+endocast_runs "$cthead" -500
+"$py" bench/vtk_mesh.py "$cthead" --iso -500 --runs "$runs"
