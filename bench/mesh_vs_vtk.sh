@@ -16,7 +16,7 @@ bin=target/release/endocast
 colon=$out/colon256.nii.gz
 [ -f "$colon" ] || $bin phantom colon --size 256 -o "$colon" >/dev/null
 cthead=$out/cthead.nii.gz
-[ -f "$cthead" ] || $bin convert ../shared/data/head-ct-stanford-cthead -o "$cthead" >/dev/null
+[ -f "$cthead" ] || $bin convert ../shared/data/head-ct-stanford-cthead/CThead.nhdr -o "$cthead" >/dev/null
 
 # endocast_runs VOLUME ISO [X,Y,Z]: median wall and CPU seconds of `endocast mesh`.
 endocast_runs() {
@@ -39,6 +39,6 @@ endocast_runs "$colon" -500
 "$py" bench/vtk_mesh.py "$colon" --iso -500 --runs "$runs"
 endocast_runs "$colon" -500 56.5,-11.5,-18
 "$py" bench/vtk_mesh.py "$colon" --iso -500 --runs "$runs" --from-ijk 184 116 101
-echo "== CThead (256×256×99), skin/air −500 HU (stored HU + 1024)"
-endocast_runs "$cthead" -500
-"$py" bench/vtk_mesh.py "$cthead" --iso -500 --runs "$runs"
+echo "== CThead (256×256×113, 1×1×2 mm), skin/air at 550 (stored, about −470 HU)"
+endocast_runs "$cthead" 550
+"$py" bench/vtk_mesh.py "$cthead" --iso 550 --runs "$runs"
