@@ -146,7 +146,8 @@ impl Prepared {
                 *out = around(integrator, out, hits, in_front, dir);
             }
             _ => {
-                if let Some(split) = self.split_task(integrator, row, x, hits) {
+                let surface = out.depth_mm;
+                if let Some(split) = self.split_task(integrator, row, x, hits, surface) {
                     *task = split;
                 }
             }
@@ -154,13 +155,15 @@ impl Prepared {
     }
 
     /// Pixel `(x, row.y)`'s ray walked again, ended at the opaque hit and split at the
-    /// translucent ones.
+    /// translucent ones. `surface` is where the ray walked without geometry met the hybrid
+    /// mode's isosurface (NaN: nowhere).
     fn split_task(
         &self,
         integrator: &Integrator<'_>,
         row: &SceneRow<'_, '_>,
         x: usize,
         hits: &[Hit],
+        surface: f32,
     ) -> Option<RayTask> {
         let ray = self.ray(row.camera, x, row.y)?;
         let mut task = self.task_of(&ray, x, row.y)?;
@@ -173,13 +176,23 @@ impl Prepared {
             Some((last, rest)) if last.opacity >= 1.0 => (rest, Some(last)),
             _ => (hits, None),
         };
-        if let Some(opaque) = opaque {
-            task.march.limit(opaque.t_mm);
+        let end_mm = opaque.map_or(f32::INFINITY, |hit| hit.t_mm);
+        if opaque.is_some() {
+            // A surface crossed within a step in front of the opaque hit is found only with the
+            // sample behind the crossing: the search may look that far, the compositing
+            // stops at the hit (`Split::end_mm`).
+            let search_end = if surface < end_mm && self.params.mode == Mode::Hybrid {
+                end_mm.max(surface + task.march.grid().step)
+            } else {
+                end_mm
+            };
+            task.march.limit(search_end);
         }
         let split = Split {
             ray: &ray.voxel,
             bricks: self.renderer.grid.bricks(),
             dir: task.dir_world,
+            end_mm,
         };
         task.out = integrator.run_split(&mut task.march, &split, translucent);
         if let (Some(hit), false) = (opaque, task.out.terminated) {
@@ -190,11 +203,13 @@ impl Prepared {
     }
 }
 
-/// A split ray's voxel-space ray, brick counts and unit world direction.
+/// A split ray's voxel-space ray, brick counts, unit world direction and where its opaque hit
+/// ends it, mm (infinity: none).
 pub(super) struct Split<'a> {
     ray: &'a VoxelRay,
     bricks: [usize; 3],
     dir: Vec3,
+    end_mm: f32,
 }
 
 impl Integrator<'_> {
@@ -209,7 +224,8 @@ impl Integrator<'_> {
                 let iso = self.params.lower.iso;
                 let depth = self
                     .search(march, iso, &mut ())
-                    .map(|bracket| self.refine(march.grid(), iso, bracket));
+                    .map(|bracket| self.refine(march.grid(), iso, bracket))
+                    .filter(|&depth| depth < split.end_mm);
                 let Some(depth) = depth else {
                     for hit in hits {
                         add_hit(self, &mut out.accum, hit, dir);
@@ -222,7 +238,7 @@ impl Integrator<'_> {
                 }
                 out.depth_mm = depth;
                 self.lit_surface(march, dir, &mut out);
-                let from = (depth, span.1);
+                let from = (depth, span.1.min(split.end_mm));
                 self.parts(march, split, from, &hits[behind..], &mut out, |m, out| {
                     self.composite(m, out, dir, false, &mut ());
                 });

@@ -340,3 +340,59 @@ fn the_colon_mesh_is_watertight_on_the_isosurface_and_drawn_where_the_wall_is() 
         "{off} of {compared} pixels off by 0.2 voxel or more"
     );
 }
+
+/// An opaque plane just behind a translucent hybrid wall (the sphere's wall meets the plane on
+/// a circle, so every distance between them down to zero occurs): wherever the wall lies in
+/// front of the plane it is found at the depth the render without geometry gives, also within
+/// the last step before the plane (where a search ended at the plane would miss it).
+#[test]
+fn a_translucent_wall_just_in_front_of_opaque_geometry_is_still_found() {
+    let (renderer, shell) = shell();
+    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
+    let px = 96;
+    let camera = camera_at_centre(centre, px);
+    let d = 0.8 * shell.inner_radius_vox;
+    let (a, b) = (3.0 * shell.inner_radius_vox, d);
+    let corners = [
+        centre + DVec3::new(-a, -a, b),
+        centre + DVec3::new(a, -a, b),
+        centre + DVec3::new(a, a, b),
+        centre + DVec3::new(-a, a, b),
+    ];
+    let plane = TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]]).unwrap();
+    let mut translucent = settings(Mode::Hybrid);
+    translucent.iso_opacity = 0.6;
+    let draw = |scene: Option<Scene>| {
+        let mut prepared = renderer.prepare(&translucent).unwrap();
+        prepared.set_scene(scene.map(Arc::new));
+        prepared.render(&camera)
+    };
+    let mut scene = Scene::new();
+    scene.add_mesh(plane, Material::MESH);
+    let (with, without) = (draw(Some(scene)), draw(None));
+    let (mut walls, mut close) = (0, 0);
+    for y in 0..px {
+        for x in 0..px {
+            let i = x + px * y;
+            let ray = camera.pixel_ray(x, y).unwrap();
+            let t_plane = (d / ray.dir.z) as f32;
+            let wall = without.depth_mm[i];
+            if wall < t_plane {
+                walls += 1;
+                close += usize::from(t_plane - wall < 0.5);
+                assert!(
+                    (with.depth_mm[i] - wall).abs() < 1e-3,
+                    "({x},{y}) wall {wall} plane {t_plane}: {}",
+                    with.depth_mm[i]
+                );
+                assert_eq!(with.color[i].transmittance, 0.0, "({x},{y})");
+            } else {
+                assert!((with.depth_mm[i] - t_plane).abs() < 1e-3, "({x},{y})");
+            }
+        }
+    }
+    assert!(
+        walls > 500 && close > 20,
+        "{walls} walls, {close} within half a mm"
+    );
+}
