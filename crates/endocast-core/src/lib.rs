@@ -13,6 +13,7 @@
 //! ```
 
 pub mod animation;
+pub mod annotate;
 pub mod camera;
 pub mod coverage;
 pub mod flight;

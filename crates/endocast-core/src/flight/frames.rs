@@ -3,9 +3,10 @@
 use super::error::FlightError;
 use super::overview::Overview;
 use super::Shot;
+use crate::annotate::{self, Annotations, DrawOptions, SurfaceView};
 use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
-use crate::render::{Camera, Prepared, RenderSettings, RenderStats, Renderer, StereoFrames};
+use crate::render::{Camera, Frame, Prepared, RenderSettings, RenderStats, Renderer, StereoFrames};
 use crate::scene::Scene;
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
@@ -74,6 +75,8 @@ pub struct Flight {
     prepared: Option<Prepared>,
     /// Geometry drawn in every endoscope frame.
     scene: Option<Arc<Scene>>,
+    /// Annotations drawn as decals on every endoscope frame.
+    marks: Option<Annotations>,
     /// The frames rendered into (the second for a stereo pair's right eye), their buffers
     /// reused from shot to shot.
     frames: StereoFrames,
@@ -90,6 +93,7 @@ impl Flight {
             coverage: None,
             prepared: None,
             scene: None,
+            marks: None,
             frames: StereoFrames::default(),
         }
     }
@@ -101,6 +105,22 @@ impl Flight {
             prepared.set_scene(scene.clone());
         }
         self.scene = scene;
+    }
+
+    /// Draws `marks` on every endoscope frame from now on, where the view sees the tissue they
+    /// were put on.
+    pub fn set_annotations(&mut self, marks: Option<Annotations>) {
+        self.marks = marks;
+    }
+
+    /// `image`, the picture of `frame` taken by `camera`, with the annotations drawn on it.
+    fn with_marks(&self, mut image: Image, camera: &Camera, frame: &Frame) -> Image {
+        if let Some(marks) = &self.marks {
+            let spacing = self.renderer.volume().geometry().spacing_mm();
+            let view = SurfaceView::new(camera, &frame.depth_mm, spacing);
+            annotate::draw(&mut image, &view, marks.items(), &DrawOptions::default());
+        }
+        image
     }
 
     /// The dashboard's overview (rendered at [`Flight::overview_size`]) and the route drawn on it.
@@ -154,7 +174,10 @@ impl Flight {
         let (camera, eyes, stats) = self.render_shot(shot, settings)?;
         let endoscope = match (self.options.stereo, eyes) {
             (Some(stereo), Some([left, right])) => stereo::combine(&left, &right, stereo.output)?,
-            _ => Image::from_frame(&self.frames.eyes[0], settings.background)?,
+            _ => {
+                let image = Image::from_frame(&self.frames.eyes[0], settings.background)?;
+                self.with_marks(image, &camera, &self.frames.eyes[0])
+            }
         };
         let image = match self.options.layout {
             Layout::Endoscope => endoscope,
@@ -208,11 +231,12 @@ impl Flight {
                 prepared.render_stereo_into(&camera, &rig, &mut self.frames)?;
                 let [left, right] = &self.frames.eyes;
                 let background = settings.background;
+                let cameras = rig.eyes(&camera)?;
                 let eyes = [
-                    Image::from_frame(left, background)?,
-                    Image::from_frame(right, background)?,
+                    self.with_marks(Image::from_frame(left, background)?, &cameras[0], left),
+                    self.with_marks(Image::from_frame(right, background)?, &cameras[1], right),
                 ];
-                (rig.eyes(&camera)?[0], Some(eyes))
+                (cameras[0], Some(eyes))
             }
         };
         let mut stats = self.frames.eyes[0].stats;

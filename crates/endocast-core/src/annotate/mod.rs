@@ -1,0 +1,223 @@
+//! Drawing and measuring on tissue (Sinus Endoscopy §4.4, "Drawing Facilities"): points with
+//! text labels, strokes (polylines of surface points) and distances between two surface points,
+//! all held as world positions (mm, LPS) on the surface the user saw.
+//!
+//! - [`SurfaceView`] is a rendered view's camera and depth layer: [`SurfaceView::pick`] turns an
+//!   image position into the surface point seen there (pixel → ray → depth, any lens), and
+//!   [`SurfaceView::visibility`] says whether a world point is on the surface this view shows
+//!   (the paper's shadow-map-like depth comparison: a point is hidden when something nearer
+//!   covers it, and also when the tissue it was drawn on is gone — a threshold change moved the
+//!   surface away, so the view's ray runs past the point);
+//! - [`draw`] puts the annotations into a view's image as decals where they are visible, labels
+//!   in the built-in bitmap font;
+//! - [`ScanIdentity`] fingerprints a scan (dimensions, spacing, origin, voxels) so that a case's
+//!   annotations are never drawn on another scan.
+//!
+//! ```
+//! use endocast_core::annotate::{Annotation, Annotations, Shape};
+//! use glam::DVec3;
+//!
+//! let mut marks = Annotations::default();
+//! let id = marks.add(Annotation::new(Shape::Distance(DVec3::ZERO, DVec3::new(3.0, 4.0, 0.0))));
+//! assert_eq!(marks.get(id).unwrap().distance_mm(), Some(5.0));
+//! assert_eq!(marks.get(id).unwrap().caption(), "5.0 mm");
+//! ```
+
+mod draw;
+mod identity;
+mod pick;
+
+#[cfg(test)]
+mod tests;
+
+pub use draw::{draw, DrawOptions};
+pub use identity::{IdentityMismatch, ScanIdentity};
+pub use pick::{SurfaceView, Visibility};
+
+use crate::views::Rgb;
+use glam::DVec3;
+
+/// Default colour of points and labels.
+pub const POINT_COLOR: Rgb = [255, 220, 0];
+/// Default colour of strokes.
+pub const STROKE_COLOR: Rgb = [60, 255, 120];
+/// Default colour of measurements.
+pub const MEASURE_COLOR: Rgb = [0, 220, 255];
+
+/// What an annotation marks, world mm (LPS).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// One surface point (with a text label when the annotation has one).
+    Point(DVec3),
+    /// A line drawn on the tissue: surface points in drawing order.
+    Stroke(Vec<DVec3>),
+    /// The straight distance between two surface points.
+    Distance(DVec3, DVec3),
+}
+
+impl Shape {
+    /// The kind's name as case files and the CLI write it: `point`, `stroke` or `measure`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Point(_) => "point",
+            Self::Stroke(_) => "stroke",
+            Self::Distance(..) => "measure",
+        }
+    }
+
+    /// Its points, in order.
+    pub fn points(&self) -> Vec<DVec3> {
+        match self {
+            Self::Point(p) => vec![*p],
+            Self::Stroke(points) => points.clone(),
+            Self::Distance(a, b) => vec![*a, *b],
+        }
+    }
+
+    /// The shape of kind `kind` through `points`, or why there is none (a point needs one, a
+    /// measurement two, a stroke at least one; every coordinate finite).
+    pub fn from_points(kind: &str, points: &[DVec3]) -> Result<Self, String> {
+        if let Some(p) = points.iter().find(|p| !p.is_finite()) {
+            return Err(format!("point {:?} is not finite", p.to_array()));
+        }
+        match (kind, points) {
+            ("point", [p]) => Ok(Self::Point(*p)),
+            ("measure", [a, b]) => Ok(Self::Distance(*a, *b)),
+            ("stroke", [_, ..]) => Ok(Self::Stroke(points.to_vec())),
+            ("point" | "measure" | "stroke", _) => Err(format!(
+                "a {kind} needs {} point(s), found {}",
+                match kind {
+                    "point" => "1",
+                    "measure" => "2",
+                    _ => "1 or more",
+                },
+                points.len()
+            )),
+            _ => Err(format!(
+                "unknown annotation kind {kind:?} (point, stroke or measure)"
+            )),
+        }
+    }
+}
+
+/// One annotation: a shape, an optional text label and a colour.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Annotation {
+    /// Its number in its set (given by [`Annotations::add`]; stable when others are removed).
+    pub id: u32,
+    /// What it marks.
+    pub shape: Shape,
+    /// Text drawn beside it (may be empty).
+    pub label: String,
+    /// Its colour.
+    pub color: Rgb,
+}
+
+impl Annotation {
+    /// An unlabelled annotation of `shape` in its kind's default colour (id 0 until added).
+    pub fn new(shape: Shape) -> Self {
+        let color = match shape {
+            Shape::Point(_) => POINT_COLOR,
+            Shape::Stroke(_) => STROKE_COLOR,
+            Shape::Distance(..) => MEASURE_COLOR,
+        };
+        Self {
+            id: 0,
+            shape,
+            label: String::new(),
+            color,
+        }
+    }
+
+    /// The same annotation labelled `label`.
+    pub fn labelled(self, label: &str) -> Self {
+        Self {
+            label: label.to_owned(),
+            ..self
+        }
+    }
+
+    /// A measurement's length, mm.
+    pub fn distance_mm(&self) -> Option<f64> {
+        match self.shape {
+            Shape::Distance(a, b) => Some(a.distance(b)),
+            _ => None,
+        }
+    }
+
+    /// The text drawn beside it: the label, and for a measurement its length (`"12.3 mm"`).
+    pub fn caption(&self) -> String {
+        match (self.distance_mm(), self.label.is_empty()) {
+            (Some(mm), true) => format!("{mm:.1} mm"),
+            (Some(mm), false) => format!("{} {mm:.1} mm", self.label),
+            (None, _) => self.label.clone(),
+        }
+    }
+
+    /// Where its caption is anchored: a point's position, a stroke's first point, a
+    /// measurement's midpoint.
+    pub fn anchor(&self) -> DVec3 {
+        match &self.shape {
+            Shape::Point(p) => *p,
+            Shape::Stroke(points) => points.first().copied().unwrap_or(DVec3::NAN),
+            Shape::Distance(a, b) => (*a + *b) / 2.0,
+        }
+    }
+}
+
+/// The annotations of a case, oldest first, each with a unique id.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Annotations {
+    items: Vec<Annotation>,
+}
+
+impl Annotations {
+    /// A set holding `items` as they are (ids kept; a case file's). Duplicate ids are renumbered
+    /// after the largest.
+    pub fn from_items(items: Vec<Annotation>) -> Self {
+        let mut set = Self::default();
+        for item in items {
+            let taken = set.get(item.id).is_some() || item.id == 0;
+            let id = if taken { set.next_id() } else { item.id };
+            set.items.push(Annotation { id, ..item });
+        }
+        set
+    }
+
+    /// Adds `annotation` with a new id (one more than the largest) and returns the id.
+    pub fn add(&mut self, annotation: Annotation) -> u32 {
+        let id = self.next_id();
+        self.items.push(Annotation { id, ..annotation });
+        id
+    }
+
+    fn next_id(&self) -> u32 {
+        self.items.iter().map(|a| a.id).max().unwrap_or(0) + 1
+    }
+
+    /// Removes annotation `id`; returns it, or `None` when there is none.
+    pub fn remove(&mut self, id: u32) -> Option<Annotation> {
+        let at = self.items.iter().position(|a| a.id == id)?;
+        Some(self.items.remove(at))
+    }
+
+    /// Annotation `id`.
+    pub fn get(&self, id: u32) -> Option<&Annotation> {
+        self.items.iter().find(|a| a.id == id)
+    }
+
+    /// Every annotation, oldest first.
+    pub fn items(&self) -> &[Annotation] {
+        &self.items
+    }
+
+    /// How many there are.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Whether there is none.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+}
