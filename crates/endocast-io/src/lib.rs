@@ -18,6 +18,7 @@
 //! ```
 
 pub mod atomic;
+pub mod case;
 mod compressed;
 pub mod dicom;
 mod encode;

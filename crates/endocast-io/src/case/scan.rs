@@ -1,0 +1,96 @@
+//! The scan a case is about: where it comes from, and its fingerprint.
+
+use endocast_core::annotate::ScanIdentity;
+use endocast_core::phantom::{Phantom, PhantomOptions};
+use endocast_core::Volume;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Where a scan comes from, as a case file records it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ScanSource {
+    /// A file or DICOM folder, and the DICOM series when not the largest.
+    File {
+        /// The file or folder.
+        path: PathBuf,
+        /// SeriesInstanceUID, DICOM only.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        series: Option<String>,
+    },
+    /// A generated phantom (see `endocast phantom`).
+    Phantom {
+        /// Its name (`colon`, `straight-tube`, ...).
+        name: String,
+        /// Its largest dimension, voxels.
+        size: usize,
+    },
+}
+
+impl ScanSource {
+    /// Reads or generates the volume; the error is one line naming the file and the problem.
+    pub fn load(&self) -> Result<Volume, String> {
+        match self {
+            Self::File { path, series } => {
+                let mut options = crate::OpenOptions::default();
+                options.series.clone_from(series);
+                crate::open(path, &options)
+                    .map(|loaded| loaded.volume)
+                    .map_err(|e| format!("cannot read the scan: {e}"))
+            }
+            Self::Phantom { name, size } => {
+                let phantom = Phantom::from_name(name)
+                    .ok_or_else(|| format!("no phantom called {name:?}"))?;
+                let options = PhantomOptions {
+                    size: *size,
+                    ..PhantomOptions::default()
+                };
+                Ok(phantom.build(&options))
+            }
+        }
+    }
+
+    /// A short name for titles and messages.
+    pub fn label(&self) -> String {
+        match self {
+            Self::File { path, .. } => path.display().to_string(),
+            Self::Phantom { name, size } => format!("{name} phantom ({size})"),
+        }
+    }
+}
+
+/// A [`ScanIdentity`] as case files hold it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IdentityRecord {
+    /// Voxels per axis.
+    pub dims: [usize; 3],
+    /// Voxel spacing, mm.
+    pub spacing_mm: [f64; 3],
+    /// World position of the first voxel, mm (LPS).
+    pub origin_mm: [f64; 3],
+    /// Hash of the voxel values (16 hex digits).
+    pub voxel_hash: String,
+}
+
+impl From<&ScanIdentity> for IdentityRecord {
+    fn from(id: &ScanIdentity) -> Self {
+        Self {
+            dims: id.dims,
+            spacing_mm: id.spacing_mm,
+            origin_mm: id.origin_mm,
+            voxel_hash: id.voxel_hash.clone(),
+        }
+    }
+}
+
+impl From<&IdentityRecord> for ScanIdentity {
+    fn from(r: &IdentityRecord) -> Self {
+        Self {
+            dims: r.dims,
+            spacing_mm: r.spacing_mm,
+            origin_mm: r.origin_mm,
+            voxel_hash: r.voxel_hash.clone(),
+        }
+    }
+}
