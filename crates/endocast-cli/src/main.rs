@@ -1,5 +1,6 @@
 //! The `endocast` command-line tool: every command is a thin front end over the libraries.
 
+mod case_args;
 mod commands;
 mod input;
 mod look;
@@ -42,6 +43,9 @@ enum Command {
     Mesh(Box<commands::mesh::MeshArgs>),
     /// Frames per second along a fly path (default: the paper's protocol on the colon phantom).
     Bench(Box<commands::bench::BenchArgs>),
+    /// Add, list and remove the annotations of a case file: labelled points, strokes on the
+    /// tissue and measurements, at world points or picked through a pixel of a view.
+    Annotate(Box<commands::annotate::AnnotateArgs>),
     /// The interactive workstation: fly through a scan with the slices, the controls, key
     /// frames, marks and cases (a window; `--screenshot` grabs it and quits).
     View(Box<commands::view::ViewArgs>),
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Fly(args) => commands::fly::run(&args),
         Command::View(args) => commands::view::run(&args),
         Command::Mesh(args) => commands::mesh::run(&args),
+        Command::Annotate(args) => commands::annotate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,6 +2,7 @@
 
 #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
+mod annotate;
 mod bad_input;
 mod common;
 mod default_views;

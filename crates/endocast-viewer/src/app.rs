@@ -3,7 +3,8 @@
 //! [`ViewerApp::frame_ui`] draws one UI frame on any [`egui::Context`], so tests run it headlessly
 //! with synthetic input; [`run`] puts it in a native window (eframe, OpenGL).
 
-use crate::case::{Autosave, Case};
+use crate::case::{Autosave, Case, SessionCase};
+use crate::mark_tool::MarkTool;
 use crate::panel::controls_ui;
 use crate::scene::{ScanSource, Scene};
 use crate::session::Session;
@@ -180,8 +181,7 @@ impl ViewerApp {
                     autosave: Autosave::new(path, AUTOSAVE_INTERVAL),
                     view_texture: None,
                     shown: None,
-                    marking: false,
-                    label: "mark".into(),
+                    marks: MarkTool::default(),
                     last_input: None,
                 });
                 self.loading = None;
@@ -244,7 +244,7 @@ impl ViewerApp {
         let refined = self
             .ready
             .as_ref()
-            .is_some_and(|r| matches!(r.shown, Some((_, Stage::Still(n)))  if n >= 4));
+            .is_some_and(|r| matches!(r.shown, Some((_, Stage::Still(n), _)) if n >= 4));
         if refined && !self.screenshot_requested {
             self.screenshot_requested = true;
             ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::default()));

@@ -1,225 +1,82 @@
-//! Case files: the scan reference, the controls, the camera, the key frames and the
-//! annotations, as JSON, written atomically (a temporary file renamed over the old one, so a
-//! crash or a kill during a save leaves the previous case intact), and autosaved.
-//!
-//! ```json
-//! {"format": "endocast-case", "version": 1,
-//!  "scan": {"kind": "file", "path": "chest-ct"},
-//!  "controls": {"preset": "bronchoscopy", "mode": "hybrid", "iso_hu": -500, ...},
-//!  "camera": {"eye": [0, 0, 0], "forward": [0, 0, 1], "up": [0, -1, 0]},
-//!  "key_frames": [], "annotations": []}
-//! ```
+//! Case files as the viewer uses them: the one case format of `endocast_io::case` (scan
+//! reference and fingerprint, controls, camera, key frames, annotations; written atomically),
+//! made from a session and applied to one, and autosaved.
 
 use crate::controller::FlyCamera;
-use crate::scene::ScanSource;
-use crate::session::{Annotation, Controls, Session};
+use crate::session::{Controls, Session};
 use endocast_core::animation::KeyFrame;
 use endocast_core::camera::Projection;
 use endocast_core::presets::Preset;
 use endocast_core::render::Mode;
 use endocast_core::views::slices::Window;
+pub use endocast_io::case::{
+    Case, CaseCamera, CaseControls, CaseError, CaseKeyFrame, FORMAT, VERSION,
+};
 use glam::DVec3;
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// The `"format"` value of case files.
-pub const FORMAT: &str = "endocast-case";
-/// The version this code reads and writes.
-pub const VERSION: u32 = 1;
-/// A case file larger than this is refused unread.
-const MAX_BYTES: u64 = 64 << 20;
-
-/// A case as the file holds it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Case {
-    /// Always [`FORMAT`].
-    pub format: String,
-    /// Always [`VERSION`].
-    pub version: u32,
-    /// The scan.
-    pub scan: ScanSource,
-    /// The control panel.
-    pub controls: CaseControls,
-    /// The camera.
-    pub camera: CaseCamera,
-    /// The key frames, in playback order.
-    #[serde(default)]
-    pub key_frames: Vec<CaseKeyFrame>,
-    /// The annotations.
-    #[serde(default)]
-    pub annotations: Vec<CaseAnnotation>,
-    /// A number that grows with every save of a session (the autosave test reads it).
-    #[serde(default)]
-    pub revision: u64,
-}
-
-/// The controls by name, so the file reads as the CLI's options do.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-#[allow(missing_docs)]
-pub struct CaseControls {
-    pub preset: String,
-    pub mode: String,
-    pub iso_hu: f64,
-    pub iso_opacity: f32,
-    pub lens: String,
-    pub fov_deg: f64,
-    pub stereo: bool,
-    pub collision: bool,
-    pub speed_mm_s: f64,
-    pub window_level_hu: f64,
-    pub window_width_hu: f64,
-}
-
-/// A camera: eye (world mm, LPS), view direction and image up.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-#[allow(missing_docs)]
-pub struct CaseCamera {
-    pub eye: [f64; 3],
-    pub forward: [f64; 3],
-    pub up: [f64; 3],
-}
-
-/// A key frame as path files have it (see `docs/path-format.md`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-#[allow(missing_docs)]
-pub struct CaseKeyFrame {
-    pub eye: [f64; 3],
-    pub forward: [f64; 3],
-    pub up: [f64; 3],
-    pub fov_deg: f64,
-    pub iso_hu: f64,
-    pub iso_opacity: f64,
-}
-
-/// A labelled point, world mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-#[allow(missing_docs)]
-pub struct CaseAnnotation {
-    pub label: String,
-    pub point: [f64; 3],
-}
-
-/// Why a case cannot be read or applied.
-#[derive(Debug, thiserror::Error)]
-#[error("case file {path}: {problem}")]
-pub struct CaseError {
-    /// The file.
-    pub path: PathBuf,
-    /// What is wrong, one line.
-    pub problem: String,
-}
-
-impl CaseError {
-    fn new(path: &Path, problem: impl Into<Problem>) -> Self {
-        Self {
-            path: path.to_owned(),
-            problem: problem.into().0,
-        }
-    }
-}
-
-/// A case error's problem in words (from any error or text).
-struct Problem(String);
-
-impl<T: std::fmt::Display> From<T> for Problem {
-    fn from(problem: T) -> Self {
-        Self(problem.to_string())
-    }
-}
-
-impl CaseCamera {
-    fn of(camera: &FlyCamera) -> Self {
-        Self {
-            eye: camera.eye_mm().to_array(),
-            forward: camera.forward().to_array(),
-            up: camera.up().to_array(),
-        }
-    }
-
-    fn fly_camera(&self) -> Option<FlyCamera> {
-        let v = DVec3::from_array;
-        FlyCamera::new(v(self.eye), v(self.forward), v(self.up))
-    }
-}
-
-impl Case {
+/// A case made from a session and applied to one.
+pub trait SessionCase: Sized {
     /// The case of `session` now.
-    pub fn of(session: &Session, revision: u64) -> Self {
-        let c = &session.controls;
-        Self {
-            format: FORMAT.into(),
-            version: VERSION,
-            scan: session.scene().source.clone(),
-            controls: CaseControls {
-                preset: c.preset.name.into(),
-                mode: c.mode.name().into(),
-                iso_hu: c.iso_hu,
-                iso_opacity: c.iso_opacity,
-                lens: c.projection.name().into(),
-                fov_deg: c.fov_deg,
-                stereo: c.stereo,
-                collision: c.collision,
-                speed_mm_s: c.speed_mm_s,
-                window_level_hu: c.window.level_hu,
-                window_width_hu: c.window.width_hu,
-            },
-            camera: CaseCamera::of(session.fly_camera()),
-            key_frames: session.key_frames().iter().map(key_to_case).collect(),
-            annotations: session
-                .annotations()
-                .iter()
-                .map(|a| CaseAnnotation {
-                    label: a.label.clone(),
-                    point: a.point_mm.to_array(),
-                })
-                .collect(),
-            revision,
-        }
-    }
-
-    /// Reads `path`; the error names the file and the problem.
-    pub fn read(path: &Path) -> Result<Self, CaseError> {
-        let size = std::fs::metadata(path)
-            .map_err(|e| CaseError::new(path, e))?
-            .len();
-        if size > MAX_BYTES {
-            return Err(CaseError::new(path, format!("{size} bytes is too large")));
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| CaseError::new(path, e))?;
-        let case: Self = serde_json::from_str(&text).map_err(|e| CaseError::new(path, e))?;
-        if case.format != FORMAT || case.version != VERSION {
-            return Err(CaseError::new(
-                path,
-                format!(
-                    "format {:?} version {} is not {FORMAT:?} version {VERSION}",
-                    case.format, case.version
-                ),
-            ));
-        }
-        Ok(case)
-    }
-
-    /// Writes the case to `path` atomically.
-    pub fn write(&self, path: &Path) -> Result<(), CaseError> {
-        let json = serde_json::to_vec_pretty(self).map_err(|e| CaseError::new(path, e))?;
-        endocast_io::atomic::write_file(path, |w| w.write_all(&json))
-            .map_err(|e| CaseError::new(path, e))
-    }
-
+    fn of(session: &Session, revision: u64) -> Self;
     /// The controls this case sets; `path` names the file in errors.
-    pub fn controls(&self, path: &Path) -> Result<Controls, CaseError> {
-        let c = &self.controls;
+    fn controls(&self, path: &Path) -> Result<Option<Controls>, CaseError>;
+    /// Puts `session` (open on this case's scan; refused for another scan) in this case's
+    /// state.
+    fn apply(&self, session: &mut Session, path: &Path) -> Result<(), CaseError>;
+}
+
+fn camera_of(camera: &FlyCamera) -> CaseCamera {
+    CaseCamera {
+        eye: camera.eye_mm().to_array(),
+        forward: camera.forward().to_array(),
+        up: camera.up().to_array(),
+    }
+}
+
+fn fly_camera(c: &CaseCamera) -> Option<FlyCamera> {
+    let v = DVec3::from_array;
+    FlyCamera::new(v(c.eye), v(c.forward), v(c.up))
+}
+
+fn controls_of(c: &Controls) -> CaseControls {
+    CaseControls {
+        preset: c.preset.name.into(),
+        mode: c.mode.name().into(),
+        iso_hu: c.iso_hu,
+        iso_opacity: c.iso_opacity,
+        lens: c.projection.name().into(),
+        fov_deg: c.fov_deg,
+        stereo: c.stereo,
+        collision: c.collision,
+        speed_mm_s: c.speed_mm_s,
+        window_level_hu: c.window.level_hu,
+        window_width_hu: c.window.width_hu,
+    }
+}
+
+impl SessionCase for Case {
+    fn of(session: &Session, revision: u64) -> Self {
+        let scene = session.scene();
+        let mut case = Case::new(scene.source.clone(), Some(&scene.identity));
+        case.controls = Some(controls_of(&session.controls));
+        case.camera = Some(camera_of(session.fly_camera()));
+        case.key_frames = session.key_frames().iter().map(key_to_case).collect();
+        case.set_annotations(session.marks());
+        case.revision = revision;
+        case
+    }
+
+    fn controls(&self, path: &Path) -> Result<Option<Controls>, CaseError> {
+        let Some(c) = &self.controls else {
+            return Ok(None);
+        };
         let bad = |what: &str, name: &str| CaseError::new(path, format!("unknown {what} {name:?}"));
         let preset = Preset::find(&c.preset).ok_or_else(|| bad("preset", &c.preset))?;
         let window = Window::new(c.window_level_hu, c.window_width_hu)
             .map_err(|e| CaseError::new(path, e))?;
-        Ok(Controls {
+        Ok(Some(Controls {
             preset,
             mode: Mode::from_name(&c.mode).ok_or_else(|| bad("mode", &c.mode))?,
             iso_hu: c.iso_hu,
@@ -230,33 +87,33 @@ impl Case {
             collision: c.collision,
             speed_mm_s: c.speed_mm_s,
             window,
-        })
+        }))
     }
 
-    /// Puts `session` (open on this case's scan) in this case's state.
-    pub fn apply(&self, session: &mut Session, path: &Path) -> Result<(), CaseError> {
-        let controls = self.controls(path)?;
-        let camera = self
-            .camera
-            .fly_camera()
-            .ok_or_else(|| CaseError::new(path, "the camera has no valid frame"))?;
+    fn apply(&self, session: &mut Session, path: &Path) -> Result<(), CaseError> {
+        self.check_scan(&session.scene().identity, path)?;
+        let controls = SessionCase::controls(self, path)?;
+        let camera = match &self.camera {
+            Some(c) => Some(
+                fly_camera(c)
+                    .ok_or_else(|| CaseError::new(path, "the camera has no valid frame"))?,
+            ),
+            None => None,
+        };
         let keys = self
             .key_frames
             .iter()
             .map(|k| key_from_case(k).map_err(|e| CaseError::new(path, e)))
             .collect::<Result<Vec<_>, _>>()?;
-        session.controls = controls;
-        session.set_camera(camera);
+        let marks = self.annotations(path)?;
+        if let Some(controls) = controls {
+            session.controls = controls;
+        }
+        if let Some(camera) = camera {
+            session.set_camera(camera);
+        }
         session.set_key_frames(keys);
-        session.set_annotations(
-            self.annotations
-                .iter()
-                .map(|a| Annotation {
-                    label: a.label.clone(),
-                    point_mm: DVec3::from_array(a.point),
-                })
-                .collect(),
-        );
+        session.set_marks(marks);
         Ok(())
     }
 }

@@ -38,6 +38,10 @@ pub mod controller;
 #[cfg(feature = "window")]
 pub mod keys;
 #[cfg(feature = "window")]
+mod mark_tool;
+#[cfg(feature = "window")]
+mod marks;
+#[cfg(feature = "window")]
 mod panel;
 pub mod scene;
 pub mod session;

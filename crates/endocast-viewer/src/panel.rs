@@ -43,7 +43,7 @@ pub(crate) fn controls_ui(
     egui::CollapsingHeader::new("Marks and measurement")
         .default_open(true)
         .show(ui, |ui| {
-            marks_ui(ui, ready);
+            crate::marks::marks_ui(ui, ready);
         });
     egui::CollapsingHeader::new("Case")
         .default_open(true)
@@ -248,48 +248,12 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
     action
 }
 
-fn marks_ui(ui: &mut egui::Ui, ready: &mut Ready) {
-    ui.checkbox(&mut ready.marking, "clicks in the view place marks");
-    ui.horizontal(|ui| {
-        ui.label("label");
-        ui.text_edit_singleline(&mut ready.label);
-    });
-    let mut delete = None;
-    for (i, a) in ready.session.annotations().iter().enumerate() {
-        ui.horizontal(|ui| {
-            let p = a.point_mm;
-            ui.label(format!("{} ({:.1}, {:.1}, {:.1})", a.label, p.x, p.y, p.z));
-            if ui.small_button("✕").clicked() {
-                delete = Some(i);
-            }
-        });
-    }
-    if let Some(i) = delete {
-        ready.session.delete_annotation(i);
-    }
-    if let Some(mm) = ready.session.measurement_mm() {
-        ui.label(format!("last two marks: {mm:.1} mm apart"));
-    }
-}
-
 /// Renders the current view at full quality and writes it beside the case file.
 fn screenshot(session: &Session, case: &Path) -> String {
     let path = case.with_extension("png");
-    let frame = session
-        .scene()
-        .renderer
-        .prepare(&session.controls.settings())
-        .map_err(|e| e.to_string())
-        .and_then(|p| {
-            session
-                .camera()
-                .map(|c| p.render(&c))
-                .map_err(|e| e.to_string())
-        });
-    let written = frame.and_then(|f| {
-        let rgb = f.to_rgb8(session.controls.settings().background);
-        endocast_io::write_png_rgb8(&path, f.width as u32, f.height as u32, &rgb)
-            .map_err(|e| e.to_string())
+    let written = session.screenshot().and_then(|image| {
+        let [w, h] = [image.width() as u32, image.height() as u32];
+        endocast_io::write_png_rgb8(&path, w, h, image.rgb()).map_err(|e| e.to_string())
     });
     match written {
         Ok(()) => format!("wrote {}", path.display()),

@@ -1,70 +1,16 @@
 //! What the viewer shows: a scan, where it came from, its renderer, its histogram and the lumen
 //! the camera flies through (the distance field the collider reads).
 
+use endocast_core::annotate::ScanIdentity;
 use endocast_core::navigate::{seed_voxel, Collider, DistanceField, Lumen, LumenSide};
-use endocast_core::phantom::{Phantom, PhantomOptions};
 use endocast_core::render::Renderer;
 use endocast_core::Volume;
+pub use endocast_io::case::ScanSource;
 use glam::DVec3;
-use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Bins of the value histogram under the isovalue slider.
 pub const HISTOGRAM_BINS: usize = 128;
-
-/// Where a scan comes from, as a case file records it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum ScanSource {
-    /// A file or DICOM folder, and the DICOM series when not the largest.
-    File {
-        /// The file or folder.
-        path: PathBuf,
-        /// SeriesInstanceUID, DICOM only.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        series: Option<String>,
-    },
-    /// A generated phantom (see `endocast phantom`).
-    Phantom {
-        /// Its name (`colon`, `straight-tube`, ...).
-        name: String,
-        /// Its largest dimension, voxels.
-        size: usize,
-    },
-}
-
-impl ScanSource {
-    /// Reads or generates the volume; the error is one line naming the file and the problem.
-    pub fn load(&self) -> Result<Volume, String> {
-        match self {
-            Self::File { path, series } => {
-                let mut options = endocast_io::OpenOptions::default();
-                options.series.clone_from(series);
-                endocast_io::open(path, &options)
-                    .map(|loaded| loaded.volume)
-                    .map_err(|e| format!("cannot read the scan: {e}"))
-            }
-            Self::Phantom { name, size } => {
-                let phantom = Phantom::from_name(name)
-                    .ok_or_else(|| format!("no phantom called {name:?}"))?;
-                let options = PhantomOptions {
-                    size: *size,
-                    ..PhantomOptions::default()
-                };
-                Ok(phantom.build(&options))
-            }
-        }
-    }
-
-    /// A short name for the title bar.
-    pub fn label(&self) -> String {
-        match self {
-            Self::File { path, .. } => path.display().to_string(),
-            Self::Phantom { name, size } => format!("{name} phantom ({size})"),
-        }
-    }
-}
 
 /// The lumen the camera is in: its distance field and the camera's radius.
 #[derive(Debug)]
@@ -117,6 +63,8 @@ pub struct Scene {
     pub histogram: Vec<u64>,
     /// Lowest and highest physical value.
     pub value_range: (f64, f64),
+    /// The scan's fingerprint, which its cases record.
+    pub identity: ScanIdentity,
 }
 
 impl Scene {
@@ -124,7 +72,9 @@ impl Scene {
     pub fn new(source: ScanSource, volume: Volume) -> Self {
         let value_range = volume.physical_range();
         let histogram = histogram(&volume);
+        let identity = ScanIdentity::of(&volume);
         Self {
+            identity,
             source,
             renderer: Arc::new(Renderer::for_many_frames(volume)),
             histogram,

@@ -7,12 +7,14 @@ use crate::controller::{FlyCamera, LocalMove};
 use crate::scene::{Navigation, Scene};
 use crate::worker::{RenderWorker, View};
 use endocast_core::animation::{Animation, KeyFrame};
+use endocast_core::annotate::{self, Annotation, Annotations, DrawOptions, Shape, SurfaceView};
 use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
 use endocast_core::navigate::{default_view, LumenChoice};
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::{Mode, RenderSettings};
 use endocast_core::views::slices::Window;
+use endocast_core::views::Image;
 use glam::DVec3;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -84,15 +86,6 @@ impl Controls {
     }
 }
 
-/// A placed label on the tissue, world mm.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Annotation {
-    /// What the user called it.
-    pub label: String,
-    /// Where, world mm (LPS).
-    pub point_mm: DVec3,
-}
-
 /// A flight along the recorded key frames.
 #[derive(Debug, Clone)]
 pub struct Playback {
@@ -130,7 +123,11 @@ pub struct Session {
     last_submit: Option<(u64, Instant)>,
     key_frames: Vec<KeyFrame>,
     playback: Option<Playback>,
-    annotations: Vec<Annotation>,
+    marks: Annotations,
+    /// The stroke being drawn, surface points so far.
+    stroke: Vec<DVec3>,
+    /// Grows with every change of the annotations or the stroke being drawn.
+    marks_revision: u64,
 }
 
 impl Session {
@@ -169,7 +166,9 @@ impl Session {
             last_submit: None,
             key_frames: Vec::new(),
             playback: None,
-            annotations: Vec::new(),
+            marks: Annotations::default(),
+            stroke: Vec::new(),
+            marks_revision: 0,
         };
         session.find_lumen();
         session
@@ -470,40 +469,106 @@ impl Session {
 
     /// Labels the surface point seen at pixel `(x, y)`; false when no surface is seen there.
     pub fn annotate_pixel(&mut self, x: usize, y: usize, label: &str) -> bool {
-        match self.surface_point(x, y) {
-            Some(point_mm) => {
-                self.annotations.push(Annotation {
-                    label: label.to_owned(),
-                    point_mm,
-                });
-                true
-            }
-            None => false,
+        self.surface_point(x, y)
+            .map(|p| {
+                let mark = Annotation::new(Shape::Point(p)).labelled(label);
+                self.add_mark(mark)
+            })
+            .is_some()
+    }
+
+    /// Measures between the surface points seen at pixels `a` and `b`: adds the measurement
+    /// and returns its length, mm; `None` when either pixel shows no surface.
+    pub fn measure_pixels(&mut self, a: [usize; 2], b: [usize; 2]) -> Option<f64> {
+        let p = self.surface_point(a[0], a[1])?;
+        let q = self.surface_point(b[0], b[1])?;
+        self.add_mark(Annotation::new(Shape::Distance(p, q)));
+        Some(p.distance(q))
+    }
+
+    /// Continues the stroke being drawn (or starts one) at the surface seen at pixel
+    /// `(x, y)`; false when no surface is seen there.
+    pub fn stroke_to_pixel(&mut self, x: usize, y: usize) -> bool {
+        let Some(p) = self.surface_point(x, y) else {
+            return false;
+        };
+        if self.stroke.last() != Some(&p) {
+            self.stroke.push(p);
+            self.marks_revision += 1;
         }
+        true
+    }
+
+    /// The stroke being drawn, surface points so far.
+    pub fn stroke_in_progress(&self) -> &[DVec3] {
+        &self.stroke
+    }
+
+    /// Ends the stroke being drawn, adding it (labelled `label`) when it has a point; returns
+    /// its id.
+    pub fn finish_stroke(&mut self, label: &str) -> Option<u32> {
+        let points = std::mem::take(&mut self.stroke);
+        (!points.is_empty()).then(|| {
+            let mark = Annotation::new(Shape::Stroke(points)).labelled(label);
+            self.add_mark(mark)
+        })
     }
 
     /// The annotations, oldest first.
     pub fn annotations(&self) -> &[Annotation] {
-        &self.annotations
+        self.marks.items()
+    }
+
+    /// The annotations as a set.
+    pub fn marks(&self) -> &Annotations {
+        &self.marks
     }
 
     /// Replaces the annotations (a reopened case).
-    pub fn set_annotations(&mut self, annotations: Vec<Annotation>) {
-        self.annotations = annotations;
+    pub fn set_marks(&mut self, marks: Annotations) {
+        self.marks = marks;
+        self.stroke.clear();
+        self.marks_revision += 1;
     }
 
-    /// Deletes annotation `index`.
-    pub fn delete_annotation(&mut self, index: usize) {
-        if index < self.annotations.len() {
-            self.annotations.remove(index);
-        }
+    fn add_mark(&mut self, mark: Annotation) -> u32 {
+        self.marks_revision += 1;
+        self.marks.add(mark)
     }
 
-    /// The distance between the last two annotations, mm (a measurement).
-    pub fn measurement_mm(&self) -> Option<f64> {
-        match self.annotations.as_slice() {
-            [.., a, b] => Some(a.point_mm.distance(b.point_mm)),
-            _ => None,
-        }
+    /// A number that grows with every change of the annotations or the stroke being drawn
+    /// (the view redraws its decals when it changes).
+    pub fn marks_revision(&self) -> u64 {
+        self.marks_revision
+    }
+
+    /// Deletes annotation `id`.
+    pub fn delete_annotation(&mut self, id: u32) {
+        self.marks.remove(id);
+        self.marks_revision += 1;
+    }
+
+    /// The current view rendered at full quality, with the annotations drawn where it sees
+    /// their tissue.
+    pub fn screenshot(&self) -> Result<Image, String> {
+        let settings = self.controls.settings();
+        let prepared = self
+            .scene
+            .renderer
+            .prepare(&settings)
+            .map_err(|e| e.to_string())?;
+        let camera = self.camera().map_err(|e| e.to_string())?;
+        let frame = prepared.render(&camera);
+        let mut image =
+            Image::from_frame(&frame, settings.background).map_err(|e| e.to_string())?;
+        let spacing = self.scene.volume().geometry().spacing_mm();
+        let view = SurfaceView::new(&camera, &frame.depth_mm, spacing);
+        annotate::draw(
+            &mut image,
+            &view,
+            self.marks.items(),
+            &DrawOptions::default(),
+        );
+        Ok(image)
     }
 }

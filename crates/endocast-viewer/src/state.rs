@@ -1,6 +1,7 @@
 //! What the window keeps beside the session, shared by the window's parts.
 
 use crate::case::Autosave;
+use crate::mark_tool::MarkTool;
 use crate::session::Session;
 use crate::slices::SlicesView;
 use endocast_core::render::progressive::Stage;
@@ -12,11 +13,9 @@ pub(crate) struct Ready {
     pub slices: SlicesView,
     pub autosave: Autosave,
     pub view_texture: Option<egui::TextureHandle>,
-    pub shown: Option<(u64, Stage)>,
-    /// Clicks in the view place marks instead of turning the camera.
-    pub marking: bool,
-    /// The label of the next mark.
-    pub label: String,
+    pub shown: Option<(u64, Stage, u64)>,
+    /// What clicks and drags in the view do: look, label, draw or measure.
+    pub marks: MarkTool,
     /// The last time the camera was moved by input.
     pub last_input: Option<Instant>,
 }

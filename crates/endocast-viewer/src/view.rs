@@ -4,7 +4,7 @@
 use crate::keys::{held_motion, Commands};
 use crate::session::Session;
 use crate::state::Ready;
-use egui::{Color32, Pos2, Rect, Sense, Stroke, TextureOptions, Vec2};
+use egui::{Color32, Pos2, Rect, Sense, TextureOptions, Vec2};
 use std::time::Instant;
 
 /// The longest UI frame step the flight integrates, seconds (a stalled frame never jumps the
@@ -21,8 +21,9 @@ pub(crate) fn view_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     ];
     ready.session.set_view_size(size);
     let response = ui.allocate_rect(rect, Sense::click_and_drag());
+    let marking = crate::marks::view_input(&response, ready, rect, ppp);
     let mut moved = false;
-    if response.dragged() {
+    if response.dragged() && !marking {
         let d = response.drag_delta();
         let fov = ready.session.controls.fov_deg.to_radians();
         let rad_per_point = fov / f64::from(rect.height().max(1.0));
@@ -32,7 +33,7 @@ pub(crate) fn view_ui(ui: &mut egui::Ui, ready: &mut Ready) {
         );
         moved |= d != Vec2::ZERO;
     }
-    if response.clicked() {
+    if response.clicked() && !marking {
         if let Some(pos) = response.interact_pointer_pos() {
             moved |= click(ready, rect, pos, ppp);
         }
@@ -43,20 +44,13 @@ pub(crate) fn view_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     }
     ready.session.sync(moved);
     show_frame(ui, ready, rect);
-    draw_annotations(ui, &ready.session, rect, ppp);
 }
 
-/// A click in the view: turn toward the surface point there, or mark it.
+/// A click in the view: turn toward the surface point there.
 fn click(ready: &mut Ready, rect: Rect, pos: Pos2, ppp: f64) -> bool {
     let x = (f64::from(pos.x - rect.min.x) * ppp) as usize;
     let y = (f64::from(pos.y - rect.min.y) * ppp) as usize;
-    if ready.marking {
-        let label = ready.label.clone();
-        ready.session.annotate_pixel(x, y, &label);
-        false
-    } else {
-        ready.session.look_at_pixel(x, y)
-    }
+    ready.session.look_at_pixel(x, y)
 }
 
 /// Flies by the held keys and runs the pressed commands; true when the camera moved.
@@ -118,16 +112,18 @@ fn run_commands(session: &mut Session, c: Commands) -> bool {
 /// Uploads the newest frame when it is new and draws it, aspect kept, in `rect`.
 fn show_frame(ui: &egui::Ui, ready: &mut Ready, rect: Rect) {
     let worker = ready.session.worker();
+    let marks = ready.session.marks_revision();
     let update = worker.with_latest(|f| {
         let f = f?;
-        if ready.shown == Some((f.generation, f.stage)) {
+        if ready.shown == Some((f.generation, f.stage, marks)) {
             return None;
         }
-        let image = egui::ColorImage::from_rgb([f.image.width(), f.image.height()], f.image.rgb());
+        let shown = crate::marks::with_marks(&ready.session, f);
+        let image = egui::ColorImage::from_rgb([shown.width(), shown.height()], shown.rgb());
         Some((f.generation, f.stage, image))
     });
     if let Some((generation, stage, image)) = update {
-        ready.shown = Some((generation, stage));
+        ready.shown = Some((generation, stage, marks));
         match &mut ready.view_texture {
             Some(t) => t.set(image, TextureOptions::LINEAR),
             None => {
@@ -167,37 +163,4 @@ fn fit(rect: Rect, aspect: f32) -> Rect {
         Vec2::new(rect.width(), rect.width() / aspect.max(1e-3))
     };
     Rect::from_center_size(rect.center(), size)
-}
-
-/// The marks, projected into the view, and the measurement between the last two.
-fn draw_annotations(ui: &egui::Ui, session: &Session, rect: Rect, ppp: f64) {
-    let Ok(camera) = session.camera() else {
-        return;
-    };
-    let painter = ui.painter_at(rect);
-    let to_screen = |(x, y): (f64, f64)| rect.min + Vec2::new((x / ppp) as f32, (y / ppp) as f32);
-    let mut last = Vec::new();
-    for a in session.annotations() {
-        if let Some(p) = camera.project(a.point_mm).map(to_screen) {
-            painter.circle_stroke(p, 5.0, Stroke::new(2.0, Color32::YELLOW));
-            painter.text(
-                p + Vec2::new(8.0, -8.0),
-                egui::Align2::LEFT_BOTTOM,
-                &a.label,
-                egui::FontId::proportional(14.0),
-                Color32::YELLOW,
-            );
-            last.push(p);
-        }
-    }
-    if let (Some(mm), [.., a, b]) = (session.measurement_mm(), last.as_slice()) {
-        painter.line_segment([*a, *b], Stroke::new(1.5, Color32::YELLOW));
-        painter.text(
-            a.lerp(*b, 0.5),
-            egui::Align2::CENTER_BOTTOM,
-            format!("{mm:.1} mm"),
-            egui::FontId::proportional(14.0),
-            Color32::YELLOW,
-        );
-    }
 }

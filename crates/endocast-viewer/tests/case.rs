@@ -1,8 +1,9 @@
 //! Case files: reopened exactly, strict on reading, and never lost to a kill during a save.
 
 use crate::common::{settled, tube_session};
+use endocast_core::annotate::STROKE_COLOR;
 use endocast_core::presets::Preset;
-use endocast_viewer::case::{Autosave, Case};
+use endocast_viewer::case::{Autosave, Case, SessionCase};
 use endocast_viewer::controller::LocalMove;
 use endocast_viewer::scene::Scene;
 use endocast_viewer::session::Session;
@@ -16,7 +17,7 @@ fn reopen(path: &std::path::Path) -> Session {
     let case = Case::read(path).unwrap();
     let volume = case.scan.load().unwrap();
     let scene = Arc::new(Scene::new(case.scan.clone(), volume));
-    let preset = Preset::find(&case.controls.preset).unwrap();
+    let preset = Preset::find(&case.controls.as_ref().unwrap().preset).unwrap();
     let mut session = Session::new(scene, preset, None, || {});
     session.set_view_size([64, 64]);
     case.apply(&mut session, path).unwrap();
@@ -62,6 +63,55 @@ fn a_saved_case_reopens_to_the_same_view_with_its_marks_and_key_frames() {
 }
 
 #[test]
+fn a_stroke_drawn_on_the_tissue_is_in_the_saved_case_and_only_fits_its_scan() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("drawn.endocast-case.json");
+    let (mut session, _) = tube_session();
+    settled(&mut session);
+    // A drag across the view, as the draw tool makes it.
+    for x in 16..48 {
+        assert!(session.stroke_to_pixel(x, 20 + x / 4));
+    }
+    let id = session.finish_stroke("resect").unwrap();
+    assert!(session.stroke_in_progress().is_empty());
+    // The screenshot shows it where the wall is.
+    let shot = session.screenshot().unwrap();
+    let green = shot.rgb().chunks(3).filter(|p| *p == STROKE_COLOR).count();
+    assert!(green > 30, "{green} stroke pixels in the screenshot");
+    let mm = session.measure_pixels([20, 40], [44, 40]).unwrap();
+    Autosave::new(path.clone(), Duration::ZERO)
+        .tick(&session, true)
+        .unwrap();
+
+    let case = Case::read(&path).unwrap();
+    let marks = case.annotations(&path).unwrap();
+    let stroke = marks.get(id).unwrap();
+    assert_eq!(stroke.shape.kind(), "stroke");
+    assert_eq!(stroke.label, "resect");
+    assert_eq!(stroke.shape.points().len(), 32);
+    assert_eq!(marks.items()[1].distance_mm(), Some(mm));
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.contains("\"voxel_hash\"") && text.contains("\"measure\""),
+        "{text}"
+    );
+    assert_eq!(reopen(&path).marks(), session.marks());
+
+    // The same case on another scan is refused, saying why.
+    let other = endocast_viewer::scene::ScanSource::Phantom {
+        name: "straight-tube".into(),
+        size: 36,
+    };
+    let scene = Arc::new(Scene::new(other.clone(), other.load().unwrap()));
+    let mut elsewhere = Session::new(scene, Preset::find("colonoscopy").unwrap(), None, || {});
+    let error = case.apply(&mut elsewhere, &path).unwrap_err().to_string();
+    assert!(
+        error.contains("drawn.endocast-case.json") && error.contains("dimensions"),
+        "{error}"
+    );
+}
+
+#[test]
 fn bad_case_files_are_refused_with_the_file_and_the_problem() {
     let dir = tempfile::tempdir().unwrap();
     let (session, _) = tube_session();
@@ -89,7 +139,7 @@ fn bad_case_files_are_refused_with_the_file_and_the_problem() {
         let path = dir.path().join(name);
         std::fs::write(&path, content).unwrap();
         let error = Case::read(&path)
-            .and_then(|case| case.controls(&path).map(|_| ()))
+            .and_then(|case| SessionCase::controls(&case, &path).map(|_| ()))
             .unwrap_err()
             .to_string();
         assert!(error.contains(name) && error.contains(expect), "{error}");

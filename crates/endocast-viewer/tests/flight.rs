@@ -196,20 +196,26 @@ fn marks_lie_on_the_wall_and_measure_between_them() {
     let (mut session, truth) = tube_session();
     settled(&mut session);
     assert!(session.annotate_pixel(32, 32, "polyp"));
+    assert!(!session.annotate_pixel(640, 32, "outside"));
+    let mm = session.measure_pixels([12, 32], [52, 32]).unwrap();
     session.turn(std::f64::consts::PI, 0.0);
     settled(&mut session);
     assert!(session.annotate_pixel(32, 32, "opposite"));
-    let [a, b] = [0, 1].map(|i| session.annotations()[i].point_mm);
-    for p in [a, b] {
-        let off = off_axis_mm(&truth, p);
+    let marks = session.annotations();
+    assert_eq!(marks.len(), 3);
+    let points: Vec<_> = marks.iter().flat_map(|a| a.shape.points()).collect();
+    for p in &points {
+        let off = off_axis_mm(&truth, *p);
         assert!(
             (off - truth.radius_mm).abs() < 1.0,
             "mark {off} mm off axis"
         );
     }
-    let mm = session.measurement_mm().unwrap();
+    assert_eq!(marks[1].distance_mm(), Some(mm));
+    assert!(mm > 5.0 && mm < 2.0 * truth.radius_mm, "{mm} mm");
+    let across = points[0].distance(points[3]);
     assert!(
-        (mm - 2.0 * truth.radius_mm).abs() < 2.0,
-        "{mm} mm across the tube"
+        (across - 2.0 * truth.radius_mm).abs() < 2.0,
+        "{across} mm across the tube"
     );
 }

@@ -2,6 +2,7 @@
 //! animated GIF or an MP4, as the endoscopic view alone or as a dashboard; optionally measuring
 //! how much of the lumen wall the flight showed.
 
+use crate::case_args::CaseArgs;
 use crate::commands::fly_coverage;
 use crate::input::InputArgs;
 use crate::look::{set_threads, transfer_function, LookArgs};
@@ -60,6 +61,8 @@ pub struct FlyArgs {
     lens: LensArgs,
     #[command(flatten)]
     scene: SceneArgs,
+    #[command(flatten)]
+    case: CaseArgs,
     #[command(flatten)]
     stereo: StereoArgs,
     /// Endoscope image size, pixels.
@@ -138,6 +141,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     let optics = args
         .lens
         .optics(preset, args.fov_deg, 0.0, (hi - lo).length())?;
+    let marks = args.case.annotations(&loaded.volume)?;
     let renderer = Arc::new(Renderer::for_many_frames(loaded.volume));
     let options = FlightOptions {
         size: args.size,
@@ -151,6 +155,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
     flight.set_scene(args.scene.scene()?);
+    flight.set_annotations(marks);
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {

@@ -1,5 +1,6 @@
 //! `endocast render`: one view of a scan, from inside (endoscopic) or framing it from outside.
 
+use crate::case_args::{draw_marks, CaseArgs};
 use crate::input::InputArgs;
 use crate::look::{in_pool, LookArgs};
 use crate::lumen::LumenArgs;
@@ -41,6 +42,8 @@ pub struct RenderArgs {
     stereo: StereoArgs,
     #[command(flatten)]
     scene: SceneArgs,
+    #[command(flatten)]
+    case: CaseArgs,
     /// Eye position, world mm (LPS, as `endocast info` reports). Without it, an endoscopic
     /// preset looks along the largest lumen from its most central point; otherwise the view
     /// frames the whole volume from the front.
@@ -86,6 +89,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     eprintln!("{}", look.summary);
     let (settings, preset) = (look.settings, look.preset.as_ref());
     let camera = camera(args, preset, &loaded.volume, &settings)?;
+    let marks = args.case.annotations(&loaded.volume)?;
+    if marks.is_some() && args.stereo.stereo.is_some() {
+        bail!("--case draws on one view: leave out --stereo");
+    }
     let renderer = Arc::new(Renderer::new(loaded.volume));
     let mut prepared = renderer
         .prepare(&settings)
@@ -112,8 +119,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         None => {
             let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
             let [w, h] = [frame.width as u32, frame.height as u32];
-            let rgb = frame.to_rgb8(settings.background);
-            endocast_io::write_image_rgb8(&args.output, w, h, &rgb)
+            let mut image = Image::from_frame(&frame, settings.background)?;
+            if let Some(marks) = &marks {
+                let spacing = renderer.volume().geometry().spacing_mm();
+                draw_marks(&mut image, marks, &camera, &frame.depth_mm, spacing);
+            }
+            endocast_io::write_image_rgb8(&args.output, w, h, image.rgb())
                 .context("cannot write the image")?;
             frame
         }
