@@ -100,6 +100,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     let preset = args.look.preset()?;
     set_threads(args.look.threads)?;
     let settings = args.look.settings()?;
+    let look = args.look.look()?;
     let window = slice_window(args.window.as_deref(), preset)?;
     if !(args.frame_step.is_finite() && args.frame_step > 0.0) {
         bail!(
@@ -150,7 +151,12 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         window,
     };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
-    flight.set_scene(args.scene.scene()?);
+    let scene = args.scene.scene()?;
+    if look.is_some() && (scene.is_some() || stereo.is_some()) {
+        bail!("--look clinical and realistic draw no geometry and no stereo pair yet; use --look plain");
+    }
+    flight.set_scene(scene);
+    flight.set_look(look);
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {

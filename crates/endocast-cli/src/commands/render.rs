@@ -9,10 +9,13 @@ use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::default_up;
+use endocast_core::look::{self, RayPass};
 use endocast_core::navigate::{default_view, DefaultView, FramingReason};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
-use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
+use endocast_core::render::{
+    Camera, Frame, Prepared, RenderOptions, RenderSettings, Renderer, Still,
+};
 use endocast_core::tissue::{self, ScanValues};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
@@ -65,6 +68,10 @@ pub struct RenderArgs {
     /// Also write the depth image: float32 .npy, mm from the eye to the first hit, NaN where none.
     #[arg(long, value_name = "FILE.npy")]
     depth_out: Option<PathBuf>,
+    /// Average this many jittered frames (sub-pixel offsets, shifted sample grids): a
+    /// converged still without sampling bands or stair-stepped edges.
+    #[arg(long, value_name = "FRAMES", default_value_t = 1)]
+    still: usize,
     /// Print the frame's statistics and the camera pose it used as JSON.
     #[arg(long)]
     json: bool,
@@ -84,13 +91,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let look = args.look.on_scan(&loaded.volume)?;
     eprintln!("{}", look.summary);
+    if !(1..=MAX_STILL_FRAMES).contains(&args.still) {
+        bail!(
+            "--still must be between 1 and {MAX_STILL_FRAMES} frames, not {}",
+            args.still
+        );
+    }
     let (settings, preset) = (look.settings, look.preset.as_ref());
     let camera = camera(args, preset, &loaded.volume, &settings)?;
     let renderer = Arc::new(Renderer::new(loaded.volume));
     let mut prepared = renderer
         .prepare(&settings)
         .context("invalid render settings")?;
-    prepared.set_scene(args.scene.scene()?);
+    let scene = args.scene.scene()?;
+    if look.look.is_some() && (scene.is_some() || args.stereo.stereo.is_some()) {
+        bail!("--look clinical and realistic draw no geometry and no stereo pair yet; use --look plain");
+    }
+    prepared.set_scene(scene);
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
     }
@@ -110,7 +127,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             both
         }
         None => {
-            let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
+            let frame = match &look.look {
+                Some(l) => {
+                    let pass =
+                        RayPass::new(&renderer, &settings, &l.ray).context("invalid look")?;
+                    in_pool(args.look.threads, || {
+                        look::still(&pass, &camera, &l.shading, args.still)
+                    })?
+                    .context("invalid look")?
+                }
+                None => in_pool(args.look.threads, || still(&prepared, &camera, args.still))??,
+            };
             let [w, h] = [frame.width as u32, frame.height as u32];
             let rgb = frame.to_rgb8(settings.background);
             endocast_io::write_image_rgb8(&args.output, w, h, &rgb)
@@ -140,6 +167,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The most frames `--still` averages.
+const MAX_STILL_FRAMES: usize = 256;
+
+/// The average of `frames` jittered frames of `camera` (one: the plain frame).
+fn still(prepared: &Prepared, camera: &Camera, frames: usize) -> Result<Frame> {
+    let mut still = Still::new();
+    for _ in 0..frames {
+        // Nothing cancels it.
+        let _ = still.render_next(prepared, camera, &RenderOptions::new());
+    }
+    Ok(still.frame().clone())
 }
 
 /// The camera the options describe; without one, for an endoscopic preset, a view from inside

@@ -317,7 +317,7 @@ fn look_pass<'s>(
     let (_, pass) = match slot.take() {
         Some((s, pass)) if s == *settings => slot.insert((s, pass)),
         _ => {
-            let pass = RayPass::new(Arc::clone(renderer), settings, &look.ray)?;
+            let pass = RayPass::new(renderer, settings, &look.ray)?;
             slot.insert((settings.clone(), pass))
         }
     };

@@ -68,7 +68,7 @@ impl RayPass {
     /// empty-space skipping; its mode and isovalue are replaced). Fails on an out-of-range
     /// setting.
     pub fn new(
-        renderer: Arc<Renderer>,
+        renderer: &Arc<Renderer>,
         base: &RenderSettings,
         settings: &RayPassSettings,
     ) -> Result<Self, LookError> {

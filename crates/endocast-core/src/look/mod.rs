@@ -34,8 +34,8 @@
 //! let mut look = Look::of_kind(LookKind::Realistic, &preset.look).unwrap();
 //! (look.ray.tissue_hu, look.ray.secretion_hu) =
 //!     (Layered::tissue_threshold_hu(), Layered::secretion_threshold_hu());
-//! let pass = RayPass::new(Arc::new(Renderer::new(volume)), &RenderSettings::default(), &look.ray)
-//!     .unwrap();
+//! let renderer = Arc::new(Renderer::new(volume));
+//! let pass = RayPass::new(&renderer, &RenderSettings::default(), &look.ray).unwrap();
 //! let camera = Camera::look_at(DVec3::new(0.0, 0.0, -11.0), DVec3::ZERO, DVec3::Y, 40.0, [16, 16])
 //!     .unwrap();
 //! let gbuffer = pass.trace(&camera, Quality::Full);

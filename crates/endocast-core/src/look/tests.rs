@@ -30,7 +30,7 @@ fn pass(volume: Volume, secretion: SecretionMode, base: &RenderSettings) -> RayP
         secretion,
         ..RayPassSettings::default()
     };
-    RayPass::new(Arc::new(Renderer::new(volume)), base, &settings).unwrap()
+    RayPass::new(&Arc::new(Renderer::new(volume)), base, &settings).unwrap()
 }
 
 /// Shading that leaves only the secretion's fog: red tissue, green secretion, no texture,
@@ -144,7 +144,7 @@ fn interleaved_sampling_removes_the_bands_of_the_sample_grid() {
     let normal = DVec3::new(0.5, 0.0, -(0.75f64.sqrt()));
     let point = DVec3::new(32.0, 32.0, 30.0);
     let volume = rasterize([64, 64, 64], &options(64), &|p: DVec3| {
-        ramp((point - p).dot(normal) * -1.0, TISSUE_HU, AIR_HU)
+        ramp((p - point).dot(normal), TISSUE_HU, AIR_HU)
     });
     let camera = looking_down_k(&volume, DVec3::new(31.5, 31.5, 4.0), 40.0, 64);
     let world_point = volume.geometry().world_of(point);
@@ -160,7 +160,7 @@ fn interleaved_sampling_removes_the_bands_of_the_sample_grid() {
             ..RayPassSettings::default()
         };
         let renderer = Arc::new(Renderer::new(volume.clone()));
-        let gbuffer = RayPass::new(renderer, &coarse, &settings)
+        let gbuffer = RayPass::new(&renderer, &coarse, &settings)
             .unwrap()
             .trace(&camera, Quality::Full);
         let error: Vec<f64> = (0..64 * 64)
@@ -206,7 +206,7 @@ fn smoothing_keeps_silhouettes_and_removes_noise() {
             ..RayPassSettings::default()
         };
         let renderer = Arc::new(Renderer::new(volume));
-        RayPass::new(renderer, &RenderSettings::default(), &settings)
+        RayPass::new(&renderer, &RenderSettings::default(), &settings)
             .unwrap()
             .trace(&camera, Quality::Full)
     };
