@@ -166,16 +166,16 @@ pub struct RealismArgs {
     #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
     secretion_iso: Option<f64>,
     /// Wetness, 0 (dry) to 1: darkening where the tissue turns away, sharp highlights.
-    #[arg(long, value_name = "0..1")]
+    #[arg(long, value_name = "0..1", allow_negative_numbers = true)]
     wetness: Option<f32>,
     /// Detail texture: mucosa, grid, none, or a PNG file (its luminance).
     #[arg(long, value_name = "NAME|FILE.png")]
     texture: Option<String>,
     /// Edge of one texture tile on the tissue, mm.
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     texture_scale: Option<f32>,
     /// Distance at which the tip's light falls to half, mm (0: no fall-off).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     attenuation: Option<f32>,
 }
 

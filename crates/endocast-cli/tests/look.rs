@@ -73,7 +73,6 @@ fn looks_secretion_wetness_texture_and_attenuation_change_the_image() {
     assert!((13.0..20.0).contains(&centre), "tissue at {centre} mm");
     let variants: Vec<Vec<u8>> = [
         &["--look", "realistic", "--secretion", "off"][..],
-        &["--look", "realistic", "--secretion", "accumulate"],
         &["--look", "realistic", "--wetness", "0"],
         &[
             "--look",
@@ -92,6 +91,12 @@ fn looks_secretion_wetness_texture_and_attenuation_change_the_image() {
     for (n, v) in variants.iter().enumerate() {
         assert_ne!(*v, realistic, "variant {n} changed nothing");
     }
+    // Accumulated along the ray, the continuous layer measures as with constant density.
+    render(
+        &volume,
+        &png,
+        &["--look", "realistic", "--secretion", "accumulate"],
+    );
     // A PNG as texture: the plain image itself.
     let texture = dir.path().join("texture.png");
     std::fs::write(&texture, &plain).unwrap();
