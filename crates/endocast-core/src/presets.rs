@@ -107,6 +107,12 @@ pub enum Structure {
     /// The airway tree grown from the trachea's round section in the top axial slices, its
     /// threshold lowered until it stops leaking into the lung.
     Trachea,
+    /// The aorta: the longest chain of bright round sections of 7–16 mm radius in the axial
+    /// slices (see [`crate::navigate::find_aorta`]).
+    Aorta,
+    /// The colon: the largest gas component inside the body, not the lung (see
+    /// [`crate::navigate::find_colon`]).
+    Colon,
 }
 
 /// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
@@ -186,7 +192,7 @@ pub const ALL: &[Preset] = &[
             threshold: -500.0,
             side: LumenSide::Below,
             tissue: "gas",
-            structure: Structure::Largest,
+            structure: Structure::Colon,
         }),
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
@@ -254,7 +260,7 @@ pub const ALL: &[Preset] = &[
             threshold: 130.0,
             side: LumenSide::Above,
             tissue: "contrast",
-            structure: Structure::Largest,
+            structure: Structure::Aorta,
         }),
         // A vessel window: contrast light grey, calcium and metal white, fat dark.
         window: Window {

@@ -6,12 +6,12 @@ use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use crate::scene_args::SceneArgs;
+use crate::structure;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::default_up;
 use endocast_core::look::{self, RayPass};
 use endocast_core::navigate::{default_view, DefaultView, FramingReason};
-use endocast_core::pose::Pose;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::render::{
     Camera, Frame, Prepared, RenderOptions, RenderSettings, Renderer, Still,
@@ -75,6 +75,10 @@ pub struct RenderArgs {
     /// Print the frame's statistics and the camera pose it used as JSON.
     #[arg(long)]
     json: bool,
+    /// Also write the structure the preset found (its lumen tinted green on the axial, coronal
+    /// and sagittal slices through the camera) as a PNG; needs --preset and no --eye.
+    #[arg(long, value_name = "FILE.png")]
+    show_structure: Option<PathBuf>,
     /// Trace one pixel and print every sample along its ray.
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
     debug_pixel: Option<[usize; 2]>,
@@ -98,7 +102,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let (settings, preset) = (look.settings, look.preset.as_ref());
-    let camera = camera(args, preset, &loaded.volume, &settings)?;
+    let (camera, view) = camera(args, preset, &loaded.volume, &settings)?;
+    if let Some(path) = &args.show_structure {
+        structure::write(path, &loaded.volume, view.as_ref(), preset)?;
+    }
     let renderer = Arc::new(Renderer::new(loaded.volume));
     let mut prepared = renderer
         .prepare(&settings)
@@ -183,21 +190,23 @@ fn still(prepared: &Prepared, camera: &Camera, frames: usize) -> Result<Frame> {
 }
 
 /// The camera the options describe; without one, for an endoscopic preset, a view from inside
-/// the largest lumen along its axis, else one framing the whole volume from the front.
+/// the structure it means along its axis, else one framing the whole volume from the front
+/// (with the default view it came from).
 fn camera(
     args: &RenderArgs,
     preset: Option<&Preset>,
     volume: &Volume,
     settings: &RenderSettings,
-) -> Result<Camera> {
+) -> Result<(Camera, Option<DefaultView>)> {
     let fov_deg = args
         .fov
         .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
-    let (eye, look_at, up) = match (args.eye, args.look_at) {
-        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None),
+    let (eye, look_at, up, view) = match (args.eye, args.look_at) {
+        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None, None),
         (None, None) => {
-            let pose = default_pose(args, preset, volume, settings, fov_deg);
-            (pose.eye_mm, pose.look_at_mm, Some(pose.up))
+            let view = default_pose(args, preset, volume, settings, fov_deg);
+            let pose = view.pose();
+            (pose.eye_mm, pose.look_at_mm, Some(pose.up), Some(view))
         }
         _ => bail!("--eye and --look-at go together"),
     };
@@ -209,9 +218,10 @@ fn camera(
     let (lo, hi) = volume.geometry().world_bounds();
     let height_mm = (hi - lo).length();
     let optics = args.lens.optics(preset, args.fov, args.near, height_mm)?;
-    optics
+    let camera = optics
         .camera(eye, look_at, up, args.size)
-        .context("invalid camera")
+        .context("invalid camera")?;
+    Ok((camera, view))
 }
 
 /// Writes a stereo pair as `output` asks: one combined image at `path`, or for a pair
@@ -237,14 +247,15 @@ fn write_stereo(
 }
 
 /// The library's default view (see [`default_view`]) for `--preset` and the lumen options,
-/// saying on stderr where it put the camera and why it fell back to framing the volume.
+/// saying on stderr what it found, where it put the camera and why it fell back to framing the
+/// volume.
 fn default_pose(
     args: &RenderArgs,
     preset: Option<&Preset>,
     volume: &Volume,
     settings: &RenderSettings,
     fov_deg: f64,
-) -> Pose {
+) -> DefaultView {
     let mut choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
     if let Some(choice) = choice.as_mut() {
         choice.within =
@@ -258,9 +269,11 @@ fn default_pose(
             pose,
             threshold,
             side,
+            what,
+            ..
         } => eprintln!(
-            "camera inside the lumen {side} {threshold:.1} (found in {found_ms:.0} ms): --eye {} \
-             --look-at {} --up {}",
+            "found the {what}\ncamera inside the lumen {side} {threshold:.1} (found in \
+             {found_ms:.0} ms): --eye {} --look-at {} --up {}",
             triple(pose.eye_mm),
             triple(pose.look_at_mm),
             triple(pose.up)
@@ -275,7 +288,7 @@ fn default_pose(
             _ => {}
         },
     }
-    view.pose()
+    view
 }
 
 /// Warns, saying why and what to try, when nothing in the image was hit or drawn.
