@@ -11,6 +11,7 @@
 //! ```
 
 use crate::controller::FlyCamera;
+use crate::geometry::Toggles;
 use crate::scene::ScanSource;
 use crate::session::{Annotation, Controls, Session};
 use endocast_core::animation::KeyFrame;
@@ -219,6 +220,7 @@ impl Case {
         let preset = Preset::find(&c.preset).ok_or_else(|| bad("preset", &c.preset))?;
         let window = Window::new(c.window_level_hu, c.window_width_hu)
             .map_err(|e| CaseError::new(path, e))?;
+        let defaults = preset.settings();
         Ok(Controls {
             preset,
             mode: Mode::from_name(&c.mode).ok_or_else(|| bad("mode", &c.mode))?,
@@ -230,6 +232,9 @@ impl Case {
             collision: c.collision,
             speed_mm_s: c.speed_mm_s,
             window,
+            tf: defaults.tf,
+            peel: defaults.peel,
+            geometry: Toggles::default(),
         })
     }
 

@@ -5,9 +5,11 @@ use endocast_core::navigate::{seed_voxel, Collider, DistanceField, Lumen, LumenS
 use endocast_core::phantom::{Phantom, PhantomOptions};
 use endocast_core::render::Renderer;
 use endocast_core::Volume;
+use endocast_io::SeriesSummary;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// Bins of the value histogram under the isovalue slider.
@@ -37,23 +39,21 @@ pub enum ScanSource {
 impl ScanSource {
     /// Reads or generates the volume; the error is one line naming the file and the problem.
     pub fn load(&self) -> Result<Volume, String> {
+        self.load_with_series().map(|(volume, _)| volume)
+    }
+
+    /// Reads or generates the volume, with the series a DICOM folder holds (empty for other
+    /// sources) so the user can choose another.
+    pub fn load_with_series(&self) -> Result<(Volume, Vec<SeriesSummary>), String> {
         match self {
             Self::File { path, series } => {
                 let mut options = endocast_io::OpenOptions::default();
                 options.series.clone_from(series);
                 endocast_io::open(path, &options)
-                    .map(|loaded| loaded.volume)
+                    .map(|loaded| (loaded.volume, loaded.source.series_found))
                     .map_err(|e| format!("cannot read the scan: {e}"))
             }
-            Self::Phantom { name, size } => {
-                let phantom = Phantom::from_name(name)
-                    .ok_or_else(|| format!("no phantom called {name:?}"))?;
-                let options = PhantomOptions {
-                    size: *size,
-                    ..PhantomOptions::default()
-                };
-                Ok(phantom.build(&options))
-            }
+            Self::Phantom { name, size } => build_phantom(name, *size).map(|v| (v, Vec::new())),
         }
     }
 
@@ -66,9 +66,24 @@ impl ScanSource {
     }
 }
 
-/// The lumen the camera is in: its distance field and the camera's radius.
+/// Numbers the lumens found, so views of one (the overview) know when it changed.
+static LUMENS_FOUND: AtomicU64 = AtomicU64::new(0);
+
+/// The phantom called `name`, `size` voxels at its largest.
+fn build_phantom(name: &str, size: usize) -> Result<Volume, String> {
+    let phantom = Phantom::from_name(name).ok_or_else(|| format!("no phantom called {name:?}"))?;
+    let options = PhantomOptions {
+        size,
+        ..PhantomOptions::default()
+    };
+    Ok(phantom.build(&options))
+}
+
+/// The lumen the camera is in: its voxels, its distance field and the camera's radius.
 #[derive(Debug)]
 pub struct Navigation {
+    lumen: Arc<Lumen>,
+    id: u64,
     field: DistanceField,
     radius_mm: f64,
 }
@@ -83,7 +98,22 @@ impl Navigation {
         let lumen = Lumen::from_seed(volume, seed, threshold, side).ok()?;
         let field = DistanceField::new(&lumen, volume.geometry());
         let radius_mm = (2.0 * field.min_spacing_mm()).min(0.5 * field.max_mm());
-        Some(Self { field, radius_mm })
+        Some(Self {
+            lumen: Arc::new(lumen),
+            id: LUMENS_FOUND.fetch_add(1, Ordering::Relaxed),
+            field,
+            radius_mm,
+        })
+    }
+
+    /// The lumen's voxels.
+    pub fn lumen(&self) -> &Arc<Lumen> {
+        &self.lumen
+    }
+
+    /// A number of this lumen, different for every lumen found in this process.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// The collider for a camera at `eye_mm`: the camera's radius, shrunk to fit where the eye
@@ -92,6 +122,27 @@ impl Navigation {
     pub fn collider_at(&self, eye_mm: DVec3) -> Option<Collider<'_>> {
         let room = 0.9 * self.field.distance_mm(eye_mm);
         Collider::new(&self.field, self.radius_mm.min(room)).ok()
+    }
+
+    /// The point of the cross-section through `eye_mm` (perpendicular to `forward`) farthest
+    /// from the wall nearby: climbs the distance field within that plane in quarter-voxel
+    /// steps until it no longer rises ("centre in lumen").
+    pub fn centred(&self, eye_mm: DVec3, forward: DVec3) -> DVec3 {
+        let step = 0.25 * self.field.min_spacing_mm();
+        let limit = (4.0 * self.field.max_mm() / step).ceil() as usize + 1;
+        let mut p = eye_mm;
+        for _ in 0..limit {
+            let g = self.field.gradient(p);
+            let Some(uphill) = (g - forward * g.dot(forward)).try_normalize() else {
+                break;
+            };
+            let next = p + uphill * step;
+            if self.field.distance_mm(next) <= self.field.distance_mm(p) {
+                break;
+            }
+            p = next;
+        }
+        p
     }
 
     /// Distance from `p_mm` to the wall, mm (0 outside the lumen).
@@ -117,6 +168,8 @@ pub struct Scene {
     pub histogram: Vec<u64>,
     /// Lowest and highest physical value.
     pub value_range: (f64, f64),
+    /// The series of the DICOM folder it was read from (empty for other sources).
+    pub series_found: Vec<SeriesSummary>,
 }
 
 impl Scene {
@@ -129,7 +182,14 @@ impl Scene {
             renderer: Arc::new(Renderer::for_many_frames(volume)),
             histogram,
             value_range,
+            series_found: Vec::new(),
         }
+    }
+
+    /// The scene, knowing the series its DICOM folder holds.
+    pub fn with_series(mut self, series_found: Vec<SeriesSummary>) -> Self {
+        self.series_found = series_found;
+        self
     }
 
     /// The volume.

@@ -4,14 +4,16 @@
 //! tests drive a session exactly as the window does.
 
 use crate::controller::{FlyCamera, LocalMove};
+use crate::geometry::{Geometry, Toggles};
+use crate::jobs::{Job, Polled};
 use crate::scene::{Navigation, Scene};
 use crate::worker::{RenderWorker, View};
 use endocast_core::animation::{Animation, KeyFrame};
 use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
-use endocast_core::navigate::{default_view, LumenChoice};
+use endocast_core::navigate::{default_view, LumenChoice, LumenSide};
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
-use endocast_core::render::{Mode, RenderSettings};
+use endocast_core::render::{Mode, PeelSettings, RenderSettings, TransferFunction};
 use endocast_core::views::slices::Window;
 use glam::DVec3;
 use std::sync::Arc;
@@ -46,11 +48,18 @@ pub struct Controls {
     pub speed_mm_s: f64,
     /// Window of the slices.
     pub window: Window,
+    /// The transfer function (DVR, and behind a translucent wall).
+    pub tf: TransferFunction,
+    /// How `peel` mode peels.
+    pub peel: PeelSettings,
+    /// The geometry shown with the scan.
+    pub geometry: Toggles,
 }
 
 impl Controls {
     /// The clinical defaults of `preset`, collision on, 20 mm/s.
     pub fn of_preset(preset: &'static Preset) -> Self {
+        let defaults = preset.settings();
         Self {
             preset,
             mode: preset.mode,
@@ -62,6 +71,9 @@ impl Controls {
             collision: true,
             speed_mm_s: 20.0,
             window: preset.window,
+            tf: defaults.tf,
+            peel: defaults.peel,
+            geometry: Toggles::default(),
         }
     }
 
@@ -71,6 +83,8 @@ impl Controls {
         settings.mode = self.mode;
         settings.iso_hu = self.iso_hu;
         settings.iso_opacity = self.iso_opacity;
+        settings.tf.clone_from(&self.tf);
+        settings.peel.clone_from(&self.peel);
         settings
     }
 
@@ -120,6 +134,8 @@ impl Playback {
 pub struct Session {
     scene: Arc<Scene>,
     navigation: Option<Navigation>,
+    /// The lumen being found around a new eye position.
+    finding: Option<Job<Option<Navigation>>>,
     camera: FlyCamera,
     home: FlyCamera,
     /// The control panel's values.
@@ -131,6 +147,7 @@ pub struct Session {
     key_frames: Vec<KeyFrame>,
     playback: Option<Playback>,
     annotations: Vec<Annotation>,
+    geometry: Geometry,
 }
 
 impl Session {
@@ -160,6 +177,7 @@ impl Session {
         let mut session = Self {
             scene,
             navigation: None,
+            finding: None,
             camera,
             home: camera,
             controls,
@@ -170,8 +188,10 @@ impl Session {
             key_frames: Vec::new(),
             playback: None,
             annotations: Vec::new(),
+            geometry: Geometry::default(),
         };
-        session.find_lumen();
+        // The first lumen is found here, on the loading thread; later ones off the UI thread.
+        session.navigation = session.lumen_search().and_then(|search| search());
         session
     }
 
@@ -213,20 +233,51 @@ impl Session {
             .camera(c.eye_mm(), c.eye_mm() + c.forward(), c.up(), self.view_size)
     }
 
-    /// Sends the current view to the worker when it differs from the last one sent (or when the
-    /// camera has just stopped, so the view refines); returns the new request's generation.
-    pub fn sync(&mut self, moving: bool) -> Option<u64> {
+    /// The view to render now; `None` when the controls make no camera.
+    fn view(&mut self, moving: bool) -> Option<View> {
         let camera = self.camera().ok()?;
         let stereo = self
             .controls
             .stereo
             .then(|| StereoRig::focused_at(self.focus_mm()));
-        let view = View {
+        let marks = self.annotations.iter().map(|a| a.point_mm).collect();
+        let (lo, hi) = self.scene.volume().geometry().world_bounds();
+        let scene = self
+            .geometry
+            .scene(self.controls.geometry, marks, (lo + hi) / 2.0);
+        Some(View {
             camera,
             settings: self.controls.settings(),
             stereo,
             moving,
-        };
+            scene,
+        })
+    }
+
+    /// The meshes read and the scene built from the geometry toggles.
+    pub fn geometry_mut(&mut self) -> &mut Geometry {
+        &mut self.geometry
+    }
+
+    /// Whether the view (camera, settings or geometry) differs from the last one sent to the
+    /// worker, so that the window renders it at moving quality first.
+    pub fn view_changed(&mut self) -> bool {
+        match (self.view(false), &self.last_view) {
+            (Some(now), Some(last)) => {
+                View {
+                    moving: last.moving,
+                    ..now
+                } != *last
+            }
+            (now, last) => now.is_some() != last.is_some(),
+        }
+    }
+
+    /// Sends the current view to the worker when it differs from the last one sent (or when the
+    /// camera has just stopped, so the view refines); returns the new request's generation.
+    pub fn sync(&mut self, moving: bool) -> Option<u64> {
+        self.poll_lumen();
+        let view = self.view(moving)?;
         if self.last_view.as_ref() == Some(&view) {
             return None;
         }
@@ -265,7 +316,12 @@ impl Session {
 
     /// Flies by `step` (sliding along the wall when collision is on); returns the distance
     /// travelled, mm.
+    /// While the lumen around a new position is being found, collision holds the camera.
     pub fn fly(&mut self, step: LocalMove) -> f64 {
+        self.poll_lumen();
+        if self.controls.collision && self.finding.is_some() {
+            return 0.0;
+        }
         let eye = self.camera.eye_mm();
         let collider = self
             .navigation
@@ -320,6 +376,18 @@ impl Session {
         self.find_lumen();
     }
 
+    /// Moves the eye, within the plane across the view, to the middle of the lumen around it
+    /// (the view direction stays); false outside a lumen.
+    pub fn centre_in_lumen(&mut self) -> bool {
+        let Some(nav) = &self.navigation else {
+            return false;
+        };
+        let c = &self.camera;
+        let centre = nav.centred(c.eye_mm(), c.forward());
+        self.camera.jump_to(centre);
+        true
+    }
+
     /// Back to the starting view.
     pub fn reset(&mut self) {
         self.camera = self.home;
@@ -342,22 +410,60 @@ impl Session {
 
     /// Finds the lumen around the eye for the preset's lumen threshold (the wall isovalue for a
     /// preset without one); none when the eye is in the wall or outside.
+    ///
+    /// A new lumen is found on a thread of its own (a flood fill and a distance field: up to
+    /// a second on a large scan); meanwhile there is none, see [`Session::finding_lumen`].
     pub fn find_lumen(&mut self) {
         let eye = self.camera.eye_mm();
         if let Some(nav) = &self.navigation {
             if nav.distance_mm(eye) > 0.0 {
+                self.finding = None;
                 return;
             }
         }
+        self.navigation = None;
+        self.finding = self
+            .lumen_search()
+            .map(|search| Job::spawn("lumen", self.worker.notifier(), search));
+    }
+
+    /// The search for the lumen around the eye, to run anywhere; `None` without a threshold.
+    fn lumen_search(&self) -> Option<impl FnOnce() -> Option<Navigation> + Send + 'static> {
+        let (threshold, side) = self.lumen_threshold()?;
+        let renderer = Arc::clone(&self.scene.renderer);
+        let eye = self.camera.eye_mm();
+        Some(move || Navigation::around(renderer.volume(), eye, threshold, side))
+    }
+
+    /// Whether the lumen around the eye is being found.
+    pub fn finding_lumen(&self) -> bool {
+        self.finding.is_some()
+    }
+
+    /// Takes the lumen found, when the search has finished.
+    pub fn poll_lumen(&mut self) {
+        let Some(job) = &self.finding else {
+            return;
+        };
+        match job.poll() {
+            Polled::Running => {}
+            Polled::Done(navigation) => {
+                self.navigation = navigation;
+                self.finding = None;
+            }
+            Polled::Lost => self.finding = None,
+        }
+    }
+
+    /// The threshold and side the lumen is grown at: the preset's lumen threshold, else the
+    /// wall isovalue (lumen darker than the wall).
+    pub fn lumen_threshold(&self) -> Option<(f64, LumenSide)> {
         let choice = LumenChoice {
             preset: Some(self.controls.preset).filter(|p| p.lumen.is_some()),
             iso: Some(self.controls.iso_hu),
             ..LumenChoice::default()
         };
-        self.navigation = choice
-            .resolve()
-            .ok()
-            .and_then(|(t, side)| Navigation::around(self.scene.volume(), eye, t, side));
+        choice.resolve().ok()
     }
 
     /// Records the current view as a key frame (after the last).
