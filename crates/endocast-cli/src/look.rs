@@ -4,6 +4,7 @@
 use crate::peel::PeelArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use endocast_core::look::{Look, LookKind, PresetLook, SecretionMode, Texture, BUILT_IN_TEXTURES};
 use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, RenderSettings, TransferFunction};
 use endocast_core::tissue::{self, ScanValues};
@@ -48,6 +49,8 @@ pub struct LookArgs {
     skip_empty: bool,
     #[command(flatten)]
     peel: PeelArgs,
+    #[command(flatten)]
+    realism: RealismArgs,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -85,12 +88,29 @@ impl LookArgs {
                 (s, None, summary)
             }
         };
+        let look_base = preset.map_or_else(|| tissue::default_look(&scan), |p| p.look);
         Ok(ScanLook {
             settings: self.overridden(base)?,
             preset,
             summary,
             scan,
+            look: self.realism.look(&look_base, self.iso)?,
         })
+    }
+
+    /// The clinical or realistic look the options ask for, with the preset's values as the
+    /// table gives them (HU; see [`LookArgs::on_scan`] for a scan's units); `None` for plain.
+    pub fn look(&self) -> Result<Option<Look>> {
+        let base = self.preset()?.map_or(PresetLook::CT, |p| p.look);
+        self.realism.look(&base, self.iso)
+    }
+
+    /// The name of the look asked for with `--look` (`plain` when none).
+    pub fn look_name(&self) -> String {
+        self.realism
+            .look
+            .as_deref()
+            .map_or_else(|| "plain".to_owned(), |n| n.trim().to_ascii_lowercase())
     }
 
     fn overridden(&self, mut s: RenderSettings) -> Result<RenderSettings> {
@@ -130,6 +150,130 @@ impl LookArgs {
     }
 }
 
+/// The endoscopic look (Krüger et al.'s Sinus Endoscopy): secretion, wetness, texture, light.
+#[derive(Args, Debug, Clone, Default)]
+pub struct RealismArgs {
+    /// plain (the mode's own image), clinical (the tissue lit from the tip, smoothed) or
+    /// realistic (wet, textured mucosa, secretion); default: the preset's, else plain. With a
+    /// look other than plain, --iso is the tissue threshold the rays stop at.
+    #[arg(long, value_name = "LOOK")]
+    look: Option<String>,
+    /// Secretion: off, on (constant density between the first secretion and tissue hits) or
+    /// accumulate (along the ray).
+    #[arg(long, value_name = "MODE")]
+    secretion: Option<String>,
+    /// Secretion threshold, physical units (between the lumen's value and the tissue's).
+    #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
+    secretion_iso: Option<f64>,
+    /// Wetness, 0 (dry) to 1: darkening where the tissue turns away, sharp highlights.
+    #[arg(long, value_name = "0..1", allow_negative_numbers = true)]
+    wetness: Option<f32>,
+    /// Detail texture: mucosa, grid, none, or a PNG file (its luminance).
+    #[arg(long, value_name = "NAME|FILE.png")]
+    texture: Option<String>,
+    /// Edge of one texture tile on the tissue, mm.
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    texture_scale: Option<f32>,
+    /// Distance at which the tip's light falls to half, mm (0: no fall-off).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    attenuation: Option<f32>,
+}
+
+impl RealismArgs {
+    /// The options that only a clinical or realistic look uses, as given.
+    fn given(&self) -> Vec<&'static str> {
+        let flags = [
+            ("--secretion", self.secretion.is_some()),
+            ("--secretion-iso", self.secretion_iso.is_some()),
+            ("--wetness", self.wetness.is_some()),
+            ("--texture", self.texture.is_some()),
+            ("--texture-scale", self.texture_scale.is_some()),
+            ("--attenuation", self.attenuation.is_some()),
+        ];
+        flags
+            .iter()
+            .filter(|(_, on)| *on)
+            .map(|(f, _)| *f)
+            .collect()
+    }
+
+    /// The look asked for over `base` (a preset's look in the scan's units), `tissue_iso` the
+    /// `--iso` given; `None` for plain.
+    fn look(&self, base: &PresetLook, tissue_iso: Option<f64>) -> Result<Option<Look>> {
+        let kind = match &self.look {
+            Some(name) => LookKind::from_name(name).with_context(|| {
+                format!("unknown look {name:?}; choose plain, clinical or realistic")
+            })?,
+            None => base.kind,
+        };
+        let Some(mut look) = Look::of_kind(kind, base) else {
+            let given = self.given();
+            if !given.is_empty() {
+                bail!(
+                    "{} only apply to --look clinical or realistic (the plain look has no deferred stage)",
+                    given.join(", ")
+                );
+            }
+            return Ok(None);
+        };
+        if let Some(iso) = tissue_iso {
+            look.ray.tissue_hu = finite("--iso", iso)?;
+        }
+        if let Some(iso) = self.secretion_iso {
+            look.ray.secretion_hu = finite("--secretion-iso", iso)?;
+        }
+        if let Some(mode) = &self.secretion {
+            look.ray.secretion = SecretionMode::from_name(mode).with_context(|| {
+                format!("unknown secretion mode {mode:?}; choose off, on or accumulate")
+            })?;
+        }
+        if let Some(w) = self.wetness {
+            if !(0.0..=1.0).contains(&w) {
+                bail!("--wetness must be between 0 and 1, not {w}");
+            }
+            look.shading.wetness = w;
+        }
+        if let Some(spec) = &self.texture {
+            look.shading.texture = texture(spec)?.map(std::sync::Arc::new);
+        }
+        if let Some(mm) = self.texture_scale {
+            if !(mm.is_finite() && mm > 0.0) {
+                bail!("--texture-scale must be a positive number of mm, not {mm}");
+            }
+            look.shading.texture_mm = mm;
+        }
+        if let Some(mm) = self.attenuation {
+            if !(mm.is_finite() && mm >= 0.0) {
+                bail!("--attenuation must be a distance in mm (0 for none), not {mm}");
+            }
+            look.shading.attenuation_mm = (mm > 0.0).then_some(mm);
+        }
+        look.ray.validate().context("invalid look")?;
+        look.shading.validate().context("invalid look")?;
+        Ok(Some(look))
+    }
+}
+
+/// A detail texture by built-in name (`none`: no texture) or from a PNG file.
+fn texture(spec: &str) -> Result<Option<Texture>> {
+    let name = spec.trim();
+    if BUILT_IN_TEXTURES.contains(&name.to_ascii_lowercase().as_str()) {
+        return Ok(Texture::built_in(name));
+    }
+    let path = std::path::Path::new(spec);
+    let is_png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png && !path.exists() {
+        bail!(
+            "unknown texture {spec:?}; choose {} or a .png file",
+            BUILT_IN_TEXTURES.join(", ")
+        );
+    }
+    let texture = endocast_io::texture::read_texture(path).context("cannot use the texture")?;
+    Ok(Some(texture))
+}
+
 /// How a scan looks, its values understood.
 #[derive(Debug, Clone)]
 pub struct ScanLook {
@@ -141,6 +285,8 @@ pub struct ScanLook {
     pub summary: String,
     /// What the histogram says.
     pub scan: ScanValues,
+    /// The clinical or realistic look's stages; `None` for the plain look.
+    pub look: Option<Look>,
 }
 
 /// The preset called `name`, or an error listing the known ones.

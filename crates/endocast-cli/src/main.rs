@@ -10,6 +10,7 @@ mod parse;
 mod peel;
 mod progress;
 mod scene_args;
+mod structure;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -8,6 +8,7 @@ mod common;
 mod default_views;
 mod info_shared_data;
 mod integrity;
+mod look;
 mod navigation;
 mod phantom_convert;
 mod presets;

@@ -130,6 +130,11 @@ impl Coverage {
         })
     }
 
+    /// The grid the coverage was made for.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
     /// The same wall with nothing seen yet: a fresh coverage for another pass over it (its
     /// result can be [merged](Coverage::merge) with this one's).
     pub fn cleared(&self) -> Self {
@@ -300,17 +305,21 @@ impl Coverage {
             let Some(hit) = camera.point_at(x, y, f64::from(*depth)) else {
                 continue;
             };
-            let unseen = self
-                .cell_corners(hit)
-                .into_iter()
-                .flatten()
-                .any(|c| self.wall.get(c) && !self.seen.get(c));
-            if unseen {
+            if self.unseen_near(hit) {
                 image.blend(x as i64, y as i64, color, amount);
                 tinted += 1;
             }
         }
         Ok(tinted)
+    }
+
+    /// Whether an unseen wall voxel is a corner of the grid cell holding `p_mm` (world mm): a
+    /// hit there shows wall never seen.
+    pub fn unseen_near(&self, p_mm: DVec3) -> bool {
+        self.cell_corners(p_mm)
+            .into_iter()
+            .flatten()
+            .any(|c| self.wall.get(c) && !self.seen.get(c))
     }
 }
 

@@ -19,6 +19,7 @@ pub mod coverage;
 pub mod flight;
 pub mod geometry;
 pub mod isosurface;
+pub mod look;
 pub mod navigate;
 pub mod path;
 pub mod phantom;

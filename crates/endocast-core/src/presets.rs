@@ -18,6 +18,7 @@
 //! Hounsfield units, `ventricles` in the intensity units of a T1 MRI.
 
 use crate::camera::Projection;
+use crate::look::{PresetLook, SecretionMode};
 use crate::navigate::LumenSide;
 use crate::render::{Mode, PeelLayer, PeelSettings, RenderSettings, TransferFunction};
 use crate::views::slices::Window;
@@ -106,6 +107,12 @@ pub enum Structure {
     /// The airway tree grown from the trachea's round section in the top axial slices, its
     /// threshold lowered until it stops leaking into the lung.
     Trachea,
+    /// The aorta: the longest chain of bright round sections of 7–16 mm radius in the axial
+    /// slices (see [`crate::navigate::find_aorta`]).
+    Aorta,
+    /// The colon: the largest gas component inside the body, not the lung (see
+    /// [`crate::navigate::find_colon`]).
+    Colon,
 }
 
 /// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
@@ -161,6 +168,9 @@ pub struct Preset {
     pub fov_deg: f64,
     /// The scale the values above are written on.
     pub reference: Reference,
+    /// The look shown by default, and the thresholds, colours and surface the clinical and
+    /// realistic looks take (`--look`).
+    pub look: PresetLook,
 }
 
 /// The window for CT with an air-filled lumen: air black, soft tissue light grey, bone white.
@@ -182,12 +192,19 @@ pub const ALL: &[Preset] = &[
             threshold: -500.0,
             side: LumenSide::Below,
             tissue: "gas",
-            structure: Structure::Largest,
+            structure: Structure::Colon,
         }),
         window: AIR_TISSUE,
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::Hounsfield,
+        look: PresetLook {
+            secretion_mode: SecretionMode::Off,
+            texture_mm: 15.0,
+            attenuation_mm: 60.0,
+            tissue_color: [0.95, 0.6, 0.5],
+            ..PresetLook::CT
+        },
     },
     Preset {
         name: "bronchoscopy",
@@ -214,6 +231,15 @@ pub const ALL: &[Preset] = &[
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::Hounsfield,
+        look: PresetLook {
+            // Thin bronchial walls reach only about −500 HU: a higher tissue threshold would
+            // open holes in them; the secretion threshold stays above the lung (−820 HU).
+            tissue: -450.0,
+            secretion: -780.0,
+            attenuation_mm: 50.0,
+            tissue_color: [0.95, 0.68, 0.62],
+            ..PresetLook::CT
+        },
     },
     Preset {
         name: "angioscopy",
@@ -234,7 +260,7 @@ pub const ALL: &[Preset] = &[
             threshold: 130.0,
             side: LumenSide::Above,
             tissue: "contrast",
-            structure: Structure::Largest,
+            structure: Structure::Aorta,
         }),
         // A vessel window: contrast light grey, calcium and metal white, fat dark.
         window: Window {
@@ -244,6 +270,18 @@ pub const ALL: &[Preset] = &[
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::Hounsfield,
+        look: PresetLook {
+            // The lumen is bright: the "secretion" threshold lies between contrast and wall.
+            tissue: 130.0,
+            secretion: 220.0,
+            secretion_mode: SecretionMode::Off,
+            wetness: 0.4,
+            texture: "none",
+            attenuation_mm: 30.0,
+            tissue_color: [0.85, 0.35, 0.3],
+            secretion_color: [0.8, 0.1, 0.1],
+            ..PresetLook::CT
+        },
     },
     Preset {
         name: "sinus",
@@ -269,6 +307,7 @@ pub const ALL: &[Preset] = &[
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::Hounsfield,
+        look: PresetLook::CT,
     },
     Preset {
         name: "ventricles",
@@ -298,6 +337,19 @@ pub const ALL: &[Preset] = &[
         reference: Reference::T1Brain {
             csf: 43.0,
             tissue: 119.0,
+        },
+        look: PresetLook {
+            // Ependyma: between CSF (43) and the wall at 75, and the secretion threshold just
+            // above CSF (none by default: CSF is clear).
+            tissue: 80.0,
+            secretion: 60.0,
+            secretion_mode: SecretionMode::Off,
+            wetness: 0.5,
+            texture_mm: 20.0,
+            attenuation_mm: 30.0,
+            tissue_color: [0.92, 0.84, 0.76],
+            secretion_color: [0.85, 0.85, 0.9],
+            ..PresetLook::CT
         },
     },
     Preset {
@@ -338,6 +390,17 @@ pub const ALL: &[Preset] = &[
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::AsGiven,
+        look: PresetLook {
+            // The marrow is the "lumen" (above the threshold): the secretion lies above too.
+            tissue: 30.0,
+            secretion: 40.0,
+            secretion_mode: SecretionMode::Off,
+            wetness: 0.3,
+            texture: "none",
+            attenuation_mm: 30.0,
+            tissue_color: [0.93, 0.88, 0.78],
+            ..PresetLook::CT
+        },
     },
     Preset {
         name: "ramp",
@@ -354,6 +417,7 @@ pub const ALL: &[Preset] = &[
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::Hounsfield,
+        look: PresetLook::CT,
     },
     Preset {
         name: "complex",
@@ -370,6 +434,7 @@ pub const ALL: &[Preset] = &[
         projection: Projection::Pinhole,
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::Hounsfield,
+        look: PresetLook::CT,
     },
 ];
 
@@ -440,6 +505,7 @@ impl Preset {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::look::LookKind;
 
     #[test]
     fn names_are_unique_lower_case_and_found_in_any_case() {
@@ -508,6 +574,26 @@ mod tests {
             assert_eq!(Preset::find(name).unwrap().settings(), settings, "{name}");
         }
         assert_eq!(Mode::Hybrid, base.mode);
+    }
+
+    #[test]
+    fn every_look_puts_the_secretion_on_the_lumen_side_of_the_tissue() {
+        for preset in ALL {
+            let look = preset.look;
+            assert_eq!(look.kind, LookKind::Plain, "{}", preset.name);
+            let lumen_below = preset.lumen.is_none_or(|l| l.side == LumenSide::Below);
+            assert_eq!(look.secretion < look.tissue, lumen_below, "{}", preset.name);
+            for kind in [LookKind::Clinical, LookKind::Realistic] {
+                let l = crate::look::Look::of_kind(kind, &look).unwrap();
+                assert_eq!(l.ray.validate(), Ok(()), "{}", preset.name);
+                assert_eq!(l.shading.validate(), Ok(()), "{}", preset.name);
+            }
+        }
+        let sinus = Preset::find("sinus").unwrap().look;
+        assert_eq!(
+            (sinus.tissue, sinus.secretion_mode),
+            (-230.0, SecretionMode::On)
+        );
     }
 
     #[test]

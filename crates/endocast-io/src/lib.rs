@@ -39,6 +39,7 @@ pub mod raw;
 pub mod route_file;
 pub mod samples;
 mod text;
+pub mod texture;
 pub mod transfer_json;
 pub mod video;
 

@@ -4,7 +4,11 @@
 //! with synthetic input; [`run`] puts it in a native window (eframe, OpenGL).
 
 use crate::case::{Autosave, Case, SessionCase};
+use crate::flight_ui::FlightTools;
+use crate::geometry_ui::MeshLoader;
+use crate::jobs::Polled;
 use crate::mark_tool::MarkTool;
+use crate::overview::OverviewView;
 use crate::panel::controls_ui;
 use crate::scene::{ScanSource, Scene};
 use crate::session::Session;
@@ -139,13 +143,14 @@ impl ViewerApp {
             egui::SidePanel::right("slices")
                 .resizable(false)
                 .exact_width(250.0)
-                .show(ctx, |ui| ready.slices.slices_ui(ui, &mut ready.session));
+                .show(ctx, |ui| side_ui(ui, ready));
             egui::CentralPanel::default()
                 .frame(egui::Frame::NONE.fill(egui::Color32::BLACK))
                 .show(ctx, |ui| view_ui(ui, ready));
             if let Some(action) = action {
                 self.act(action);
             }
+            self.poll_tasks();
             self.autosave(false);
         } else {
             egui::CentralPanel::default().show(ctx, |ui| {
@@ -178,6 +183,10 @@ impl ViewerApp {
                 self.ready = Some(Ready {
                     session,
                     slices: SlicesView::default(),
+                    overview: OverviewView::default(),
+                    tools: FlightTools::default(),
+                    meshes: MeshLoader::default(),
+                    tasks: Vec::new(),
                     autosave: Autosave::new(path, AUTOSAVE_INTERVAL),
                     view_texture: None,
                     shown: None,
@@ -187,6 +196,28 @@ impl ViewerApp {
                 self.loading = None;
             }
         }
+    }
+
+    /// Picks up what finished off the UI thread: planned paths, exports, screenshots.
+    fn poll_tasks(&mut self) {
+        let Some(ready) = &mut self.ready else {
+            return;
+        };
+        let finished = [
+            ready.tools.poll(&mut ready.session),
+            ready.meshes.poll(&mut ready.session),
+        ];
+        if let Some(message) = finished.into_iter().flatten().last() {
+            self.message = message;
+        }
+        ready.tasks.retain(|job| match job.poll() {
+            Polled::Running => true,
+            Polled::Done(message) => {
+                self.message = message;
+                false
+            }
+            Polled::Lost => false,
+        });
     }
 
     fn status_ui(&self, ui: &mut egui::Ui) {
@@ -217,6 +248,17 @@ impl ViewerApp {
                     let source = ScanSource::File { path, series: None };
                     self.start_loading(source, None);
                 }
+            }
+            Action::OpenSeries(uid) => {
+                let folder = match self.session().map(|s| &s.scene().source) {
+                    Some(ScanSource::File { path, .. }) => path.clone(),
+                    _ => return,
+                };
+                let source = ScanSource::File {
+                    path: folder,
+                    series: Some(uid),
+                };
+                self.start_loading(source, None);
             }
             Action::SaveCase => self.autosave(true),
             Action::Message(m) => self.message = m,
@@ -273,6 +315,28 @@ impl ViewerApp {
     }
 }
 
+/// The right column: the three slices through the camera and the overview, each `edge`
+/// wide, with the camera's position and direction.
+fn side_ui(ui: &mut egui::Ui, ready: &mut Ready) {
+    let edge = ui.available_width().min(ui.available_height() / 4.5);
+    if let Some(p) = ready.slices.slices_ui(ui, &ready.session, edge) {
+        ready.tools.slice_clicked(&mut ready.session, p);
+    }
+    let path: Vec<_> = ready
+        .session
+        .key_frames()
+        .iter()
+        .map(|k| k.eye_mm)
+        .collect();
+    ready
+        .overview
+        .overview_ui(ui, &ready.session, &path, ready.tools.ends(), edge);
+    let c = ready.session.fly_camera();
+    let (e, f) = (c.eye_mm(), c.forward());
+    ui.label(format!("eye  {:7.1} {:7.1} {:7.1} mm", e.x, e.y, e.z));
+    ui.label(format!("view {:7.2} {:7.2} {:7.2}", f.x, f.y, f.z));
+}
+
 /// "Frame 12.3 ms · quarter → 41 ms after input · eye … · wall 4.1 mm".
 fn frame_status(ready: &Ready) -> String {
     let session = &ready.session;
@@ -292,10 +356,11 @@ fn frame_status(ready: &Ready) -> String {
         })
     });
     let eye = session.fly_camera().eye_mm();
-    let wall = session
-        .navigation()
-        .map(|n| format!(" · wall {:.1} mm", n.distance_mm(eye)))
-        .unwrap_or_default();
+    let wall = match session.navigation() {
+        Some(n) => format!(" · wall {:.1} mm", n.distance_mm(eye)),
+        None if session.finding_lumen() => " · finding the lumen…".into(),
+        None => String::new(),
+    };
     format!(
         "{} · eye ({:.1}, {:.1}, {:.1}) mm{wall}",
         frame.unwrap_or_else(|| "rendering…".into()),
@@ -346,8 +411,8 @@ fn load(
         None => None,
     };
     let source = case_file.as_ref().map_or(source, |c| c.scan.clone());
-    let volume = source.load()?;
-    let scene = Arc::new(Scene::new(source, volume));
+    let (volume, series) = source.load_with_series()?;
+    let scene = Arc::new(Scene::new(source, volume).with_series(series));
     let repaint = ctx.clone();
     let mut session = Session::new(scene, preset, pose, move || repaint.request_repaint());
     if let (Some(file), Some(path)) = (&case_file, &case) {

@@ -3,6 +3,7 @@
 //! made from a session and applied to one, and autosaved.
 
 use crate::controller::FlyCamera;
+use crate::geometry::Toggles;
 use crate::session::{Controls, Session};
 use endocast_core::animation::KeyFrame;
 use endocast_core::camera::Projection;
@@ -76,6 +77,7 @@ impl SessionCase for Case {
         let preset = Preset::find(&c.preset).ok_or_else(|| bad("preset", &c.preset))?;
         let window = Window::new(c.window_level_hu, c.window_width_hu)
             .map_err(|e| CaseError::new(path, e))?;
+        let defaults = preset.settings();
         Ok(Some(Controls {
             preset,
             mode: Mode::from_name(&c.mode).ok_or_else(|| bad("mode", &c.mode))?,
@@ -87,6 +89,9 @@ impl SessionCase for Case {
             collision: c.collision,
             speed_mm_s: c.speed_mm_s,
             window,
+            tf: defaults.tf,
+            peel: defaults.peel,
+            geometry: Toggles::default(),
         }))
     }
 

@@ -24,6 +24,7 @@ pub const HELP: &[(&str, &str)] = &[
     ("K", "record a key frame"),
     ("P / Space", "play / pause the key frames"),
     ("C", "collision on / off"),
+    ("Z", "centre in the lumen (across the view)"),
     ("H", "back to the start"),
     ("+ / −", "faster / slower"),
 ];
@@ -61,6 +62,8 @@ pub struct Commands {
     pub toggle_collision: bool,
     /// H.
     pub reset: bool,
+    /// Z.
+    pub centre: bool,
     /// + (doubles the speed).
     pub faster: bool,
     /// − (halves the speed).
@@ -76,6 +79,7 @@ impl Commands {
             play_pause: p(Key::P) || p(Key::Space),
             toggle_collision: p(Key::C),
             reset: p(Key::H),
+            centre: p(Key::Z),
             faster: p(Key::Plus) || p(Key::Equals),
             slower: p(Key::Minus),
         }

@@ -12,6 +12,10 @@
 //! - [`session`]: the state of one open scan — every user action is a method, so tests drive it
 //!   without a window;
 //! - [`case`]: case files, written atomically and autosaved;
+//! - [`planner`]: the centred path between two points (or to the farthest) as key frames;
+//! - [`export`]: the flight filmed (GIF, MP4, PNGs) and its path files (ours, Slicer Markups);
+//! - [`geometry`]: the grid, the endoscope's instrument, marker spheres and meshes drawn;
+//! - [`jobs`]: work off the UI thread (slices, overview, planning, export, screenshots);
 //! - [`app`]: the window (egui), which maps input to the session and draws what it has.
 //!
 //! ```no_run
@@ -35,6 +39,13 @@
 pub mod app;
 pub mod case;
 pub mod controller;
+pub mod export;
+#[cfg(feature = "window")]
+mod flight_ui;
+pub mod geometry;
+#[cfg(feature = "window")]
+mod geometry_ui;
+pub mod jobs;
 #[cfg(feature = "window")]
 pub mod keys;
 #[cfg(feature = "window")]
@@ -42,13 +53,18 @@ mod mark_tool;
 #[cfg(feature = "window")]
 mod marks;
 #[cfg(feature = "window")]
+mod overview;
+#[cfg(feature = "window")]
 mod panel;
+pub mod planner;
 pub mod scene;
 pub mod session;
 #[cfg(feature = "window")]
 mod slices;
 #[cfg(feature = "window")]
 mod state;
+#[cfg(feature = "window")]
+mod tf_editor;
 #[cfg(feature = "window")]
 mod view;
 pub mod worker;

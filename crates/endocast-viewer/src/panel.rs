@@ -1,14 +1,18 @@
 //! The control panel: the scan, the view's controls with clinical defaults per preset, the
 //! flight, the key frames, the marks and the case.
 
+use crate::jobs::Job;
 use crate::keys::HELP;
+use crate::scene::ScanSource;
 use crate::session::Session;
 use crate::state::{Action, Ready};
-use egui::{Color32, Sense, Stroke, Vec2};
+use crate::tf_editor::histogram_ui;
 use endocast_core::camera::Projection;
 use endocast_core::presets;
-use endocast_core::render::Mode;
+use endocast_core::render::{Mode, PeelLayer, PeelSettings, Unpeeled};
+use endocast_io::SeriesSummary;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Draws the panel; returns what the application must do.
 pub(crate) fn controls_ui(
@@ -29,6 +33,9 @@ pub(crate) fn controls_ui(
             action = Some(Action::Open);
         }
     });
+    if let Some(uid) = series_ui(ui, &ready.session) {
+        action = Some(Action::OpenSeries(uid));
+    }
     ui.separator();
     view_controls_ui(ui, &mut ready.session);
     ui.separator();
@@ -38,6 +45,27 @@ pub(crate) fn controls_ui(
         .show(ui, |ui| {
             if let Some(a) = key_frames_ui(ui, &mut ready.session) {
                 action = Some(a);
+            }
+        });
+    egui::CollapsingHeader::new("Geometry")
+        .default_open(false)
+        .show(ui, |ui| {
+            if let Some(m) = ready.meshes.geometry_ui(ui, &mut ready.session) {
+                action = Some(Action::Message(m));
+            }
+        });
+    egui::CollapsingHeader::new("Planned path")
+        .default_open(true)
+        .show(ui, |ui| {
+            if let Some(m) = ready.tools.path_ui(ui, &ready.session) {
+                action = Some(Action::Message(m));
+            }
+        });
+    egui::CollapsingHeader::new("Export the flight")
+        .default_open(false)
+        .show(ui, |ui| {
+            if let Some(m) = ready.tools.export_ui(ui, &ready.session) {
+                action = Some(Action::Message(m));
             }
         });
     egui::CollapsingHeader::new("Marks and measurement")
@@ -54,10 +82,8 @@ pub(crate) fn controls_ui(
                     action = Some(Action::SaveCase);
                 }
                 if ui.button("Screenshot").clicked() {
-                    action = Some(Action::Message(screenshot(
-                        &ready.session,
-                        ready.autosave.path(),
-                    )));
+                    let job = screenshot(ui, &ready.session, ready.autosave.path());
+                    ready.tasks.push(job);
                 }
             });
         });
@@ -73,6 +99,44 @@ pub(crate) fn controls_ui(
     action
 }
 
+/// With a DICOM folder of several series: the one shown, and the others to choose from;
+/// returns the SeriesInstanceUID chosen.
+fn series_ui(ui: &mut egui::Ui, session: &Session) -> Option<String> {
+    let scene = session.scene();
+    if scene.series_found.len() < 2 {
+        return None;
+    }
+    let shown = match &scene.source {
+        ScanSource::File { series, .. } => series.clone(),
+        ScanSource::Phantom { .. } => None,
+    };
+    let name = |s: &SeriesSummary| {
+        let what = if s.description.is_empty() {
+            &s.uid
+        } else {
+            &s.description
+        };
+        format!("{} {what} ({} images)", s.modality, s.images)
+    };
+    // Without a choice the reader took the largest series, listed first.
+    let current = shown.or_else(|| scene.series_found.first().map(|s| s.uid.clone()));
+    let mut chosen = current.clone();
+    egui::ComboBox::from_label("series")
+        .selected_text(
+            scene
+                .series_found
+                .iter()
+                .find(|s| Some(&s.uid) == current.as_ref())
+                .map_or_else(|| "?".into(), name),
+        )
+        .show_ui(ui, |ui| {
+            for s in &scene.series_found {
+                ui.selectable_value(&mut chosen, Some(s.uid.clone()), name(s));
+            }
+        });
+    chosen.filter(|uid| Some(uid) != current.as_ref())
+}
+
 fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     let mut preset = session.controls.preset;
     egui::ComboBox::from_label("preset")
@@ -86,7 +150,7 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     if !std::ptr::eq(preset, session.controls.preset) {
         session.apply_preset(preset);
     }
-    let scene = std::sync::Arc::clone(session.scene());
+    let scene = Arc::clone(session.scene());
     let c = &mut session.controls;
     egui::ComboBox::from_label("mode")
         .selected_text(c.mode.name())
@@ -96,7 +160,9 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
             }
         });
     let (lo, hi) = scene.value_range;
-    histogram_ui(ui, &scene.histogram, (lo, hi), &mut c.iso_hu);
+    histogram_ui(ui, &scene.histogram, (lo, hi), &mut c.iso_hu, &mut c.tf).on_hover_text(
+        "click: isovalue · drag a dot: transfer function · double-click: add · right-click: remove",
+    );
     ui.add(egui::Slider::new(&mut c.iso_hu, lo..=hi).text("isovalue"));
     ui.add(egui::Slider::new(&mut c.iso_opacity, 0.0..=1.0).text("surface opacity"));
     egui::ComboBox::from_label("lens")
@@ -115,43 +181,45 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     c.fov_deg = c.fov_deg.clamp(fov_lo, fov_hi);
     ui.add(egui::Slider::new(&mut c.fov_deg, fov_lo..=fov_hi.min(220.0)).text("field of view °"));
     ui.checkbox(&mut c.stereo, "stereo (red/cyan anaglyph)");
+    if c.mode == Mode::Peel {
+        peel_ui(ui, &mut c.peel, c.iso_hu, (lo, hi));
+    }
 }
 
-/// The value histogram (log counts) with the isovalue marked; a click sets the isovalue.
-fn histogram_ui(ui: &mut egui::Ui, counts: &[u64], (lo, hi): (f64, f64), iso: &mut f64) {
-    let (response, painter) =
-        ui.allocate_painter(Vec2::new(ui.available_width(), 56.0), Sense::click());
-    let rect = response.rect;
-    painter.rect_filled(rect, 2.0, Color32::from_gray(24));
-    let top = counts
-        .iter()
-        .map(|&c| ((c + 1) as f64).ln())
-        .fold(1.0, f64::max);
-    let w = rect.width() / counts.len() as f32;
-    for (i, &c) in counts.iter().enumerate() {
-        let h = (((c + 1) as f64).ln() / top) as f32 * rect.height();
-        let x = rect.left() + i as f32 * w;
-        painter.rect_filled(
-            egui::Rect::from_min_max(
-                egui::pos2(x, rect.bottom() - h),
-                egui::pos2(x + w, rect.bottom()),
-            ),
-            0.0,
-            Color32::from_gray(150),
-        );
-    }
-    let span = (hi - lo).max(1e-9);
-    let x = rect.left() + ((*iso - lo) / span) as f32 * rect.width();
-    painter.line_segment(
-        [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
-        Stroke::new(2.0, Color32::from_rgb(255, 120, 80)),
-    );
-    if let Some(pos) = response
-        .interact_pointer_pos()
-        .filter(|_| response.clicked())
-    {
-        *iso = lo + f64::from((pos.x - rect.left()) / rect.width()) * span;
-    }
+/// The depth-peeling settings (`peel` mode): which peel, its threshold and direction, how much
+/// of what lies before it stays, and what rays without it show.
+fn peel_ui(ui: &mut egui::Ui, peel: &mut PeelSettings, iso_hu: f64, (lo, hi): (f64, f64)) {
+    let mut last = peel.layer == PeelLayer::Last;
+    let mut n = match peel.layer {
+        PeelLayer::Nth(n) => n,
+        PeelLayer::Last => 1,
+    };
+    ui.horizontal(|ui| {
+        ui.label("peel");
+        ui.add_enabled(!last, egui::DragValue::new(&mut n).range(1..=16));
+        ui.checkbox(&mut last, "last");
+    });
+    peel.layer = if last {
+        PeelLayer::Last
+    } else {
+        PeelLayer::Nth(n)
+    };
+    let mut own = peel.threshold_hu.is_some();
+    let mut threshold = peel.threshold_hu.unwrap_or(iso_hu);
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut own, "own threshold");
+        ui.add_enabled(own, egui::Slider::new(&mut threshold, lo..=hi));
+    });
+    peel.threshold_hu = own.then_some(threshold);
+    ui.checkbox(&mut peel.falling, "count crossings into darker material");
+    ui.add(egui::Slider::new(&mut peel.keep, 0.0..=1.0).text("keep in front"));
+    let mut context = peel.unpeeled == Unpeeled::Context;
+    ui.checkbox(&mut context, "rays without the peel show context");
+    peel.unpeeled = if context {
+        Unpeeled::Context
+    } else {
+        Unpeeled::Discard
+    };
 }
 
 fn flight_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
@@ -172,9 +240,14 @@ fn flight_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     if let Ok(window) = endocast_core::views::slices::Window::new(level, width) {
         c.window = window;
     }
-    if ui.button("Reset view (H)").clicked() {
-        session.reset();
-    }
+    ui.horizontal(|ui| {
+        if ui.button("Centre in lumen (Z)").clicked() {
+            session.centre_in_lumen();
+        }
+        if ui.button("Reset view (H)").clicked() {
+            session.reset();
+        }
+    });
 }
 
 fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
@@ -231,32 +304,27 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
     if let Some(i) = delete {
         session.delete_key_frame(i);
     }
-    if !session.key_frames().is_empty() && ui.button("Export key frames (path JSON)").clicked() {
-        let path = Path::new("endocast-key-frames.json");
-        let document = endocast_io::path_file::PathDocument {
-            name: "key frames".into(),
-            key_frames: session.key_frames().to_vec(),
-            ..Default::default()
-        };
-        action = Some(Action::Message(
-            match endocast_io::path_file::write_path_json(path, &document) {
-                Ok(()) => format!("wrote {} (endocast fly --path reads it)", path.display()),
-                Err(e) => e.to_string(),
-            },
-        ));
-    }
     action
 }
 
-/// Renders the current view at full quality and writes it beside the case file.
-fn screenshot(session: &Session, case: &Path) -> String {
+/// Renders the current view at full quality (with its annotations) off the UI thread and
+/// writes it beside the case file; the job's result is the status line.
+fn screenshot(ui: &egui::Ui, session: &Session, case: &Path) -> Job<String> {
     let path = case.with_extension("png");
-    let written = session.screenshot().and_then(|image| {
-        let [w, h] = [image.width() as u32, image.height() as u32];
-        endocast_io::write_png_rgb8(&path, w, h, image.rgb()).map_err(|e| e.to_string())
-    });
-    match written {
-        Ok(()) => format!("wrote {}", path.display()),
-        Err(e) => e,
-    }
+    let work = session.screenshot_work();
+    let ctx = ui.ctx().clone();
+    Job::spawn(
+        "screenshot",
+        Arc::new(move || ctx.request_repaint()),
+        move || {
+            let written = work().and_then(|image| {
+                let [w, h] = [image.width() as u32, image.height() as u32];
+                endocast_io::write_png_rgb8(&path, w, h, image.rgb()).map_err(|e| e.to_string())
+            });
+            match written {
+                Ok(()) => format!("wrote {}", path.display()),
+                Err(e) => e,
+            }
+        },
+    )
 }

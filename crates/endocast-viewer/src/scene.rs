@@ -6,15 +6,22 @@ use endocast_core::navigate::{seed_voxel, Collider, DistanceField, Lumen, LumenS
 use endocast_core::render::Renderer;
 use endocast_core::Volume;
 pub use endocast_io::case::ScanSource;
+use endocast_io::SeriesSummary;
 use glam::DVec3;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// Bins of the value histogram under the isovalue slider.
 pub const HISTOGRAM_BINS: usize = 128;
 
-/// The lumen the camera is in: its distance field and the camera's radius.
+/// Numbers the lumens found, so views of one (the overview) know when it changed.
+static LUMENS_FOUND: AtomicU64 = AtomicU64::new(0);
+
+/// The lumen the camera is in: its voxels, its distance field and the camera's radius.
 #[derive(Debug)]
 pub struct Navigation {
+    lumen: Arc<Lumen>,
+    id: u64,
     field: DistanceField,
     radius_mm: f64,
 }
@@ -29,7 +36,22 @@ impl Navigation {
         let lumen = Lumen::from_seed(volume, seed, threshold, side).ok()?;
         let field = DistanceField::new(&lumen, volume.geometry());
         let radius_mm = (2.0 * field.min_spacing_mm()).min(0.5 * field.max_mm());
-        Some(Self { field, radius_mm })
+        Some(Self {
+            lumen: Arc::new(lumen),
+            id: LUMENS_FOUND.fetch_add(1, Ordering::Relaxed),
+            field,
+            radius_mm,
+        })
+    }
+
+    /// The lumen's voxels.
+    pub fn lumen(&self) -> &Arc<Lumen> {
+        &self.lumen
+    }
+
+    /// A number of this lumen, different for every lumen found in this process.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// The collider for a camera at `eye_mm`: the camera's radius, shrunk to fit where the eye
@@ -38,6 +60,27 @@ impl Navigation {
     pub fn collider_at(&self, eye_mm: DVec3) -> Option<Collider<'_>> {
         let room = 0.9 * self.field.distance_mm(eye_mm);
         Collider::new(&self.field, self.radius_mm.min(room)).ok()
+    }
+
+    /// The point of the cross-section through `eye_mm` (perpendicular to `forward`) farthest
+    /// from the wall nearby: climbs the distance field within that plane in quarter-voxel
+    /// steps until it no longer rises ("centre in lumen").
+    pub fn centred(&self, eye_mm: DVec3, forward: DVec3) -> DVec3 {
+        let step = 0.25 * self.field.min_spacing_mm();
+        let limit = (4.0 * self.field.max_mm() / step).ceil() as usize + 1;
+        let mut p = eye_mm;
+        for _ in 0..limit {
+            let g = self.field.gradient(p);
+            let Some(uphill) = (g - forward * g.dot(forward)).try_normalize() else {
+                break;
+            };
+            let next = p + uphill * step;
+            if self.field.distance_mm(next) <= self.field.distance_mm(p) {
+                break;
+            }
+            p = next;
+        }
+        p
     }
 
     /// Distance from `p_mm` to the wall, mm (0 outside the lumen).
@@ -65,6 +108,8 @@ pub struct Scene {
     pub value_range: (f64, f64),
     /// The scan's fingerprint, which its cases record.
     pub identity: ScanIdentity,
+    /// The series of the DICOM folder it was read from (empty for other sources).
+    pub series_found: Vec<SeriesSummary>,
 }
 
 impl Scene {
@@ -79,7 +124,14 @@ impl Scene {
             renderer: Arc::new(Renderer::for_many_frames(volume)),
             histogram,
             value_range,
+            series_found: Vec::new(),
         }
+    }
+
+    /// The scene, knowing the series its DICOM folder holds.
+    pub fn with_series(mut self, series_found: Vec<SeriesSummary>) -> Self {
+        self.series_found = series_found;
+        self
     }
 
     /// The volume.

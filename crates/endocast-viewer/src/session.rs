@@ -4,15 +4,17 @@
 //! tests drive a session exactly as the window does.
 
 use crate::controller::{FlyCamera, LocalMove};
+use crate::geometry::{Geometry, Toggles};
+use crate::jobs::{Job, Polled};
 use crate::scene::{Navigation, Scene};
 use crate::worker::{RenderWorker, View};
 use endocast_core::animation::{Animation, KeyFrame};
 use endocast_core::annotate::{self, Annotation, Annotations, DrawOptions, Shape, SurfaceView};
 use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
-use endocast_core::navigate::{default_view, LumenChoice};
+use endocast_core::navigate::{default_view, LumenChoice, LumenSide};
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
-use endocast_core::render::{Mode, RenderSettings};
+use endocast_core::render::{Mode, PeelSettings, RenderSettings, TransferFunction};
 use endocast_core::views::slices::Window;
 use endocast_core::views::Image;
 use glam::DVec3;
@@ -48,11 +50,18 @@ pub struct Controls {
     pub speed_mm_s: f64,
     /// Window of the slices.
     pub window: Window,
+    /// The transfer function (DVR, and behind a translucent wall).
+    pub tf: TransferFunction,
+    /// How `peel` mode peels.
+    pub peel: PeelSettings,
+    /// The geometry shown with the scan.
+    pub geometry: Toggles,
 }
 
 impl Controls {
     /// The clinical defaults of `preset`, collision on, 20 mm/s.
     pub fn of_preset(preset: &'static Preset) -> Self {
+        let defaults = preset.settings();
         Self {
             preset,
             mode: preset.mode,
@@ -64,6 +73,9 @@ impl Controls {
             collision: true,
             speed_mm_s: 20.0,
             window: preset.window,
+            tf: defaults.tf,
+            peel: defaults.peel,
+            geometry: Toggles::default(),
         }
     }
 
@@ -73,6 +85,8 @@ impl Controls {
         settings.mode = self.mode;
         settings.iso_hu = self.iso_hu;
         settings.iso_opacity = self.iso_opacity;
+        settings.tf.clone_from(&self.tf);
+        settings.peel.clone_from(&self.peel);
         settings
     }
 
@@ -113,6 +127,8 @@ impl Playback {
 pub struct Session {
     scene: Arc<Scene>,
     navigation: Option<Navigation>,
+    /// The lumen being found around a new eye position.
+    finding: Option<Job<Option<Navigation>>>,
     camera: FlyCamera,
     home: FlyCamera,
     /// The control panel's values.
@@ -128,6 +144,7 @@ pub struct Session {
     stroke: Vec<DVec3>,
     /// Grows with every change of the annotations or the stroke being drawn.
     marks_revision: u64,
+    geometry: Geometry,
 }
 
 impl Session {
@@ -157,6 +174,7 @@ impl Session {
         let mut session = Self {
             scene,
             navigation: None,
+            finding: None,
             camera,
             home: camera,
             controls,
@@ -169,8 +187,10 @@ impl Session {
             marks: Annotations::default(),
             stroke: Vec::new(),
             marks_revision: 0,
+            geometry: Geometry::default(),
         };
-        session.find_lumen();
+        // The first lumen is found here, on the loading thread; later ones off the UI thread.
+        session.navigation = session.lumen_search().and_then(|search| search());
         session
     }
 
@@ -212,20 +232,55 @@ impl Session {
             .camera(c.eye_mm(), c.eye_mm() + c.forward(), c.up(), self.view_size)
     }
 
-    /// Sends the current view to the worker when it differs from the last one sent (or when the
-    /// camera has just stopped, so the view refines); returns the new request's generation.
-    pub fn sync(&mut self, moving: bool) -> Option<u64> {
+    /// The view to render now; `None` when the controls make no camera.
+    fn view(&mut self, moving: bool) -> Option<View> {
         let camera = self.camera().ok()?;
         let stereo = self
             .controls
             .stereo
             .then(|| StereoRig::focused_at(self.focus_mm()));
-        let view = View {
+        let marks = self.marks.items().iter().filter_map(|a| match a.shape {
+            Shape::Point(p) => Some(p),
+            _ => None,
+        });
+        let marks = marks.collect();
+        let (lo, hi) = self.scene.volume().geometry().world_bounds();
+        let scene = self
+            .geometry
+            .scene(self.controls.geometry, marks, (lo + hi) / 2.0);
+        Some(View {
             camera,
             settings: self.controls.settings(),
             stereo,
             moving,
-        };
+            scene,
+        })
+    }
+
+    /// The meshes read and the scene built from the geometry toggles.
+    pub fn geometry_mut(&mut self) -> &mut Geometry {
+        &mut self.geometry
+    }
+
+    /// Whether the view (camera, settings or geometry) differs from the last one sent to the
+    /// worker, so that the window renders it at moving quality first.
+    pub fn view_changed(&mut self) -> bool {
+        match (self.view(false), &self.last_view) {
+            (Some(now), Some(last)) => {
+                View {
+                    moving: last.moving,
+                    ..now
+                } != *last
+            }
+            (now, last) => now.is_some() != last.is_some(),
+        }
+    }
+
+    /// Sends the current view to the worker when it differs from the last one sent (or when the
+    /// camera has just stopped, so the view refines); returns the new request's generation.
+    pub fn sync(&mut self, moving: bool) -> Option<u64> {
+        self.poll_lumen();
+        let view = self.view(moving)?;
         if self.last_view.as_ref() == Some(&view) {
             return None;
         }
@@ -264,7 +319,12 @@ impl Session {
 
     /// Flies by `step` (sliding along the wall when collision is on); returns the distance
     /// travelled, mm.
+    /// While the lumen around a new position is being found, collision holds the camera.
     pub fn fly(&mut self, step: LocalMove) -> f64 {
+        self.poll_lumen();
+        if self.controls.collision && self.finding.is_some() {
+            return 0.0;
+        }
         let eye = self.camera.eye_mm();
         let collider = self
             .navigation
@@ -319,6 +379,18 @@ impl Session {
         self.find_lumen();
     }
 
+    /// Moves the eye, within the plane across the view, to the middle of the lumen around it
+    /// (the view direction stays); false outside a lumen.
+    pub fn centre_in_lumen(&mut self) -> bool {
+        let Some(nav) = &self.navigation else {
+            return false;
+        };
+        let c = &self.camera;
+        let centre = nav.centred(c.eye_mm(), c.forward());
+        self.camera.jump_to(centre);
+        true
+    }
+
     /// Back to the starting view.
     pub fn reset(&mut self) {
         self.camera = self.home;
@@ -341,22 +413,60 @@ impl Session {
 
     /// Finds the lumen around the eye for the preset's lumen threshold (the wall isovalue for a
     /// preset without one); none when the eye is in the wall or outside.
+    ///
+    /// A new lumen is found on a thread of its own (a flood fill and a distance field: up to
+    /// a second on a large scan); meanwhile there is none, see [`Session::finding_lumen`].
     pub fn find_lumen(&mut self) {
         let eye = self.camera.eye_mm();
         if let Some(nav) = &self.navigation {
             if nav.distance_mm(eye) > 0.0 {
+                self.finding = None;
                 return;
             }
         }
+        self.navigation = None;
+        self.finding = self
+            .lumen_search()
+            .map(|search| Job::spawn("lumen", self.worker.notifier(), search));
+    }
+
+    /// The search for the lumen around the eye, to run anywhere; `None` without a threshold.
+    fn lumen_search(&self) -> Option<impl FnOnce() -> Option<Navigation> + Send + 'static> {
+        let (threshold, side) = self.lumen_threshold()?;
+        let renderer = Arc::clone(&self.scene.renderer);
+        let eye = self.camera.eye_mm();
+        Some(move || Navigation::around(renderer.volume(), eye, threshold, side))
+    }
+
+    /// Whether the lumen around the eye is being found.
+    pub fn finding_lumen(&self) -> bool {
+        self.finding.is_some()
+    }
+
+    /// Takes the lumen found, when the search has finished.
+    pub fn poll_lumen(&mut self) {
+        let Some(job) = &self.finding else {
+            return;
+        };
+        match job.poll() {
+            Polled::Running => {}
+            Polled::Done(navigation) => {
+                self.navigation = navigation;
+                self.finding = None;
+            }
+            Polled::Lost => self.finding = None,
+        }
+    }
+
+    /// The threshold and side the lumen is grown at: the preset's lumen threshold, else the
+    /// wall isovalue (lumen darker than the wall).
+    pub fn lumen_threshold(&self) -> Option<(f64, LumenSide)> {
         let choice = LumenChoice {
             preset: Some(self.controls.preset).filter(|p| p.lumen.is_some()),
             iso: Some(self.controls.iso_hu),
             ..LumenChoice::default()
         };
-        self.navigation = choice
-            .resolve()
-            .ok()
-            .and_then(|(t, side)| Navigation::around(self.scene.volume(), eye, t, side));
+        choice.resolve().ok()
     }
 
     /// Records the current view as a key frame (after the last).
@@ -551,24 +661,25 @@ impl Session {
     /// The current view rendered at full quality, with the annotations drawn where it sees
     /// their tissue.
     pub fn screenshot(&self) -> Result<Image, String> {
+        self.screenshot_work()()
+    }
+
+    /// The work of [`Session::screenshot`], holding what it needs, to run off the UI thread.
+    pub fn screenshot_work(&self) -> impl FnOnce() -> Result<Image, String> + Send + 'static {
+        let renderer = Arc::clone(&self.scene.renderer);
         let settings = self.controls.settings();
-        let prepared = self
-            .scene
-            .renderer
-            .prepare(&settings)
-            .map_err(|e| e.to_string())?;
-        let camera = self.camera().map_err(|e| e.to_string())?;
-        let frame = prepared.render(&camera);
-        let mut image =
-            Image::from_frame(&frame, settings.background).map_err(|e| e.to_string())?;
-        let spacing = self.scene.volume().geometry().spacing_mm();
-        let view = SurfaceView::new(&camera, &frame.depth_mm, spacing);
-        annotate::draw(
-            &mut image,
-            &view,
-            self.marks.items(),
-            &DrawOptions::default(),
-        );
-        Ok(image)
+        let camera = self.camera().map_err(|e| e.to_string());
+        let marks = self.marks.clone();
+        move || {
+            let camera = camera?;
+            let prepared = renderer.prepare(&settings).map_err(|e| e.to_string())?;
+            let frame = prepared.render(&camera);
+            let mut image =
+                Image::from_frame(&frame, settings.background).map_err(|e| e.to_string())?;
+            let spacing = renderer.volume().geometry().spacing_mm();
+            let view = SurfaceView::new(&camera, &frame.depth_mm, spacing);
+            annotate::draw(&mut image, &view, marks.items(), &DrawOptions::default());
+            Ok(image)
+        }
     }
 }

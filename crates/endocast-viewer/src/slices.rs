@@ -1,72 +1,81 @@
 //! The axial, coronal and sagittal slices through the camera, with the camera drawn and the
-//! orientation letters, in the slice window; a click jumps the camera there.
+//! orientation letters, in the slice window; a click jumps the camera there (or, in path mode,
+//! sets the path's start or end). The slices are reformatted off the UI thread ([`Derived`]):
+//! the UI shows the last ones until the new ones are there.
 
+use crate::jobs::{Derived, Job, Notify};
 use crate::session::Session;
 use egui::{Sense, TextureOptions, Vec2};
+use endocast_core::render::Camera;
 use endocast_core::views::slices::{camera_slices, Slice, SliceOptions, Window};
 use glam::DVec3;
+use std::sync::Arc;
 
 /// Edge of each slice image, pixels.
 const SLICE_PX: usize = 256;
 
-/// The slices shown, and what they were drawn for (redrawn when the camera or window changes).
+/// What the slices are drawn for: the eye, the view direction and the window.
+type SliceKey = (DVec3, DVec3, Window);
+
+/// The slices shown and their textures.
 #[derive(Default)]
 pub(crate) struct SlicesView {
-    drawn_for: Option<(DVec3, DVec3, Window)>,
-    slices: Vec<Slice>,
+    slices: Derived<SliceKey, Option<[Slice; 3]>>,
     textures: Vec<egui::TextureHandle>,
 }
 
 impl SlicesView {
-    /// Draws the three slices in a column; a click in one jumps the camera to that point.
-    pub(crate) fn slices_ui(&mut self, ui: &mut egui::Ui, session: &mut Session) {
+    /// Draws the three slices in a column, each `edge` points wide; returns the world point of
+    /// a click in one.
+    pub(crate) fn slices_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        session: &Session,
+        edge: f32,
+    ) -> Option<DVec3> {
         self.refresh(ui.ctx(), session);
-        let edge = (ui.available_width()).min(ui.available_height() / 3.3);
-        let mut jump = None;
-        for ((slice, texture), name) in self
-            .slices
+        let slices = self.slices.shown().and_then(|(_, s)| s.as_ref())?;
+        let mut clicked = None;
+        for ((slice, texture), name) in slices
             .iter()
             .zip(&self.textures)
             .zip(["axial", "coronal", "sagittal"])
         {
             let image =
                 egui::Image::from_texture((texture.id(), Vec2::splat(edge))).sense(Sense::click());
-            let response = ui
-                .add(image)
-                .on_hover_text(format!("{name}: click to jump here"));
+            let response = ui.add(image).on_hover_text(format!("{name}: click"));
             if response.clicked() {
                 if let Some(pos) = response.interact_pointer_pos() {
                     let scale = SLICE_PX as f64 / f64::from(response.rect.width());
                     let d = pos - response.rect.min;
-                    jump = Some(slice.world_at(f64::from(d.x) * scale, f64::from(d.y) * scale));
+                    clicked = Some(slice.world_at(f64::from(d.x) * scale, f64::from(d.y) * scale));
                 }
             }
         }
-        if let Some(p) = jump {
-            session.jump_to(p);
-        }
-        let c = session.fly_camera();
-        let (e, f) = (c.eye_mm(), c.forward());
-        ui.label(format!("eye  {:7.1} {:7.1} {:7.1} mm", e.x, e.y, e.z));
-        ui.label(format!("view {:7.2} {:7.2} {:7.2}", f.x, f.y, f.z));
+        clicked
     }
 
+    /// Starts reformatting when the camera or the window changed, and uploads new slices.
     fn refresh(&mut self, ctx: &egui::Context, session: &Session) {
         let c = session.fly_camera();
         let key = (c.eye_mm(), c.forward(), session.controls.window);
-        if self.drawn_for == Some(key) {
-            return;
-        }
         let Ok(camera) = session.camera() else {
             return;
         };
-        let mut options = SliceOptions::default();
-        options.size_px = SLICE_PX;
-        options.window = session.controls.window;
-        let Ok(slices) = camera_slices(session.scene().volume(), &camera, &options) else {
+        let renderer = Arc::clone(&session.scene().renderer);
+        let repaint = ctx.clone();
+        let notify: Notify = Arc::new(move || repaint.request_repaint());
+        let arrived = self.slices.refresh(&key, |&(_, _, window)| {
+            Job::spawn("slices", notify, move || {
+                reformat(renderer.volume(), &camera, window)
+            })
+        });
+        if !arrived {
+            return;
+        }
+        let Some((_, Some(slices))) = self.slices.shown() else {
             return;
         };
-        self.drawn_for = Some(key);
         self.textures = slices
             .iter()
             .zip(["axial", "coronal", "sagittal"])
@@ -77,6 +86,13 @@ impl SlicesView {
                 ctx.load_texture(name, pixels, TextureOptions::LINEAR)
             })
             .collect();
-        self.slices = slices.into();
     }
+}
+
+/// The three slices through `camera` in `window`; `None` when the camera is outside the volume.
+fn reformat(volume: &endocast_core::Volume, camera: &Camera, window: Window) -> Option<[Slice; 3]> {
+    let mut options = SliceOptions::default();
+    options.size_px = SLICE_PX;
+    options.window = window;
+    camera_slices(volume, camera, &options).ok()
 }

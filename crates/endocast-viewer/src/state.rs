@@ -1,7 +1,11 @@
 //! What the window keeps beside the session, shared by the window's parts.
 
 use crate::case::Autosave;
+use crate::flight_ui::FlightTools;
+use crate::geometry_ui::MeshLoader;
+use crate::jobs::Job;
 use crate::mark_tool::MarkTool;
+use crate::overview::OverviewView;
 use crate::session::Session;
 use crate::slices::SlicesView;
 use endocast_core::render::progressive::Stage;
@@ -11,6 +15,13 @@ use std::time::Instant;
 pub(crate) struct Ready {
     pub session: Session,
     pub slices: SlicesView,
+    pub overview: OverviewView,
+    /// Path planning and export.
+    pub tools: FlightTools,
+    /// Reading meshes.
+    pub meshes: MeshLoader,
+    /// Background tasks whose result is a line for the status bar (a screenshot).
+    pub tasks: Vec<Job<String>>,
     pub autosave: Autosave,
     pub view_texture: Option<egui::TextureHandle>,
     pub shown: Option<(u64, Stage, u64)>,
@@ -24,6 +35,8 @@ pub(crate) struct Ready {
 pub(crate) enum Action {
     /// Open the path typed in the panel (a scan, or a case file `.json`).
     Open,
+    /// Read another series of the open DICOM folder (its SeriesInstanceUID).
+    OpenSeries(String),
     /// Save the case now.
     SaveCase,
     /// Show a line in the status bar.

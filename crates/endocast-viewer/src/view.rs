@@ -42,7 +42,10 @@ pub(crate) fn view_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     if moved {
         ready.last_input = Some(Instant::now());
     }
-    ready.session.sync(moved);
+    // Any change of view (input, a control, a jump, playback) renders at moving quality first;
+    // the first UI frame without one sends the same view to refine.
+    let moving = moved || ready.session.view_changed();
+    ready.session.sync(moving);
     show_frame(ui, ready, rect);
 }
 
@@ -106,7 +109,8 @@ fn run_commands(session: &mut Session, c: Commands) -> bool {
     if c.reset {
         session.reset();
     }
-    c.reset || c.play_pause
+    let centred = c.centre && session.centre_in_lumen();
+    c.reset || c.play_pause || centred
 }
 
 /// Uploads the newest frame when it is new and draws it, aspect kept, in `rect`.

@@ -8,6 +8,8 @@
 //! accumulates jittered stills. Every finished level replaces the shown [`Delivered`] frame and
 //! wakes the UI through a callback.
 
+use crate::geometry::SceneRef;
+use crate::jobs::Notify;
 use endocast_core::camera::StereoRig;
 use endocast_core::render::progressive::{progressive, ProgressiveOptions, Stage};
 use endocast_core::render::{
@@ -38,6 +40,8 @@ pub struct View {
     pub stereo: Option<StereoRig>,
     /// The camera is moving: render a quick preview first and no still.
     pub moving: bool,
+    /// Geometry drawn with the scan.
+    pub scene: SceneRef,
 }
 
 /// A finished frame of some view.
@@ -136,6 +140,13 @@ impl RenderWorker {
         generation
     }
 
+    /// Calls the worker's `on_frame` callback (for other threads that have something to show,
+    /// e.g. a lumen found).
+    pub fn notifier(&self) -> Notify {
+        let shared = Arc::clone(&self.shared);
+        Arc::new(move || (shared.on_frame)())
+    }
+
     /// The generation of the newest request.
     pub fn generation(&self) -> u64 {
         self.shared.generation.load(Ordering::Acquire)
@@ -198,6 +209,7 @@ impl Drop for RenderWorker {
 /// The worker's loop: wait for a request, render it level by level until superseded.
 fn run(shared: &Shared, renderer: &Arc<Renderer>) {
     let mut prepared: Option<Prepared> = None;
+    let mut scene = SceneRef::default();
     while let Some(request) = next_request(shared) {
         let settings = &request.view.settings;
         let ready = match prepared.as_mut() {
@@ -209,6 +221,12 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
             lock(&shared.latest).error = Some(e.to_string());
             (shared.on_frame)();
             continue;
+        }
+        if let Some(p) = &mut prepared {
+            if request.view.scene != scene {
+                scene = request.view.scene.clone();
+                p.set_scene(scene.0.clone());
+            }
         }
         if let Some(p) = &prepared {
             // A superseded frame simply ends; the next request is already waiting.

@@ -219,3 +219,27 @@ fn marks_lie_on_the_wall_and_measure_between_them() {
         "{across} mm across the tube"
     );
 }
+
+#[test]
+fn centring_moves_the_eye_to_the_tube_axis_across_the_view() {
+    let (mut session, truth) = tube_session();
+    // Look along the tube, then slide 5 mm off the axis.
+    session.turn(0.0, std::f64::consts::FRAC_PI_2);
+    session.fly(LocalMove {
+        right_mm: 5.0,
+        ..LocalMove::default()
+    });
+    let before = *session.fly_camera();
+    assert!(off_axis_mm(&truth, before.eye_mm()) > 4.0);
+    assert!(session.centre_in_lumen());
+    let after = *session.fly_camera();
+    assert!(
+        off_axis_mm(&truth, after.eye_mm()) < 1.0,
+        "{}",
+        off_axis_mm(&truth, after.eye_mm())
+    );
+    // Only across the view: not along it, and the view direction stays.
+    let moved = after.eye_mm() - before.eye_mm();
+    assert!(moved.dot(before.forward()).abs() < 0.3, "{moved:?}");
+    assert_eq!(after.forward(), before.forward());
+}

@@ -6,4 +6,6 @@
 mod case;
 mod common;
 mod flight;
+mod plan_export;
+mod series;
 mod ui;

@@ -2,11 +2,12 @@
 
 use egui::{Event, Key, Modifiers, Pos2, RawInput, Rect, Vec2};
 use endocast_core::presets::Preset;
+use endocast_core::render::progressive::Stage;
 use endocast_viewer::app::{ViewerApp, ViewerOptions};
 use endocast_viewer::scene::ScanSource;
 use std::time::{Duration, Instant};
 
-fn options(source: ScanSource) -> ViewerOptions {
+pub fn options(source: ScanSource) -> ViewerOptions {
     ViewerOptions {
         source,
         preset: Preset::find("colonoscopy").unwrap(),
@@ -35,7 +36,7 @@ fn key(key: Key, pressed: bool) -> Event {
 }
 
 /// Runs UI frames until `done` or the timeout.
-fn run_until(ctx: &egui::Context, app: &mut ViewerApp, done: impl Fn(&ViewerApp) -> bool) {
+pub fn run_until(ctx: &egui::Context, app: &mut ViewerApp, done: impl Fn(&ViewerApp) -> bool) {
     let start = Instant::now();
     while !done(app) {
         assert!(start.elapsed() < Duration::from_secs(120), "timed out");
@@ -104,4 +105,73 @@ fn a_scan_that_cannot_be_read_says_why_and_the_app_stays_usable() {
     );
     // Another frame draws without a session.
     let _ = ctx.run(input(Vec::new()), |ctx| app.frame_ui(ctx));
+}
+
+#[test]
+fn a_change_of_control_renders_at_moving_quality_first_then_refines() {
+    let ctx = egui::Context::default();
+    let source = ScanSource::Phantom {
+        name: "straight-tube".into(),
+        size: 48,
+    };
+    let mut app = ViewerApp::new(ctx.clone(), options(source));
+    run_until(&ctx, &mut app, |a| {
+        a.session()
+            .and_then(|s| s.worker().latest())
+            .is_some_and(|f| matches!(f.stage, Stage::Still(_)))
+    });
+    // The isovalue changes between two UI frames, as a dragged slider does.
+    app.session_mut().unwrap().controls.iso_hu += 150.0;
+    let _ = ctx.run(input(Vec::new()), |ctx| app.frame_ui(ctx));
+    let changed = app.session().unwrap().worker().generation();
+    // Without another UI frame the worker stays at moving quality: never a still.
+    let moving = app
+        .session()
+        .unwrap()
+        .worker()
+        .wait_for(changed, Duration::from_secs(60), |f| f.stage == Stage::Full)
+        .expect("the moving view's full frame");
+    std::thread::sleep(Duration::from_millis(300));
+    let latest = app.session().unwrap().worker().latest().unwrap();
+    assert_eq!(latest.generation, moving.generation);
+    assert_eq!(
+        latest.stage,
+        Stage::Full,
+        "a moving view accumulated a still"
+    );
+    // The next UI frame (no change) sends the same view to refine into the still.
+    run_until(&ctx, &mut app, |a| {
+        let f = a.session().unwrap().worker().latest().unwrap();
+        f.generation > changed && matches!(f.stage, Stage::Still(_))
+    });
+}
+
+#[test]
+fn the_slices_and_the_overview_arrive_from_their_threads() {
+    let ctx = egui::Context::default();
+    let source = ScanSource::Phantom {
+        name: "colon".into(),
+        size: 64,
+    };
+    let mut app = ViewerApp::new(ctx.clone(), options(source));
+    run_until(&ctx, &mut app, |a| a.session().is_some());
+    // The overview and the three slices are textures once their jobs are done.
+    let start = Instant::now();
+    loop {
+        let _ = ctx.run(input(Vec::new()), |ctx| app.frame_ui(ctx));
+        let names = ctx
+            .tex_manager()
+            .read()
+            .allocated()
+            .map(|(_, m)| m.name.clone())
+            .collect::<Vec<_>>();
+        let all = ["axial", "coronal", "sagittal", "overview"]
+            .iter()
+            .all(|n| names.iter().any(|m| m == n));
+        if all {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(120), "only {names:?}");
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }

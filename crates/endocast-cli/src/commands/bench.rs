@@ -11,6 +11,7 @@ use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::StereoRig;
+use endocast_core::look::{self, Look, RayPass, Shading};
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::{
@@ -75,6 +76,8 @@ pub struct BenchArgs {
 struct Cell {
     name: String,
     settings: RenderSettings,
+    /// A clinical or realistic look: its ray pass and deferred stage are timed instead.
+    look: Option<Look>,
 }
 
 /// Timings of one setting over the whole path.
@@ -122,6 +125,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "| setting | min fps | avg fps | max fps | median ms | Msamples/s |\n|---|---|---|---|---|---|",
     );
     for cell in &cells {
+        if let Some(look) = &cell.look {
+            let pass =
+                RayPass::new(&renderer, &cell.settings, &look.ray).context("invalid look")?;
+            let (whole, deferred) = in_pool(args.look.threads, || {
+                measure_look(&pass, &look.shading, args.quality, &cameras)
+            })??;
+            report(args, optics.field, &cell.name, &whole, None)?;
+            let name = format!("{}: its deferred stage alone", cell.name);
+            report(args, optics.field, &name, &deferred, None)?;
+            continue;
+        }
         let mut prepared = renderer
             .prepare(&cell.settings)
             .context("invalid settings")?;
@@ -192,6 +206,28 @@ fn measure(
     (Ok(mono), pair)
 }
 
+/// Renders every camera with a look's ray `pass` at `quality` and shades it; returns the
+/// timings of the whole frame and of the deferred stage (smoothing, shading) alone.
+fn measure_look(
+    pass: &RayPass,
+    shading: &Shading,
+    quality: Quality,
+    cameras: &[Camera],
+) -> Result<(Measured, Measured)> {
+    let (mut whole, mut deferred) = (Measured::default(), Measured::default());
+    for camera in cameras {
+        let start = Instant::now();
+        let gbuffer = pass.trace(camera, quality);
+        let shaded = Instant::now();
+        look::shade(&gbuffer, camera, shading).context("invalid look")?;
+        let end = Instant::now();
+        whole.ms.push((end - start).as_secs_f64() * 1e3);
+        whole.samples += gbuffer.stats.samples;
+        deferred.ms.push((end - shaded).as_secs_f64() * 1e3);
+    }
+    Ok((whole, deferred))
+}
+
 /// A `--quality` level by name.
 fn parse_quality(name: &str) -> Result<Quality, String> {
     Quality::from_name(name).ok_or_else(|| format!("{name:?}: expected full, half or quarter"))
@@ -227,7 +263,17 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
     let mut cells = vec![Cell {
         name: "iso only".into(),
         settings: with(&|s| s.mode = Mode::Iso),
+        look: None,
     }];
+    if let Some(look) = args.look.look()? {
+        // The look against plain iso on the same path.
+        cells.push(Cell {
+            name: format!("{} look", args.look.look_name()),
+            settings: base.clone(),
+            look: Some(look),
+        });
+        return Ok((Renderer::for_many_frames(volume), poses, cells));
+    }
     for tf in ["ramp", "complex"] {
         let tf_fn = find_preset(tf)?.transfer_function();
         for opacity in [1.0, 0.8, 0.5, 0.0] {
@@ -238,6 +284,7 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
                     s.iso_opacity = opacity;
                     s.tf = tf_fn.clone();
                 }),
+                look: None,
             });
         }
     }
@@ -265,6 +312,7 @@ fn peel_cells(base: &RenderSettings) -> Vec<Cell> {
         Cell {
             name: name.into(),
             settings: s,
+            look: None,
         }
     })
     .collect()
@@ -278,9 +326,15 @@ fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, 
     options.orientation.clone_from(&args.orientation);
     let loaded = endocast_io::open(volume, &options).context("cannot read the scan")?;
     let settings = args.look.settings()?;
+    let look = args.look.look()?;
+    let what = match look {
+        Some(_) => format!("{} look", args.look.look_name()),
+        None => settings.mode.name().to_owned(),
+    };
     let cell = Cell {
-        name: format!("{} {}", volume.display(), settings.mode.name()),
+        name: format!("{} {what}", volume.display()),
         settings,
+        look,
     };
     Ok((Renderer::for_many_frames(loaded.volume), poses, vec![cell]))
 }

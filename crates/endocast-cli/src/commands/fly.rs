@@ -15,12 +15,13 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use endocast_core::coverage::Coverage;
 use endocast_core::flight::{
-    lumen_overview, wall_coverage, BackwardPass, Flight, FlightOptions, FlightStereo, Layout,
+    lumen_overview, wall_coverage_near, BackwardPass, Flight, FlightOptions, FlightStereo, Layout,
     Route, Shot, ShotSettings, WallSeen,
 };
-use endocast_core::navigate::{seed_voxel, Lumen};
+use endocast_core::navigate::{default_view, seed_voxel, DefaultView, Lumen};
 use endocast_core::presets::Preset;
 use endocast_core::render::{RenderSettings, Renderer};
+use endocast_core::tissue::{self, ScanValues};
 use endocast_core::views::slices::Window;
 use endocast_core::views::stereo::StereoOutput;
 use endocast_io::route_file::read_route;
@@ -80,8 +81,9 @@ pub struct FlyArgs {
     #[arg(long, value_name = "LEVEL,WIDTH", allow_hyphen_values = true)]
     window: Option<String>,
     /// Measure the wall seen (forward, then forward + backward), print it and write
-    /// OUT.coverage.json, OUT.coverage.png (unseen wall in red) and OUT.coverage.nii.gz
-    /// (1 seen, 2 unseen wall voxels).
+    /// OUT.coverage.json, OUT.coverage.png (wall never seen in red, seen only flying back in
+    /// orange) and OUT.coverage.nii.gz (1 seen flying forward, 2 seen only flying back, 3 never
+    /// seen).
     #[arg(long)]
     coverage: bool,
     /// Print the result (output, frames, length, speed, coverage) as JSON on stdout.
@@ -103,6 +105,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     let preset = args.look.preset()?;
     set_threads(args.look.threads)?;
     let settings = args.look.settings()?;
+    let look = args.look.look()?;
     let window = slice_window(args.window.as_deref(), preset)?;
     if !(args.frame_step.is_finite() && args.frame_step > 0.0) {
         bail!(
@@ -154,7 +157,12 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         window,
     };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
-    flight.set_scene(args.scene.scene()?);
+    let scene = args.scene.scene()?;
+    if look.is_some() && (scene.is_some() || stereo.is_some()) {
+        bail!("--look clinical and realistic draw no geometry and no stereo pair yet; use --look plain");
+    }
+    flight.set_scene(scene);
+    flight.set_look(look);
     flight.set_annotations(marks);
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
@@ -163,7 +171,11 @@ pub fn run(args: &FlyArgs) -> Result<()> {
             flight = flight.with_overview(overview, route.points_mm(2.0)?)?;
         }
         if args.coverage {
-            let wall = wall_coverage(lumen, geometry).context("no wall around the lumen")?;
+            let (wall, reach) = wall_coverage_near(lumen, geometry, &route.points_mm(1.0)?)
+                .context("no wall around the lumen near the path")?;
+            if !args.json {
+                println!("coverage measured on the wall within {reach:.1} mm of the path");
+            }
             flight = flight.with_coverage(wall);
         }
     }
@@ -318,7 +330,9 @@ fn video_options(args: &FlyArgs) -> VideoOptions {
     options
 }
 
-/// The lumen around the route's first camera position.
+/// The lumen around the route's first camera position: the structure the preset means (the
+/// aorta, not everything as bright as it) when the route starts in it, else the lumen grown
+/// from the start.
 fn lumen_at_start(
     args: &FlyArgs,
     preset: Option<&Preset>,
@@ -333,6 +347,17 @@ fn lumen_at_start(
         .pose
         .eye_mm;
     let seed = seed_voxel(volume, start).context("the route starts outside the volume")?;
+    if let Some(preset) = preset.filter(|p| p.lumen.is_some()) {
+        let mut choice = args.lumen.choice(Some(preset), Some(settings.iso_hu));
+        choice.within = tissue::central_structure(preset, volume, &ScanValues::measure(volume));
+        let view = default_view(volume, Some(&choice), preset.fov_deg);
+        if let DefaultView::InsideLumen { lumen, what, .. } = view {
+            if lumen.contains(seed) {
+                eprintln!("the path starts in the {what}: coverage is measured on its wall");
+                return Ok(*lumen);
+            }
+        }
+    }
     Lumen::from_seed(volume, seed, threshold, side)
         .with_context(|| format!("the route's start is not in a lumen {side} {threshold}"))
 }

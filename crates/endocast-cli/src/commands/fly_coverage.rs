@@ -1,8 +1,9 @@
 //! The coverage report of `endocast fly --coverage`: the wall seen flying forward, and forward
-//! plus backward (the same path flown back), printed and written beside the video.
+//! plus backward (the same path flown back), printed and written beside the video; the image
+//! and the mask show both passes, named.
 
 use anyhow::{Context, Result};
-use endocast_core::flight::WallSeen;
+use endocast_core::flight::{WallSeen, MASK_LABELS};
 use endocast_core::navigate::Lumen;
 use endocast_core::Geometry;
 use serde_json::json;
@@ -12,9 +13,10 @@ use std::path::{Path, PathBuf};
 const OVERVIEW_PX: usize = 512;
 
 /// Prints the forward and merged figures of `seen` (unless `quiet`: `--json` prints them) and
-/// writes, beside `output`, `OUT.coverage.json` (the figures), `OUT.coverage.png` (the lumen
-/// with the unseen wall in red) and `OUT.coverage.nii.gz` (the mask: 1 seen, 2 unseen wall
-/// voxels). Returns the figures.
+/// writes, beside `output`, `OUT.coverage.json` (the figures and the mask's labels),
+/// `OUT.coverage.png` (the lumen with the wall never seen in red, the wall seen only flying back
+/// in orange) and `OUT.coverage.nii.gz` (the mask: 1 seen flying forward, 2 seen only flying
+/// back, 3 never seen). Returns the figures.
 pub fn report(
     output: &Path,
     geometry: &Geometry,
@@ -36,6 +38,11 @@ pub fn report(
         "seen_forward_backward": seen.seen_forward_backward(),
         "fraction_forward": seen.fraction_forward(),
         "fraction_forward_backward": seen.fraction_forward_backward(),
+        "mask_labels": MASK_LABELS
+            .iter()
+            .map(|(label, meaning)| (label.to_string(), json!(meaning)))
+            .collect::<serde_json::Map<_, _>>(),
+        "image": "red: never seen; orange: seen only flying back",
     });
     let text = serde_json::to_string_pretty(&json)?;
     endocast_io::atomic::write_file(&beside(output, "json"), |w| w.write_all(text.as_bytes()))

@@ -5,9 +5,10 @@ use crate::input::InputArgs;
 use crate::look::find_preset;
 use crate::lumen::LumenArgs;
 use crate::parse::parse_vec3;
+use crate::structure;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::navigate::{default_view, plan_path, DefaultView, PathEnd};
+use endocast_core::navigate::{default_view, plan_in, plan_path, DefaultView, PathEnd};
 use endocast_core::path::SmoothOptions;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
 use endocast_core::tissue::{self, ScanValues};
@@ -57,6 +58,10 @@ pub struct PathArgs {
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
+    /// Also write the structure the preset found (tinted on the slices through the start) as
+    /// a PNG; needs --preset and no --from.
+    #[arg(long, value_name = "FILE.png")]
+    show_structure: Option<PathBuf>,
 }
 
 /// Runs `endocast path`.
@@ -76,20 +81,48 @@ pub fn run(args: &PathArgs) -> Result<()> {
         None => None,
     };
     let (threshold, side) = args.lumen.resolve(preset.as_ref(), args.iso)?;
-    let (start, threshold) = match point(volume, args.from, args.from_voxel, "--from")? {
-        Some(start) => (start, threshold),
-        None => default_start(volume, preset.as_ref(), &scan, &args.lumen, args.iso)?,
+    let from = point(volume, args.from, args.from_voxel, "--from")?;
+    let view = match from {
+        Some(_) => None,
+        None => Some(default_start(
+            volume,
+            preset.as_ref(),
+            &scan,
+            &args.lumen,
+            args.iso,
+        )?),
     };
-    let end =
-        point(volume, args.to, args.to_voxel, "--to")?.map_or(PathEnd::Farthest, PathEnd::Point);
+    if let Some(path) = &args.show_structure {
+        structure::write(path, volume, view.as_ref(), preset.as_ref())?;
+    }
+    let to = point(volume, args.to, args.to_voxel, "--to")?;
     let options = SmoothOptions {
         control_spacing_mm: args.smoothing,
         step_mm: 0.5,
         ..SmoothOptions::default()
     };
     let clock = Instant::now();
-    let (lumen, field, planned) = plan_path(volume, threshold, side, start, end, &options)
-        .with_context(|| format!("no path in the lumen {side} {threshold}"))?;
+    let (lumen, field, planned) = match view {
+        Some(DefaultView::InsideLumen {
+            pose,
+            threshold,
+            lumen,
+            end_mm,
+            ..
+        }) => {
+            // In the structure found: the path may not leave it for the rest of the lumen.
+            let end = to.or(end_mm).map_or(PathEnd::Farthest, PathEnd::Point);
+            let (field, planned) = plan_in(volume, &lumen, pose.eye_mm, end, &options)
+                .with_context(|| format!("no path in the lumen {side} {threshold}"))?;
+            (*lumen, field, planned)
+        }
+        _ => {
+            let start = from.context("give the start with --from X,Y,Z (mm)")?;
+            let end = to.map_or(PathEnd::Farthest, PathEnd::Point);
+            plan_path(volume, threshold, side, start, end, &options)
+                .with_context(|| format!("no path in the lumen {side} {threshold}"))?
+        }
+    };
     let seconds = clock.elapsed().as_secs_f64();
     let points = planned
         .path
@@ -122,31 +155,36 @@ pub fn run(args: &PathArgs) -> Result<()> {
     Ok(())
 }
 
-/// Without `--from`: the eye of the preset's default view inside its structure (see
-/// [`default_view`]) and the threshold the structure was found at, said on stderr; an error
-/// naming the options without a preset or lumen.
+/// Without `--from`: the preset's default view inside its structure (see [`default_view`]),
+/// whose eye starts the path, said on stderr with what was found; an error naming the options
+/// without a preset or when no structure is found.
 fn default_start(
     volume: &Volume,
     preset: Option<&Preset>,
     scan: &ScanValues,
     lumen: &LumenArgs,
     iso: Option<f64>,
-) -> Result<(DVec3, f64)> {
+) -> Result<DefaultView> {
     let preset = preset.context(
         "give the start with --from X,Y,Z (mm) or --from-voxel I,J,K, or a --preset to find it",
     )?;
     let mut choice = lumen.choice(Some(preset), iso);
     choice.within = tissue::central_structure(preset, volume, scan);
-    match default_view(volume, Some(&choice), DEFAULT_FOV_DEG) {
+    let view = default_view(volume, Some(&choice), DEFAULT_FOV_DEG);
+    match &view {
         DefaultView::InsideLumen {
-            pose, threshold, ..
+            pose,
+            threshold,
+            what,
+            ..
         } => {
             let p = pose.eye_mm;
             eprintln!(
-                "start in the {} (lumen grown at {threshold:.1}): --from {:.2},{:.2},{:.2}",
+                "found the {what}\nstart in the {} (lumen grown at {threshold:.1}): --from \
+                 {:.2},{:.2},{:.2}",
                 preset.name, p.x, p.y, p.z
             );
-            Ok((p, threshold))
+            Ok(view)
         }
         DefaultView::Framing { .. } => bail!(
             "found no {} lumen in the scan; give the start with --from X,Y,Z (mm)",

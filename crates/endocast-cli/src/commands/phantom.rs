@@ -8,7 +8,7 @@ use std::path::PathBuf;
 /// Arguments of `endocast phantom`.
 #[derive(Args, Debug)]
 pub struct PhantomArgs {
-    /// sphere-shell, straight-tube, curved-tube, colon, vessel, joint or sinus.
+    /// sphere-shell, straight-tube, curved-tube, colon, vessel, joint, sinus or layered.
     name: String,
     /// Output file: .nii, .nii.gz, .nrrd or .mha.
     #[arg(short, long)]

@@ -7,13 +7,16 @@ use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::{parse_pixel, parse_size, parse_vec3};
 use crate::scene_args::SceneArgs;
+use crate::structure;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::default_up;
+use endocast_core::look::{self, RayPass};
 use endocast_core::navigate::{default_view, DefaultView, FramingReason};
-use endocast_core::pose::Pose;
 use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
-use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
+use endocast_core::render::{
+    Camera, Frame, Prepared, RenderOptions, RenderSettings, Renderer, Still,
+};
 use endocast_core::tissue::{self, ScanValues};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
@@ -68,9 +71,17 @@ pub struct RenderArgs {
     /// Also write the depth image: float32 .npy, mm from the eye to the first hit, NaN where none.
     #[arg(long, value_name = "FILE.npy")]
     depth_out: Option<PathBuf>,
+    /// Average this many jittered frames (sub-pixel offsets, shifted sample grids): a
+    /// converged still without sampling bands or stair-stepped edges.
+    #[arg(long, value_name = "FRAMES", default_value_t = 1)]
+    still: usize,
     /// Print the frame's statistics and the camera pose it used as JSON.
     #[arg(long)]
     json: bool,
+    /// Also write the structure the preset found (its lumen tinted green on the axial, coronal
+    /// and sagittal slices through the camera) as a PNG; needs --preset and no --eye.
+    #[arg(long, value_name = "FILE.png")]
+    show_structure: Option<PathBuf>,
     /// Trace one pixel and print every sample along its ray.
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
     debug_pixel: Option<[usize; 2]>,
@@ -87,8 +98,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let look = args.look.on_scan(&loaded.volume)?;
     eprintln!("{}", look.summary);
+    if !(1..=MAX_STILL_FRAMES).contains(&args.still) {
+        bail!(
+            "--still must be between 1 and {MAX_STILL_FRAMES} frames, not {}",
+            args.still
+        );
+    }
     let (settings, preset) = (look.settings, look.preset.as_ref());
-    let camera = camera(args, preset, &loaded.volume, &settings)?;
+    let (camera, view) = camera(args, preset, &loaded.volume, &settings)?;
+    if let Some(path) = &args.show_structure {
+        structure::write(path, &loaded.volume, view.as_ref(), preset)?;
+    }
     let marks = args.case.annotations(&loaded.volume)?;
     if marks.is_some() && args.stereo.stereo.is_some() {
         bail!("--case draws on one view: leave out --stereo");
@@ -97,7 +117,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut prepared = renderer
         .prepare(&settings)
         .context("invalid render settings")?;
-    prepared.set_scene(args.scene.scene()?);
+    let scene = args.scene.scene()?;
+    if look.look.is_some() && (scene.is_some() || args.stereo.stereo.is_some()) {
+        bail!("--look clinical and realistic draw no geometry and no stereo pair yet; use --look plain");
+    }
+    prepared.set_scene(scene);
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
     }
@@ -117,7 +141,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             both
         }
         None => {
-            let frame = in_pool(args.look.threads, || prepared.render(&camera))?;
+            let frame = match &look.look {
+                Some(l) => {
+                    let pass =
+                        RayPass::new(&renderer, &settings, &l.ray).context("invalid look")?;
+                    in_pool(args.look.threads, || {
+                        look::still(&pass, &camera, &l.shading, args.still)
+                    })?
+                    .context("invalid look")?
+                }
+                None => in_pool(args.look.threads, || still(&prepared, &camera, args.still))??,
+            };
             let [w, h] = [frame.width as u32, frame.height as u32];
             let mut image = Image::from_frame(&frame, settings.background)?;
             if let Some(marks) = &marks {
@@ -153,22 +187,37 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The most frames `--still` averages.
+const MAX_STILL_FRAMES: usize = 256;
+
+/// The average of `frames` jittered frames of `camera` (one: the plain frame).
+fn still(prepared: &Prepared, camera: &Camera, frames: usize) -> Result<Frame> {
+    let mut still = Still::new();
+    for _ in 0..frames {
+        // Nothing cancels it.
+        let _ = still.render_next(prepared, camera, &RenderOptions::new());
+    }
+    Ok(still.frame().clone())
+}
+
 /// The camera the options describe; without one, for an endoscopic preset, a view from inside
-/// the largest lumen along its axis, else one framing the whole volume from the front.
+/// the structure it means along its axis, else one framing the whole volume from the front
+/// (with the default view it came from).
 fn camera(
     args: &RenderArgs,
     preset: Option<&Preset>,
     volume: &Volume,
     settings: &RenderSettings,
-) -> Result<Camera> {
+) -> Result<(Camera, Option<DefaultView>)> {
     let fov_deg = args
         .fov
         .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
-    let (eye, look_at, up) = match (args.eye, args.look_at) {
-        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None),
+    let (eye, look_at, up, view) = match (args.eye, args.look_at) {
+        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None, None),
         (None, None) => {
-            let pose = default_pose(args, preset, volume, settings, fov_deg);
-            (pose.eye_mm, pose.look_at_mm, Some(pose.up))
+            let view = default_pose(args, preset, volume, settings, fov_deg);
+            let pose = view.pose();
+            (pose.eye_mm, pose.look_at_mm, Some(pose.up), Some(view))
         }
         _ => bail!("--eye and --look-at go together"),
     };
@@ -180,9 +229,10 @@ fn camera(
     let (lo, hi) = volume.geometry().world_bounds();
     let height_mm = (hi - lo).length();
     let optics = args.lens.optics(preset, args.fov, args.near, height_mm)?;
-    optics
+    let camera = optics
         .camera(eye, look_at, up, args.size)
-        .context("invalid camera")
+        .context("invalid camera")?;
+    Ok((camera, view))
 }
 
 /// Writes a stereo pair as `output` asks: one combined image at `path`, or for a pair
@@ -208,14 +258,15 @@ fn write_stereo(
 }
 
 /// The library's default view (see [`default_view`]) for `--preset` and the lumen options,
-/// saying on stderr where it put the camera and why it fell back to framing the volume.
+/// saying on stderr what it found, where it put the camera and why it fell back to framing the
+/// volume.
 fn default_pose(
     args: &RenderArgs,
     preset: Option<&Preset>,
     volume: &Volume,
     settings: &RenderSettings,
     fov_deg: f64,
-) -> Pose {
+) -> DefaultView {
     let mut choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
     if let Some(choice) = choice.as_mut() {
         choice.within =
@@ -229,9 +280,11 @@ fn default_pose(
             pose,
             threshold,
             side,
+            what,
+            ..
         } => eprintln!(
-            "camera inside the lumen {side} {threshold:.1} (found in {found_ms:.0} ms): --eye {} \
-             --look-at {} --up {}",
+            "found the {what}\ncamera inside the lumen {side} {threshold:.1} (found in \
+             {found_ms:.0} ms): --eye {} --look-at {} --up {}",
             triple(pose.eye_mm),
             triple(pose.look_at_mm),
             triple(pose.up)
@@ -246,7 +299,7 @@ fn default_pose(
             _ => {}
         },
     }
-    view.pose()
+    view
 }
 
 /// Warns, saying why and what to try, when nothing in the image was hit or drawn.

@@ -1,6 +1,7 @@
 //! [`FlightError`]: why a flight frame (or the overview it shows) could not be made.
 
 use crate::coverage::CoverageError;
+use crate::look::LookError;
 use crate::path::PathError;
 use crate::render::{CameraError, SettingsError};
 use crate::views::ViewError;
@@ -32,4 +33,7 @@ pub enum FlightError {
     /// The overview volume could not be built.
     #[error(transparent)]
     Volume(#[from] VolumeError),
+    /// The clinical or realistic look is invalid.
+    #[error(transparent)]
+    Look(#[from] LookError),
 }

@@ -6,7 +6,10 @@ use super::Shot;
 use crate::annotate::{self, Annotations, DrawOptions, SurfaceView};
 use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
-use crate::render::{Camera, Frame, Prepared, RenderSettings, RenderStats, Renderer, StereoFrames};
+use crate::look::{shade, Look, RayPass};
+use crate::render::{
+    Camera, Frame, Prepared, Quality, RenderSettings, RenderStats, Renderer, StereoFrames,
+};
 use crate::scene::Scene;
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
@@ -80,6 +83,10 @@ pub struct Flight {
     /// The frames rendered into (the second for a stereo pair's right eye), their buffers
     /// reused from shot to shot.
     frames: StereoFrames,
+    /// The clinical or realistic look of the endoscope frames, if any.
+    look: Option<Look>,
+    /// The look's ray pass and the settings it was made for.
+    look_pass: Option<(RenderSettings, RayPass)>,
 }
 
 impl Flight {
@@ -95,7 +102,17 @@ impl Flight {
             scene: None,
             marks: None,
             frames: StereoFrames::default(),
+            look: None,
+            look_pass: None,
         }
+    }
+
+    /// Shows the endoscope frames in `look` (clinical or realistic; `None`: the renderer's own
+    /// image) from now on. A look draws no scene geometry and no stereo pair: those frames
+    /// stay plain.
+    pub fn set_look(&mut self, look: Option<Look>) {
+        self.look = look;
+        self.look_pass = None;
     }
 
     /// Draws `scene` (meshes, grid, markers, the endoscope's instruments) in every endoscope
@@ -221,7 +238,15 @@ impl Flight {
         let prepared = prepared(&mut self.prepared, &self.renderer, settings, &self.scene)?;
         let (seen_by, eyes) = match self.options.stereo {
             None => {
-                prepared.render_into(&camera, &mut self.frames.eyes[0]);
+                match &self.look {
+                    Some(look) => {
+                        let slot = &mut self.look_pass;
+                        let pass = look_pass(slot, &self.renderer, settings, look)?;
+                        let gbuffer = pass.trace(&camera, Quality::Full);
+                        self.frames.eyes[0] = shade(&gbuffer, &camera, &look.shading)?;
+                    }
+                    None => prepared.render_into(&camera, &mut self.frames.eyes[0]),
+                }
                 (camera, None)
             }
             Some(stereo) => {
@@ -304,6 +329,23 @@ fn cross_options(slices: &SliceOptions) -> SliceOptions {
         field_mm: Some(CROSS_SECTION_FIELD_MM),
         ..slices.clone()
     }
+}
+
+/// The ray pass of `look` in `slot` for `settings`, made again only when they change.
+fn look_pass<'s>(
+    slot: &'s mut Option<(RenderSettings, RayPass)>,
+    renderer: &Arc<Renderer>,
+    settings: &RenderSettings,
+    look: &Look,
+) -> Result<&'s RayPass, FlightError> {
+    let (_, pass) = match slot.take() {
+        Some((s, pass)) if s == *settings => slot.insert((s, pass)),
+        _ => {
+            let pass = RayPass::new(renderer, settings, &look.ray)?;
+            slot.insert((settings.clone(), pass))
+        }
+    };
+    Ok(pass)
 }
 
 /// The prepared renderer in `slot` for `settings`, updated only when they change.

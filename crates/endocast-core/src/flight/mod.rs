@@ -14,7 +14,10 @@ pub use error::FlightError;
 pub use frames::{Flight, FlightOptions, FlightStereo, Layout};
 pub use looks::ShotSettings;
 pub use overview::{lumen_overview, Overview};
-pub use wall::{wall_coverage, BackwardPass, WallSeen, REPORT_TINT};
+pub use wall::{
+    wall_coverage, wall_coverage_near, BackwardPass, WallSeen, BACK_ONLY_TINT,
+    LABEL_SEEN_BACK_ONLY, LABEL_SEEN_FORWARD, LABEL_UNSEEN, MASK_LABELS, REPORT_TINT,
+};
 
 use crate::animation::{Animation, AnimationError, KeyFrame};
 use crate::path::{Path, PathError};

@@ -187,9 +187,19 @@ fn flying_back_sees_at_least_the_forward_wall_and_the_figures_add_up() {
     assert_eq!(seen.seen_forward(), forward.seen_count());
     assert!(seen.seen_forward_backward() >= seen.seen_forward().max(backward.seen_count()));
     assert!(seen.fraction_forward_backward() > seen.fraction_forward());
+    let mask = seen.mask_volume().unwrap();
+    assert_eq!(mask.voxels().len(), geometry.dims().iter().product());
+    // The mask shows what the figures count, pass by pass.
+    let count = |label: u16| mask.voxels().iter().filter(|&&l| l == label).count();
+    assert_eq!(count(LABEL_SEEN_FORWARD), seen.seen_forward());
     assert_eq!(
-        seen.mask_volume().unwrap().voxels().len(),
-        geometry.dims().iter().product()
+        count(LABEL_SEEN_FORWARD) + count(LABEL_SEEN_BACK_ONLY),
+        seen.seen_forward_backward()
+    );
+    assert!(count(LABEL_SEEN_BACK_ONLY) > 0);
+    assert_eq!(
+        count(LABEL_SEEN_FORWARD) + count(LABEL_SEEN_BACK_ONLY) + count(LABEL_UNSEEN),
+        seen.wall_voxels()
     );
     let overview = seen.overview(&lumen, &geometry, [64, 48]).unwrap();
     assert_eq!([overview.image.width(), overview.image.height()], [64, 48]);

@@ -43,8 +43,15 @@ impl BitGrid {
         self.words[n >> 6] >> (n & 63) & 1 == 1
     }
 
+    /// The bit of the voxel at linear index `n` (`i` fastest).
     #[inline]
-    fn set(&mut self, v: [usize; 3]) {
+    pub(crate) fn get_linear(&self, n: usize) -> bool {
+        self.words[n >> 6] >> (n & 63) & 1 == 1
+    }
+
+    /// Sets the bit of voxel `v` (which must lie in the box).
+    #[inline]
+    pub(crate) fn set(&mut self, v: [usize; 3]) {
         let n = self.index(v);
         self.words[n >> 6] |= 1 << (n & 63);
     }
@@ -67,6 +74,12 @@ impl ValueTest {
     #[inline]
     fn holds(&self, stored: u16) -> bool {
         self.table[usize::from(stored)]
+    }
+
+    /// The test on the voxel at each linear index of `volume`.
+    fn on<'a>(&'a self, volume: &'a Volume) -> impl Fn(usize) -> bool + 'a {
+        let voxels = volume.voxels();
+        move |n| self.holds(voxels[n])
     }
 }
 
@@ -124,7 +137,41 @@ impl Lumen {
         }
         let test = ValueTest::new(volume.value_map(), threshold, side);
         let mut visited = BitGrid::new(dims);
-        let component = fill(volume, &test, seed, &mut visited);
+        let component = fill(dims, test.on(volume), seed, &mut visited);
+        Ok(Self::from_visited(
+            &visited, component, dims, threshold, side,
+        ))
+    }
+
+    /// The component of `seed` among the voxels on `side` of `threshold` that `allowed` (one bit
+    /// per voxel of the volume) also holds: a structure cut out of a lumen that, grown on the
+    /// threshold alone, would join its neighbours (the aorta out of everything above 130 HU).
+    /// Errors as [`Lumen::from_seed`]; a seed outside `allowed` is in the wall.
+    pub(crate) fn within(
+        volume: &Volume,
+        seed: [usize; 3],
+        threshold: f64,
+        side: LumenSide,
+        allowed: &BitGrid,
+    ) -> Result<Self, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let dims = volume.dims();
+        let value = volume
+            .physical(seed[0], seed[1], seed[2])
+            .ok_or(NavError::SeedOutside { seed, dims })?;
+        if !side.holds(value, threshold) || !allowed.get(seed) {
+            return Err(NavError::SeedInWall {
+                seed,
+                value,
+                side,
+                threshold,
+            });
+        }
+        let test = ValueTest::new(volume.value_map(), threshold, side);
+        let on_side = test.on(volume);
+        let mut visited = BitGrid::new(dims);
+        let holds = |n: usize| allowed.get_linear(n) && on_side(n);
+        let component = fill(dims, holds, seed, &mut visited);
         Ok(Self::from_visited(
             &visited, component, dims, threshold, side,
         ))
@@ -143,19 +190,12 @@ impl Lumen {
     ) -> Result<Option<Self>, NavError> {
         check_finite("threshold", threshold, false)?;
         let dims = volume.dims();
-        let test = ValueTest::new(volume.value_map(), threshold, side);
-        let mut visited = BitGrid::new(dims);
         let (mut best_all, mut best_inner): (Option<Component>, Option<Component>) = (None, None);
         let bigger = |best: Option<Component>, c: Component| match best {
             Some(b) if b.count >= c.count => Some(b),
             _ => Some(c),
         };
-        for (n, &stored) in volume.voxels().iter().enumerate() {
-            let v = [n % dims[0], n / dims[0] % dims[1], n / (dims[0] * dims[1])];
-            if !test.holds(stored) || visited.get(v) {
-                continue;
-            }
-            let c = fill(volume, &test, v, &mut visited);
+        for c in components(volume, threshold, side) {
             best_all = bigger(best_all, c);
             if !c.touches_border(dims) {
                 best_inner = bigger(best_inner, c);
@@ -169,6 +209,27 @@ impl Lumen {
         chosen
             .map(|c| Self::from_seed(volume, c.seed, threshold, side))
             .transpose()
+    }
+
+    /// The largest of the `tries` largest components that `accept` takes (the colon: gas, not
+    /// aerated lung, inside the body). `Ok(None)` when it takes none of them.
+    pub fn largest_accepted(
+        volume: &Volume,
+        threshold: f64,
+        side: LumenSide,
+        tries: usize,
+        accept: impl Fn(&Lumen) -> bool,
+    ) -> Result<Option<Self>, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let mut all = components(volume, threshold, side);
+        all.sort_by_key(|c| std::cmp::Reverse(c.count));
+        for c in all.into_iter().take(tries) {
+            let lumen = Self::from_seed(volume, c.seed, threshold, side)?;
+            if accept(&lumen) {
+                return Ok(Some(lumen));
+            }
+        }
+        Ok(None)
     }
 
     /// The largest component that reaches into the inclusive voxel box `lo..=hi` and does not
@@ -194,7 +255,7 @@ impl Lumen {
                     if visited.get(v) || !test.holds(volume.voxels()[volume.index(i, j, k)]) {
                         continue;
                     }
-                    let c = fill(volume, &test, v, &mut visited);
+                    let c = fill(dims, test.on(volume), v, &mut visited);
                     if !c.touches_border(dims) && best.is_none_or(|b| c.count > b.count) {
                         best = Some(c);
                     }
@@ -372,15 +433,34 @@ impl<'a> LumenNumbering<'a> {
     }
 }
 
-/// Scanline flood fill from `seed` (a lumen voxel not yet visited) over 6-connected lumen
-/// voxels, marking them in `visited`. Each stack entry starts a run along `i`; the stack holds
-/// at most a few entries per run of the component, never one per voxel.
-fn fill(volume: &Volume, test: &ValueTest, seed: [usize; 3], visited: &mut BitGrid) -> Component {
-    let [nx, ny, nz] = volume.dims();
-    let voxels = volume.voxels();
-    let open = |v: [usize; 3], visited: &BitGrid| {
-        test.holds(voxels[v[0] + nx * (v[1] + ny * v[2])]) && !visited.get(v)
-    };
+/// Every component of the voxels on `side` of `threshold`, in the order their first voxel comes.
+fn components(volume: &Volume, threshold: f64, side: LumenSide) -> Vec<Component> {
+    let dims = volume.dims();
+    let test = ValueTest::new(volume.value_map(), threshold, side);
+    let mut visited = BitGrid::new(dims);
+    let mut found = Vec::new();
+    for (n, &stored) in volume.voxels().iter().enumerate() {
+        if !test.holds(stored) || visited.get_linear(n) {
+            continue;
+        }
+        let v = [n % dims[0], n / dims[0] % dims[1], n / (dims[0] * dims[1])];
+        found.push(fill(dims, test.on(volume), v, &mut visited));
+    }
+    found
+}
+
+/// Scanline flood fill from `seed` (a lumen voxel not yet visited) over 6-connected voxels whose
+/// linear index `holds` accepts, marking them in `visited`. Each stack entry starts a run along
+/// `i`; the stack holds at most a few entries per run of the component, never one per voxel.
+fn fill(
+    dims: [usize; 3],
+    holds: impl Fn(usize) -> bool,
+    seed: [usize; 3],
+    visited: &mut BitGrid,
+) -> Component {
+    let [nx, ny, nz] = dims;
+    let open =
+        |v: [usize; 3], visited: &BitGrid| holds(v[0] + nx * (v[1] + ny * v[2])) && !visited.get(v);
     let mut c = Component {
         seed,
         count: 0,

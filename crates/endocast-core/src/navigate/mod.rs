@@ -18,27 +18,32 @@
 //! Units: points are world millimetres (LPS) unless a name says `voxel`; voxel indices are
 //! `[usize; 3]` of the volume, `i` first.
 
+mod aorta;
 mod centreline;
 mod collision;
+mod colon;
 mod distance;
 mod error;
 mod lumen;
 mod plan;
 mod preset;
+mod section;
 mod side;
 #[cfg(test)]
 mod test_util;
 mod trachea;
 mod viewpoint;
 
+pub use aorta::{find_aorta, Aorta};
 pub use centreline::{
     centreline, snap_radius_mm, CentrelinePath, PathEnd, SNAP_RADIUS_MM, SNAP_RADIUS_VOXELS,
 };
 pub use collision::Collider;
+pub use colon::find_colon;
 pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
-pub use plan::{plan_path, seed_voxel, smooth_centreline, PlannedPath};
+pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
 pub use trachea::find_trachea;
 pub use viewpoint::{default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason};

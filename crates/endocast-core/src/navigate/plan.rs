@@ -37,12 +37,26 @@ pub fn plan_path(
 ) -> Result<(Lumen, DistanceField, PlannedPath), NavError> {
     let seed = seed_voxel(volume, start_mm)?;
     let lumen = Lumen::from_seed(volume, seed, threshold, side)?;
+    let (field, planned) = plan_in(volume, &lumen, start_mm, end, options)?;
+    Ok((lumen, field, planned))
+}
+
+/// [`plan_path`] in a lumen already found (a structure cut out of a larger lumen, such as the
+/// aorta): refused with [`NavError::LumenLeaks`] before any search when it leaks, else its
+/// distance field and the planned path, which stays inside it.
+pub fn plan_in(
+    volume: &Volume,
+    lumen: &Lumen,
+    start_mm: DVec3,
+    end: PathEnd,
+    options: &SmoothOptions,
+) -> Result<(DistanceField, PlannedPath), NavError> {
     if let Some(leak) = lumen.leak() {
         return Err(leak);
     }
-    let field = DistanceField::new(&lumen, volume.geometry());
-    let planned = smooth_centreline(volume, &lumen, &field, start_mm, end, options)?;
-    Ok((lumen, field, planned))
+    let field = DistanceField::new(lumen, volume.geometry());
+    let planned = smooth_centreline(volume, lumen, &field, start_mm, end, options)?;
+    Ok((field, planned))
 }
 
 /// [`centreline`] from `start_mm` to `end`, smoothed until every sample stays a quarter voxel

@@ -2,6 +2,7 @@
 //! slices, then grown below a threshold lowered until the tree stops leaking into the lung.
 
 use super::lumen::{Lumen, LumenSide};
+use super::section::{sections, top_is_last};
 use crate::Volume;
 
 /// Axial slices searched for the trachea, from the top of the scan down.
@@ -36,103 +37,23 @@ pub fn find_trachea(volume: &Volume, threshold: f64) -> Option<(Lumen, f64)> {
 /// The centre voxel of the trachea's section in the first top slice that has one.
 fn trachea_seed(volume: &Volume, threshold: f64) -> Option<[usize; 3]> {
     let dims = volume.dims();
-    let g = volume.geometry();
-    let z_of = |k: usize| g.world_of(glam::DVec3::new(0.0, 0.0, k as f64)).z;
-    let top_first = z_of(dims[2] - 1) > z_of(0);
-    let spacing = g.spacing_mm();
-    let pixel_mm2 = spacing.x * spacing.y;
+    let spacing = volume.geometry().spacing_mm();
+    let pixel_mm = [spacing.x, spacing.y];
+    let top_last = top_is_last(volume);
     (0..TOP_SLICES.min(dims[2]))
-        .map(|n| if top_first { dims[2] - 1 - n } else { n })
+        .map(|n| if top_last { dims[2] - 1 - n } else { n })
         .find_map(|k| {
-            let sections = air_sections(volume, k, threshold);
-            sections
+            let pixel_mm2 = pixel_mm[0] * pixel_mm[1];
+            let sized = |n: usize| (AREA_MM2.0..=AREA_MM2.1).contains(&(n as f64 * pixel_mm2));
+            sections(volume, k, threshold, LumenSide::Below, sized)
                 .into_iter()
                 .filter(|s| {
-                    let area = s.pixels as f64 * pixel_mm2;
-                    let box_pixels = (s.hi[0] - s.lo[0] + 1) * (s.hi[1] - s.lo[1] + 1);
-                    (AREA_MM2.0..=AREA_MM2.1).contains(&area)
-                        && s.pixels as f64 >= MIN_FILL * box_pixels as f64
+                    (AREA_MM2.0..=AREA_MM2.1).contains(&s.area_mm2(pixel_mm))
+                        && s.fill() >= MIN_FILL
                 })
                 .min_by_key(|s| s.centre[0].abs_diff(dims[0] / 2))
                 .map(|s| [s.centre[0], s.centre[1], k])
         })
-}
-
-/// One 4-connected air section of an axial slice that does not touch the slice's border.
-struct Section {
-    pixels: usize,
-    lo: [usize; 2],
-    hi: [usize; 2],
-    /// A pixel of the section nearest its centroid.
-    centre: [usize; 2],
-}
-
-/// The air sections (values below `threshold`) of slice `k` not touching its border.
-fn air_sections(volume: &Volume, k: usize, threshold: f64) -> Vec<Section> {
-    let [nx, ny, _] = volume.dims();
-    let map = volume.value_map();
-    let slice = &volume.voxels()[k * nx * ny..(k + 1) * nx * ny];
-    let air: Vec<bool> = slice.iter().map(|&s| map.physical(s) < threshold).collect();
-    let mut seen = vec![false; nx * ny];
-    let mut sections = Vec::new();
-    for start in 0..nx * ny {
-        if !air[start] || seen[start] {
-            continue;
-        }
-        seen[start] = true;
-        let mut stack = vec![start];
-        let mut pixels = Vec::new();
-        while let Some(n) = stack.pop() {
-            pixels.push(n);
-            let (i, j) = (n % nx, n / nx);
-            let neighbours = [
-                (i > 0).then(|| n - 1),
-                (i + 1 < nx).then_some(n + 1),
-                (j > 0).then(|| n - nx),
-                (j + 1 < ny).then_some(n + nx),
-            ];
-            for m in neighbours.into_iter().flatten() {
-                if air[m] && !seen[m] {
-                    seen[m] = true;
-                    stack.push(m);
-                }
-            }
-        }
-        if let Some(section) = section_of(&pixels, nx, ny) {
-            sections.push(section);
-        }
-    }
-    sections
-}
-
-/// The section of `pixels` (linear indices in an `nx` × `ny` slice), or `None` when it touches
-/// the slice's border.
-fn section_of(pixels: &[usize], nx: usize, ny: usize) -> Option<Section> {
-    let ij = |n: usize| [n % nx, n / nx];
-    let (mut lo, mut hi) = ([usize::MAX; 2], [0; 2]);
-    let mut sum = [0.0; 2];
-    for &n in pixels {
-        let p = ij(n);
-        for a in 0..2 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-            sum[a] += p[a] as f64;
-        }
-    }
-    if lo[0] == 0 || lo[1] == 0 || hi[0] + 1 == nx || hi[1] + 1 == ny {
-        return None;
-    }
-    let mean = sum.map(|s| s / pixels.len() as f64);
-    let centre = pixels.iter().map(|&n| ij(n)).min_by(|a, b| {
-        let d = |p: &[usize; 2]| (p[0] as f64 - mean[0]).powi(2) + (p[1] as f64 - mean[1]).powi(2);
-        d(a).total_cmp(&d(b))
-    })?;
-    Some(Section {
-        pixels: pixels.len(),
-        lo,
-        hi,
-        centre,
-    })
 }
 
 #[cfg(test)]

@@ -1,6 +1,8 @@
 //! Where to put the camera when the user gave none: at the most central point of the largest
 //! relevant lumen, looking along it.
 
+use super::aorta::{find_aorta, Aorta};
+use super::colon::find_colon;
 use super::distance::DistanceField;
 use super::lumen::{Lumen, LumenSide};
 use super::preset::{Central, LumenChoice, LumenChoiceError};
@@ -47,6 +49,13 @@ pub fn viewpoint_in(volume: &Volume, lumen: &Lumen) -> Pose {
     } else {
         -axis
     };
+    looking_along(eye_mm, forward, field.max_mm().max(1.0))
+}
+
+/// The camera at `eye_mm` looking along unit `forward` at a point `distance_mm` ahead, with up
+/// as near the patient's anterior (−y, LPS) as the view allows (superior when looking nearly
+/// along y).
+pub(crate) fn looking_along(eye_mm: DVec3, forward: DVec3, distance_mm: f64) -> Pose {
     let anterior = DVec3::NEG_Y;
     let reference = if anterior.dot(forward).abs() < 0.9 {
         anterior
@@ -56,7 +65,7 @@ pub fn viewpoint_in(volume: &Volume, lumen: &Lumen) -> Pose {
     let up = (reference - forward * reference.dot(forward)).normalize();
     Pose {
         eye_mm,
-        look_at_mm: eye_mm + forward * field.max_mm().max(1.0),
+        look_at_mm: eye_mm + forward * distance_mm,
         up,
     }
 }
@@ -64,7 +73,7 @@ pub fn viewpoint_in(volume: &Volume, lumen: &Lumen) -> Pose {
 /// The camera a command uses when the user placed none, and why it was chosen.
 #[derive(Debug, Clone, PartialEq)]
 pub enum DefaultView {
-    /// Inside the largest lumen on `side` of `threshold` (see [`default_viewpoint`]).
+    /// Inside the structure the lumen choice means (see [`default_view`]).
     InsideLumen {
         /// The camera.
         pose: Pose,
@@ -72,6 +81,13 @@ pub enum DefaultView {
         threshold: f64,
         /// The lumen's side of it.
         side: LumenSide,
+        /// The structure's lumen: its mask, and what a path through it must stay in.
+        lumen: Box<Lumen>,
+        /// Where a path through it ends, world mm, for a tube whose far end is known (the
+        /// aorta's lowest section); `None`: at the farthest point.
+        end_mm: Option<DVec3>,
+        /// What was found, in words (e.g. "aorta: 402 mm, radius 11.3 mm").
+        what: String,
     },
     /// The whole volume framed from the front (see [`crate::camera::framing_pose`]).
     Framing {
@@ -108,10 +124,38 @@ pub enum FramingReason {
     },
 }
 
+/// A structure found: its lumen, the camera in it, the threshold it was grown at, the path's
+/// end where known, and what it is in words.
+struct Found {
+    lumen: Lumen,
+    pose: Pose,
+    threshold: f64,
+    end_mm: Option<DVec3>,
+    what: String,
+}
+
+impl Found {
+    /// The camera at `lumen`'s most central point ([`viewpoint_in`]), described as `name`
+    /// with its volume.
+    fn central(volume: &Volume, lumen: Lumen, threshold: f64, name: &str) -> Self {
+        let s = volume.geometry().spacing_mm();
+        let ml = lumen.voxel_count() as f64 * s.x * s.y * s.z / 1000.0;
+        Self {
+            pose: viewpoint_in(volume, &lumen),
+            what: format!("{name}: {ml:.1} ml"),
+            lumen,
+            threshold,
+            end_mm: None,
+        }
+    }
+}
+
 /// The default camera for `volume`: with a `lumen` choice (an endoscopic preset), inside the
-/// largest lumen it resolves to ([`default_viewpoint`]), looking along it; without one, or when
-/// the choice gives no threshold or the scan no such lumen, the whole volume framed from the
-/// front for the vertical field of view `fov_deg` ([`framing_pose`]), with the reason.
+/// structure it means — the airway tree from the trachea, the aorta, the colon, the central
+/// CSF component, else the largest lumen ([`default_viewpoint`]) — looking along it; without
+/// one, or when the choice gives no threshold or the scan no such lumen, the whole volume
+/// framed from the front for the vertical field of view `fov_deg` ([`framing_pose`]), with the
+/// reason.
 pub fn default_view(volume: &Volume, lumen: Option<&LumenChoice<'_>>, fov_deg: f64) -> DefaultView {
     let framing = |reason| DefaultView::Framing {
         pose: framing_pose(volume.geometry(), fov_deg),
@@ -125,23 +169,81 @@ pub fn default_view(volume: &Volume, lumen: Option<&LumenChoice<'_>>, fov_deg: f
         Err(error) => return framing(FramingReason::Choice(error)),
     };
     let structure = choice.preset.and_then(|p| p.lumen).map(|l| l.structure);
-    let largest = || default_viewpoint(volume, threshold, side).map(|pose| (pose, threshold));
-    let found = match (choice.within, structure) {
-        (Some(central), _) => central_lumen(volume, threshold, side, &central),
-        (None, Some(Structure::Trachea)) if side == LumenSide::Below => {
-            find_trachea(volume, threshold)
-                .map(|(tree, t)| (viewpoint_in(volume, &tree), t))
-                .or_else(largest)
-        }
-        _ => largest(),
-    };
-    match found {
-        Some((pose, threshold)) => DefaultView::InsideLumen {
-            pose,
-            threshold,
+    match find_structure(volume, threshold, side, choice.within, structure) {
+        Some(found) => DefaultView::InsideLumen {
+            pose: found.pose,
+            threshold: found.threshold,
             side,
+            lumen: Box::new(found.lumen),
+            end_mm: found.end_mm,
+            what: found.what,
         },
         None => framing(FramingReason::NoLumen { threshold, side }),
+    }
+}
+
+/// The structure a preset means (see [`default_view`]); a specific finder that finds nothing
+/// falls back to the largest lumen.
+fn find_structure(
+    volume: &Volume,
+    threshold: f64,
+    side: LumenSide,
+    within: Option<Central>,
+    structure: Option<Structure>,
+) -> Option<Found> {
+    let largest = || {
+        let lumen = Lumen::largest(volume, threshold, side, side == LumenSide::Below).ok()??;
+        Some(Found::central(volume, lumen, threshold, "largest lumen"))
+    };
+    match (within, structure, side) {
+        (Some(central), _, _) => central_lumen(volume, threshold, side, &central),
+        (None, Some(Structure::Trachea), LumenSide::Below) => find_trachea(volume, threshold)
+            .map(|(tree, t)| Found::central(volume, tree, t, "airway tree from the trachea"))
+            .or_else(largest),
+        (None, Some(Structure::Aorta), _) => find_aorta(volume, threshold, side)
+            .map(|aorta| aorta_found(aorta, threshold))
+            .or_else(largest),
+        (None, Some(Structure::Colon), LumenSide::Below) => find_colon(volume, threshold)
+            .map(|colon| {
+                Found::central(
+                    volume,
+                    colon,
+                    threshold,
+                    "colon (largest gas inside the body)",
+                )
+            })
+            .or_else(largest),
+        _ => largest(),
+    }
+}
+
+/// Sections below the aorta's top where the camera starts: a little inside, so the whole
+/// circle of the wall is in view.
+const AORTA_START_SECTION: usize = 2;
+/// How far ahead the camera looks along the aorta, in radii.
+const AORTA_LOOK_RADII: f64 = 4.0;
+
+/// The camera near the aorta's top looking down along it (with the flow), the path's end at
+/// its lowest section.
+fn aorta_found(aorta: Aorta, threshold: f64) -> Found {
+    let centres = &aorta.centres_mm;
+    let start = AORTA_START_SECTION.min(centres.len() - 1);
+    let eye = centres[start];
+    let ahead = centres[start..]
+        .iter()
+        .find(|c| c.distance(eye) >= AORTA_LOOK_RADII * aorta.radius_mm)
+        .copied()
+        .unwrap_or(aorta.bottom_mm);
+    let forward = (ahead - eye).try_normalize().unwrap_or(DVec3::NEG_Z);
+    Found {
+        pose: looking_along(eye, forward, aorta.radius_mm),
+        what: format!(
+            "aorta: {:.0} mm along the slices, radius {:.1} mm (median), top at z {:.1} mm",
+            aorta.length_mm, aorta.radius_mm, aorta.top_mm.z
+        ),
+        end_mm: Some(aorta.bottom_mm),
+        lumen: aorta.lumen,
+        threshold,
     }
 }
 
@@ -158,7 +260,7 @@ fn central_lumen(
     threshold: f64,
     side: LumenSide,
     central: &Central,
-) -> Option<(Pose, f64)> {
+) -> Option<Found> {
     let spacing = volume.geometry().spacing_mm();
     let voxel_mm3 = spacing.x * spacing.y * spacing.z;
     let mut best: Option<(Lumen, f64)> = None;
@@ -178,7 +280,7 @@ fn central_lumen(
             break;
         }
     }
-    best.map(|(lumen, t)| (viewpoint_in(volume, &lumen), t))
+    best.map(|(lumen, t)| Found::central(volume, lumen, t, "central CSF component"))
 }
 
 /// The voxel nearest the lumen's centroid among those within half a voxel of the largest

@@ -32,6 +32,7 @@ mod centreline;
 mod colon;
 mod curved_tube;
 mod joint;
+mod layered;
 mod noise;
 pub mod profile;
 mod raster;
@@ -45,6 +46,7 @@ pub use centreline::Centreline;
 pub use colon::{colon, Colon, Fold};
 pub use curved_tube::{curved_tube, CurvedTube};
 pub use joint::{joint, Joint};
+pub use layered::{layered, Layered, SECRETION_HU};
 pub use shape::Ball;
 pub use sinus::{sinus, Cavity, Septum, Sinus};
 pub use sphere_shell::{sphere_shell, SphereShell};
@@ -73,11 +75,13 @@ pub enum Phantom {
     Joint,
     /// Air cavities divided by thin bony septa ([`sinus`]).
     Sinus,
+    /// Air over a secretion layer of known, varying thickness over tissue ([`layered`]).
+    Layered,
 }
 
 impl Phantom {
     /// Every phantom, in a fixed order.
-    pub const ALL: [Phantom; 7] = [
+    pub const ALL: [Phantom; 8] = [
         Self::SphereShell,
         Self::StraightTube,
         Self::CurvedTube,
@@ -85,9 +89,10 @@ impl Phantom {
         Self::Vessel,
         Self::Joint,
         Self::Sinus,
+        Self::Layered,
     ];
 
-    /// The kebab-case name (`sphere-shell`, `straight-tube`, `curved-tube`, `colon`, `vessel`, `joint`, `sinus`).
+    /// The kebab-case name (`sphere-shell`, `straight-tube`, `curved-tube`, `colon`, `vessel`, `joint`, `sinus`, `layered`).
     pub fn name(self) -> &'static str {
         match self {
             Self::SphereShell => "sphere-shell",
@@ -97,6 +102,7 @@ impl Phantom {
             Self::Vessel => "vessel",
             Self::Joint => "joint",
             Self::Sinus => "sinus",
+            Self::Layered => "layered",
         }
     }
 
@@ -121,6 +127,9 @@ impl Phantom {
                 "three bones around two thin contrast layers: two isosurfaces, depth peeling"
             }
             Self::Sinus => "air cavities divided by thin bony septa: thin structures",
+            Self::Layered => {
+                "air over a secretion layer of known, growing thickness over tissue: secretion"
+            }
         }
     }
 
@@ -134,6 +143,7 @@ impl Phantom {
             Self::Vessel => vessel(options).0,
             Self::Joint => joint(options).0,
             Self::Sinus => sinus(options).0,
+            Self::Layered => layered(options).0,
         }
     }
 }

@@ -21,7 +21,7 @@ mod histogram;
 mod resolve;
 
 pub use brain::{central_box, central_structure, measure_csf, CsfContrast};
-pub use resolve::{default_settings, resolve, Resolved};
+pub use resolve::{default_look, default_settings, resolve, Resolved};
 
 use crate::{Modality, Volume};
 use histogram::Histogram;

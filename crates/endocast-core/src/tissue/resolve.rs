@@ -2,6 +2,7 @@
 
 use super::brain::measure_csf;
 use super::{short, LinearMap, ScanValues, ValueKind};
+use crate::look::PresetLook;
 use crate::navigate::LumenSide;
 use crate::presets::{Preset, Reference, Surface};
 use crate::render::{RenderSettings, TransferFunction};
@@ -86,6 +87,18 @@ pub fn resolve(preset: &Preset, volume: &Volume, scan: &ScanValues) -> Resolved 
     }
 }
 
+/// The look's values without a preset ([`PresetLook::CT`]) in the units of `scan`, as
+/// [`default_settings`] carries the render settings.
+pub fn default_look(scan: &ScanValues) -> PresetLook {
+    let map = scan.from_hounsfield();
+    let ct = PresetLook::CT;
+    PresetLook {
+        tissue: map.apply(ct.tissue),
+        secretion: map.apply(ct.secretion),
+        ..ct
+    }
+}
+
 /// The render settings without a preset ([`RenderSettings::default`]: the wall at −500 HU, the
 /// −700…−300 HU ramp) in the units of `scan` (see [`ScanValues::from_hounsfield`]: the wall on
 /// Otsu's background/object threshold for a scan that is not in HU).
@@ -103,6 +116,8 @@ pub fn default_settings(scan: &ScanValues) -> RenderSettings {
 fn map_preset(preset: &Preset, map: LinearMap) -> Preset {
     let mut p = *preset;
     p.iso = map.apply(p.iso);
+    p.look.tissue = map.apply(p.look.tissue);
+    p.look.secretion = map.apply(p.look.secretion);
     p.iso2 = p.iso2.map(|s| Surface {
         iso: map.apply(s.iso),
         ..s

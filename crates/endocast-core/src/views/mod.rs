@@ -1,7 +1,8 @@
 //! Image-space views around the endoscope: an RGB [`Image`] with small drawing primitives and a
 //! built-in bitmap [`font`], the orthogonal [`slices`] through the camera, and the
 //! [`dashboard`] that puts the endoscopic view, the slices and an overview side by side, and
-//! the [`stereo`] outputs that combine two eyes' views.
+//! the [`stereo`] outputs that combine two eyes' views, and the [`structure`] a command found
+//! tinted on the slices.
 //!
 //! No file formats here: the writers live in `endocast-io`.
 //!
@@ -23,6 +24,7 @@ pub mod dashboard;
 pub mod font;
 pub mod slices;
 pub mod stereo;
+pub mod structure;
 
 use crate::render::{Frame, MAX_IMAGE_EDGE};
 use glam::DVec3;

@@ -235,6 +235,11 @@ impl Slice {
         &self.image
     }
 
+    /// The image, to draw on.
+    pub(crate) fn image_mut(&mut self) -> &mut Image {
+        &mut self.image
+    }
+
     /// Gives the image back.
     pub fn into_image(self) -> Image {
         self.image

@@ -1,0 +1,201 @@
+//! The ray pass: one march per pixel into a [`GBuffer`] (tissue depth, hit position, normal,
+//! secretion, hit mask), the only stage of a look that samples the volume.
+
+use super::secretion::Continuation;
+use super::settings::{RayPassSettings, SecretionMode};
+use super::LookError;
+use crate::camera::Camera;
+use crate::render::quality::{reduced_camera, upsample};
+use crate::render::{
+    Crossing, Frame, Layers, Mode, Prepared, Quality, RenderOptions, RenderSettings, RenderStats,
+    Renderer,
+};
+use rayon::prelude::*;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// What the ray pass wrote per pixel (row 0 at the top, pixel `(x, y)` at `x + width · y`).
+/// A pixel without a tissue hit has NaN depth, position and normal, and no secretion.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct GBuffer {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Distance from the eye to the tissue along the ray, mm.
+    pub depth_mm: Vec<f32>,
+    /// World position of the tissue hit, mm.
+    pub hit_mm: Vec<[f32; 3]>,
+    /// Unit world normal of the tissue at the hit (central differences in the volume),
+    /// pointing into the tissue.
+    pub normal: Vec<[f32; 3]>,
+    /// Secretion in front of the tissue along the ray, mm: the distance from the first
+    /// secretion hit to the tissue ([`SecretionMode::On`]) or the length of the ray above the
+    /// secretion threshold ([`SecretionMode::Accumulate`]); 0 without secretion.
+    pub secretion_mm: Vec<f32>,
+    /// The ray pass's counters (its time included).
+    pub stats: RenderStats,
+}
+
+impl GBuffer {
+    /// Number of pixels.
+    pub fn len(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// Whether the buffer has no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The hit mask: whether pixel `i`'s ray met the tissue.
+    pub fn hit(&self, i: usize) -> bool {
+        !self.depth_mm[i].is_nan()
+    }
+}
+
+/// The ray pass of a look over one renderer: it owns a renderer prepared in [`Mode::Iso`] at
+/// the first threshold the rays meet (the secretion's, or the tissue's without secretion), and
+/// carries each ray on from its secretion hit to the tissue.
+#[derive(Debug)]
+pub struct RayPass {
+    prepared: Prepared,
+    settings: RayPassSettings,
+}
+
+impl RayPass {
+    /// The ray pass for `settings` over `renderer`, sampling as `base` says (step, refinement,
+    /// empty-space skipping; its mode and isovalue are replaced). Fails on an out-of-range
+    /// setting.
+    pub fn new(
+        renderer: &Arc<Renderer>,
+        base: &RenderSettings,
+        settings: &RayPassSettings,
+    ) -> Result<Self, LookError> {
+        settings.validate()?;
+        let map = renderer.volume().value_map();
+        let stored = |hu: f64| map.stored_from_physical(hu);
+        let mut s = base.clone();
+        s.mode = Mode::Iso;
+        s.iso_opacity = 1.0;
+        s.interleave = settings.interleave;
+        s.iso_hu = settings.tissue_hu;
+        if settings.secretion != SecretionMode::Off {
+            s.iso_hu = settings.secretion_hu;
+            // From the lumen through the secretion into the tissue, wherever the eye is.
+            s.crossing = if stored(settings.tissue_hu) > stored(settings.secretion_hu) {
+                Crossing::Rising
+            } else {
+                Crossing::Falling
+            };
+        }
+        let prepared = renderer.prepare(&s)?;
+        Ok(Self {
+            prepared,
+            settings: settings.clone(),
+        })
+    }
+
+    /// The settings in force.
+    pub fn settings(&self) -> &RayPassSettings {
+        &self.settings
+    }
+
+    /// The renderer prepared for the first threshold.
+    pub fn prepared(&self) -> &Prepared {
+        &self.prepared
+    }
+
+    /// Marches every pixel of `camera` at `quality` (below full, the buffer is traced at the
+    /// reduced size and upsampled depth-aware to the camera's).
+    pub fn trace(&self, camera: &Camera, quality: Quality) -> GBuffer {
+        self.trace_shifted(camera, quality, 0.0)
+    }
+
+    /// [`Self::trace`] with every ray's sample grid shifted by `grid_shift` steps (a still
+    /// frame's jitter).
+    pub(crate) fn trace_shifted(&self, camera: &Camera, quality: Quality, shift: f32) -> GBuffer {
+        let start = Instant::now();
+        let full = camera.size();
+        let small = match quality {
+            Quality::Full => *camera,
+            reduced => reduced_camera(camera, reduced.reduced_size(full)),
+        };
+        let with_secretion = self.settings.secretion != SecretionMode::Off;
+        let layers = if with_secretion {
+            Layers::NONE
+        } else {
+            Layers::HIT_POSITION | Layers::NORMAL
+        };
+        let options = RenderOptions {
+            grid_shift: shift,
+            ..RenderOptions::new().layers(layers)
+        };
+        let mut frame = Frame::default();
+        // Nothing cancels it.
+        let _ = self.prepared.render_with(&small, &options, &mut frame);
+        let secretion = if with_secretion {
+            self.continue_to_tissue(&small, &mut frame)
+        } else {
+            vec![0.0; frame.len()]
+        };
+        let mut gbuffer = if quality == Quality::Full {
+            into_gbuffer(frame, secretion)
+        } else {
+            // The value layer (NaN in iso mode) carries the secretion through the upsampling.
+            frame.value = secretion;
+            let mut upsampled = Frame::default();
+            upsample(&frame, full, &mut upsampled);
+            let secretion = std::mem::take(&mut upsampled.value);
+            into_gbuffer(upsampled, secretion)
+        };
+        gbuffer.stats.time = start.elapsed();
+        gbuffer
+    }
+
+    /// Carries every ray of `frame` (traced by `camera` to its secretion hit) on to the tissue:
+    /// replaces its depth with the tissue's, fills its hit positions and normals, and returns
+    /// the secretion per pixel.
+    fn continue_to_tissue(&self, camera: &Camera, frame: &mut Frame) -> Vec<f32> {
+        let renderer = self.prepared.renderer();
+        let on = Continuation::new(renderer, &self.settings);
+        let width = frame.width;
+        let hits: Vec<_> = frame
+            .depth_mm
+            .par_iter()
+            .enumerate()
+            .with_min_len(64)
+            .map(|(i, &t)| {
+                let ray = camera.pixel_ray(i % width, i / width)?;
+                on.tissue_after(ray.origin, ray.dir, t)
+            })
+            .collect();
+        let n = frame.len();
+        (frame.hit_mm, frame.normal) = (vec![[f32::NAN; 3]; n], vec![[f32::NAN; 3]; n]);
+        let mut secretion = vec![0.0; n];
+        for (i, hit) in hits.into_iter().enumerate() {
+            frame.depth_mm[i] = f32::NAN;
+            if let Some(hit) = hit {
+                frame.depth_mm[i] = hit.depth_mm;
+                frame.hit_mm[i] = hit.hit_mm;
+                frame.normal[i] = hit.normal;
+                secretion[i] = hit.secretion_mm;
+            }
+        }
+        frame.stats.iso_hits = frame.depth_mm.iter().filter(|d| !d.is_nan()).count() as u64;
+        secretion
+    }
+}
+
+/// The G-buffer of a traced `frame` and its `secretion`.
+fn into_gbuffer(frame: Frame, secretion_mm: Vec<f32>) -> GBuffer {
+    GBuffer {
+        width: frame.width,
+        height: frame.height,
+        depth_mm: frame.depth_mm,
+        hit_mm: frame.hit_mm,
+        normal: frame.normal,
+        secretion_mm,
+        stats: frame.stats,
+    }
+}

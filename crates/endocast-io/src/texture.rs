@@ -1,0 +1,61 @@
+//! Detail textures for the realistic look from PNG files: any PNG (greyscale, colour, palette,
+//! with or without alpha, 8 or 16 bits) read as its luminance, 0–1.
+
+use crate::error::{ReadError, Result};
+use endocast_core::look::Texture;
+use std::io::BufReader;
+use std::path::Path;
+
+/// Reads the PNG at `path` as a [`Texture`] of its luminance (Rec. 709 weights; alpha
+/// ignored). Errors name the file: missing, not a PNG, or an image of 0 or more than 8192
+/// pixels along an edge.
+pub fn read_texture(path: &Path) -> Result<Texture> {
+    let file = std::fs::File::open(path).map_err(|e| ReadError::io(path, e))?;
+    let mut decoder = png::Decoder::new(BufReader::new(file));
+    decoder.set_transformations(png::Transformations::normalize_to_color8());
+    let bad = |e: png::DecodingError| ReadError::format(path, format!("not a readable PNG: {e}"));
+    let mut reader = decoder.read_info().map_err(bad)?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| ReadError::format(path, "a PNG too large to decode"))?;
+    let mut buffer = vec![0; size];
+    let info = reader.next_frame(&mut buffer).map_err(bad)?;
+    let channels = info.color_type.samples();
+    let (width, height) = (info.width as usize, info.height as usize);
+    let luma = buffer[..info.buffer_size()]
+        .chunks_exact(info.line_size)
+        .flat_map(|row| row[..width * channels].chunks_exact(channels))
+        .map(|px| match px {
+            [g] | [g, _] => f32::from(*g) / 255.0,
+            [r, g, b, ..] => {
+                (0.2126 * f32::from(*r) + 0.7152 * f32::from(*g) + 0.0722 * f32::from(*b)) / 255.0
+            }
+            [] => 0.0,
+        })
+        .collect();
+    Texture::from_luma(width, height, luma).map_err(|e| ReadError::format(path, e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_colour_pngs_as_luminance_and_names_bad_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.png");
+        // Two pixels: white and pure green.
+        crate::write_image_rgb8(&path, 2, 1, &[255, 255, 255, 0, 255, 0]).unwrap();
+        let texture = read_texture(&path).unwrap();
+        assert_eq!(texture.size(), [2, 1]);
+        assert!((texture.sample(0.25, 0.5) - 1.0).abs() < 1e-6);
+        assert!((texture.sample(0.75, 0.5) - 0.7152).abs() < 1e-4);
+        let missing = dir.path().join("missing.png");
+        let error = read_texture(&missing).unwrap_err().to_string();
+        assert!(error.contains("missing.png"), "{error}");
+        let not_png = dir.path().join("x.png");
+        std::fs::write(&not_png, b"not a png").unwrap();
+        let error = read_texture(&not_png).unwrap_err().to_string();
+        assert!(error.contains("x.png") && error.contains("PNG"), "{error}");
+    }
+}

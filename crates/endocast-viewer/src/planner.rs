@@ -1,0 +1,93 @@
+//! Planned flights: the centred path through the lumen between two points (or from one to the
+//! farthest point), found off the UI thread with the navigation library's planner (as
+//! `endocast path` does), and turned into key frames the session plays, edits and exports.
+
+use crate::jobs::{Job, Notify};
+use crate::session::Session;
+use endocast_core::animation::KeyFrame;
+use endocast_core::navigate::{plan_path, LumenSide, PathEnd};
+use endocast_core::path::SmoothOptions;
+use endocast_core::Volume;
+use glam::DVec3;
+use std::sync::Arc;
+
+/// Distance between the key frames laid along a planned path, mm.
+pub const KEY_STEP_MM: f64 = 5.0;
+/// How far ahead on the path each key frame looks, mm (as `endocast fly`'s default).
+pub const LOOK_AHEAD_MM: f64 = 10.0;
+
+/// A planned flight.
+#[derive(Debug, Clone)]
+pub struct PlannedFlight {
+    /// Key frames every [`KEY_STEP_MM`] from the start to the end, looking ahead along it.
+    pub key_frames: Vec<KeyFrame>,
+    /// Length of the path, mm.
+    pub length_mm: f64,
+    /// Smallest distance from the path to the wall, mm.
+    pub min_radius_mm: f64,
+}
+
+/// What each planned key frame carries besides its pose: the field of view and the wall.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeyLook {
+    /// Field of view, degrees.
+    pub fov_deg: f64,
+    /// Wall isovalue, physical units.
+    pub iso_hu: f64,
+    /// Wall opacity, 0–1.
+    pub iso_opacity: f64,
+}
+
+/// Plans the flight through the lumen on `side` of `threshold` around `start_mm` to `end`.
+/// The error says why in one line (the start is in the wall, the end in another lumen, …).
+pub fn plan_flight(
+    volume: &Volume,
+    (threshold, side): (f64, LumenSide),
+    start_mm: DVec3,
+    end: PathEnd,
+    look: KeyLook,
+) -> Result<PlannedFlight, String> {
+    let options = SmoothOptions::default();
+    let (_, _, planned) = plan_path(volume, threshold, side, start_mm, end, &options)
+        .map_err(|e| format!("no path in the lumen {side} {threshold}: {e}"))?;
+    let path = &planned.path;
+    let length_mm = path.len_mm();
+    let count = (length_mm / KEY_STEP_MM).ceil().max(1.0) as usize;
+    let key_frames = (0..=count)
+        .map(|k| {
+            let s = (k as f64 * KEY_STEP_MM).min(length_mm);
+            let pose = path.pose_at(s, LOOK_AHEAD_MM).map_err(|e| e.to_string())?;
+            KeyFrame::from_pose(&pose, look.fov_deg, look.iso_hu, look.iso_opacity)
+                .map_err(|e| e.to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(PlannedFlight {
+        key_frames,
+        length_mm,
+        min_radius_mm: planned.min_radius_mm,
+    })
+}
+
+/// Starts planning the flight from `start_mm` to `end` in `session`'s lumen (the preset's
+/// lumen threshold, else the wall isovalue) on its own thread, with the current field of view
+/// and wall; `notify` is called when it is done.
+pub fn start_planning(
+    session: &Session,
+    start_mm: DVec3,
+    end: PathEnd,
+    notify: Notify,
+) -> Result<Job<Result<PlannedFlight, String>>, String> {
+    let lumen = session
+        .lumen_threshold()
+        .ok_or("this preset and isovalue name no lumen")?;
+    let c = &session.controls;
+    let look = KeyLook {
+        fov_deg: c.fov_deg,
+        iso_hu: c.iso_hu,
+        iso_opacity: f64::from(c.iso_opacity),
+    };
+    let renderer = Arc::clone(&session.scene().renderer);
+    Ok(Job::spawn("path", notify, move || {
+        plan_flight(renderer.volume(), lumen, start_mm, end, look)
+    }))
+}
