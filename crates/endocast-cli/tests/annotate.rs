@@ -222,3 +222,43 @@ fn a_case_of_another_scan_and_bad_annotations_are_clear_errors() {
     std::fs::write(&case, "{broken").unwrap();
     fails_with(&["annotate", c, "list"], "case.json");
 }
+
+#[test]
+fn a_case_keeps_the_orientation_given_for_a_scan_that_declares_none() {
+    let dir = tempfile::tempdir().unwrap();
+    // A NRRD without an anatomical space: its orientation must be given (`--orientation`).
+    let scan = dir.path().join("bare.nrrd");
+    let mut bytes = b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 8 8 8\nspacings: 1 1 1\n\
+encoding: raw\n\n"
+        .to_vec();
+    bytes.extend((0..512u32).map(|i| (i % 251) as u8));
+    std::fs::write(&scan, bytes).unwrap();
+    let s = scan.to_str().unwrap();
+    let case = dir.path().join("case.json");
+    let c = case.to_str().unwrap();
+    run(&[
+        "annotate",
+        c,
+        "--scan",
+        s,
+        "--orientation",
+        "LPI",
+        "add",
+        "point",
+        "--at",
+        "1,1,-1",
+    ]);
+    let saved = std::fs::read_to_string(&case).unwrap();
+    assert!(saved.contains("\"orientation\": \"LPI\""), "{saved}");
+    run(&["annotate", c, "--scan", s, "--orientation", "LPI", "list"]);
+    // Read the other way up, the same voxels are another scan: the points would land elsewhere.
+    fails_with(&["annotate", c, "--scan", s, "list"], "axes");
+    let png = dir.path().join("view.png");
+    let p = png.to_str().unwrap();
+    let view = ["--eye", "3,3,-10", "--look-at", "3,3,0", "--size", "16x16"];
+    let mut render = vec!["render", s, "-o", p, "--case", c, "--orientation", "LPS"];
+    render.extend(view);
+    fails_with(&render, "axes");
+    render[7] = "LPI";
+    run(&render);
+}

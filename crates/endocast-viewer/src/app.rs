@@ -245,18 +245,25 @@ impl ViewerApp {
                 if path.extension().is_some_and(|e| e == "json") {
                     self.start_loading(self.options.source.clone(), Some(path));
                 } else {
-                    let source = ScanSource::File { path, series: None };
+                    let source = ScanSource::File {
+                        path,
+                        series: None,
+                        orientation: None,
+                    };
                     self.start_loading(source, None);
                 }
             }
             Action::OpenSeries(uid) => {
-                let folder = match self.session().map(|s| &s.scene().source) {
-                    Some(ScanSource::File { path, .. }) => path.clone(),
-                    _ => return,
+                let Some(ScanSource::File {
+                    path, orientation, ..
+                }) = self.session().map(|s| s.scene().source.clone())
+                else {
+                    return;
                 };
                 let source = ScanSource::File {
-                    path: folder,
+                    path,
                     series: Some(uid),
+                    orientation,
                 };
                 self.start_loading(source, None);
             }

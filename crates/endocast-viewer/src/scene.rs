@@ -169,6 +169,7 @@ mod tests {
         let missing = ScanSource::File {
             path: "/nonexistent/scan.nii".into(),
             series: None,
+            orientation: None,
         };
         let error = missing.load().unwrap_err();
         assert!(error.contains("/nonexistent/scan.nii"), "{error}");

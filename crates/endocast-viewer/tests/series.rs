@@ -31,6 +31,7 @@ fn a_folder_of_two_series_opens_the_largest_and_then_the_one_chosen() {
     let source = ScanSource::File {
         path: dir.path().to_owned(),
         series: None,
+        orientation: None,
     };
     let mut app = ViewerApp::new(ctx.clone(), options(source));
     run_until(&ctx, &mut app, |a| a.session().is_some());
@@ -43,6 +44,7 @@ fn a_folder_of_two_series_opens_the_largest_and_then_the_one_chosen() {
     let chosen = ScanSource::File {
         path: dir.path().to_owned(),
         series: Some(other.uid.clone()),
+        orientation: None,
     };
     app.start_loading(chosen, None);
     assert!(app.is_loading() && app.session().is_some());
@@ -54,6 +56,7 @@ fn a_folder_of_two_series_opens_the_largest_and_then_the_one_chosen() {
     let missing = ScanSource::File {
         path: dir.path().to_owned(),
         series: Some("1.2.3.nothing".into()),
+        orientation: None,
     };
     app.start_loading(missing, None);
     run_until(&ctx, &mut app, |a| !a.is_loading());

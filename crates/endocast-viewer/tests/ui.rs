@@ -94,6 +94,7 @@ fn a_scan_that_cannot_be_read_says_why_and_the_app_stays_usable() {
     let source = ScanSource::File {
         path: "/nonexistent/chest.nii.gz".into(),
         series: None,
+        orientation: None,
     };
     let mut app = ViewerApp::new(ctx.clone(), options(source));
     run_until(&ctx, &mut app, |a| !a.is_loading());

@@ -28,6 +28,10 @@ pub struct AnnotateArgs {
     /// DICOM: the SeriesInstanceUID of --scan, when not the largest series.
     #[arg(long, value_name = "UID", requires = "scan")]
     series: Option<String>,
+    /// For a --scan that declares no patient orientation: where its index axes point (e.g.
+    /// LPI), as `render --orientation`; the case keeps it.
+    #[arg(long, value_name = "CODE", requires = "scan")]
+    orientation: Option<String>,
     #[command(subcommand)]
     action: Action,
 }
@@ -155,6 +159,7 @@ impl Opened {
         let source = args.scan.as_ref().map(|path| ScanSource::File {
             path: path.clone(),
             series: args.series.clone(),
+            orientation: args.orientation.clone(),
         });
         let volume = source.as_ref().map(load).transpose()?;
         let identity = volume.as_ref().map(ScanIdentity::of);

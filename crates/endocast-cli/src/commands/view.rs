@@ -51,6 +51,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         (Some(path), _, _) => ScanSource::File {
             path: path.clone(),
             series: args.series.clone(),
+            orientation: None,
         },
         (None, Some(name), _) => ScanSource::Phantom {
             name: name.clone(),

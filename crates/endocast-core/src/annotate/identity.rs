@@ -4,7 +4,7 @@
 use crate::Volume;
 use thiserror::Error;
 
-/// A scan's dimensions, spacing, origin and a hash of its values.
+/// A scan's dimensions, spacing, origin, axes and a hash of its values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ScanIdentity {
     /// Voxels per axis.
@@ -13,6 +13,9 @@ pub struct ScanIdentity {
     pub spacing_mm: [f64; 3],
     /// World position of voxel (0, 0, 0), mm.
     pub origin_mm: [f64; 3],
+    /// The world directions of the index axes (the direction matrix, column by column); `None`
+    /// in fingerprints recorded before it was kept, which then match any axes.
+    pub axes: Option<[f64; 9]>,
     /// A hash of the stored values and their scale and offset, 16 hex digits.
     pub voxel_hash: String,
 }
@@ -21,7 +24,7 @@ pub struct ScanIdentity {
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("the scan's {what} is {found}, the case was made on {expected}")]
 pub struct IdentityMismatch {
-    /// What differs: `dimensions`, `spacing`, `origin` or `voxel values`.
+    /// What differs: `dimensions`, `spacing`, `origin`, `axes` or `voxel values`.
     pub what: &'static str,
     /// The scan's.
     pub found: String,
@@ -31,6 +34,8 @@ pub struct IdentityMismatch {
 
 /// How far spacings and origins may differ and still match, mm (rounding in file headers).
 const GEOMETRY_TOLERANCE_MM: f64 = 1e-3;
+/// How far the direction cosines may differ and still match (rounding in file headers).
+const AXES_TOLERANCE: f64 = 1e-4;
 
 impl ScanIdentity {
     /// The identity of `volume` (one pass over its voxels).
@@ -52,6 +57,7 @@ impl ScanIdentity {
             dims: volume.dims(),
             spacing_mm: g.spacing_mm().to_array(),
             origin_mm: g.origin_mm().to_array(),
+            axes: Some(g.direction().to_cols_array()),
             voxel_hash: format!("{:016x}", hash.finish()),
         }
     }
@@ -82,6 +88,12 @@ impl ScanIdentity {
         if !near(scan.origin_mm, self.origin_mm) {
             let [a, b] = [scan.origin_mm, self.origin_mm];
             return mismatch("origin", format!("{a:?} mm"), format!("{b:?} mm"));
+        }
+        if let (Some(a), Some(b)) = (scan.axes, self.axes) {
+            if a.iter().zip(b).any(|(x, y)| (x - y).abs() > AXES_TOLERANCE) {
+                let show = |m: [f64; 9]| format!("{:?}", m.map(|v| (v * 1e4).round() / 1e4));
+                return mismatch("axes", show(a), show(b));
+            }
         }
         if scan.voxel_hash != self.voxel_hash {
             let [a, b] = [&scan.voxel_hash, &self.voxel_hash];

@@ -257,4 +257,25 @@ fn a_scan_is_recognised_and_any_change_is_named() {
     });
     let error = identity.check(&ScanIdentity::of(&bigger)).unwrap_err();
     assert!(error.to_string().contains("dimensions"), "{error}");
+    // The same voxels read with another orientation (e.g. a wrong --orientation) are refused:
+    // the annotations' world points would land elsewhere.
+    let flipped = volume
+        .geometry()
+        .with_direction(glam::DMat3::from_diagonal(DVec3::new(1.0, 1.0, -1.0)))
+        .unwrap();
+    let turned = crate::Volume::new(
+        flipped,
+        volume.voxels().to_vec(),
+        volume.value_map(),
+        volume.modality().clone(),
+    )
+    .unwrap();
+    let error = identity.check(&ScanIdentity::of(&turned)).unwrap_err();
+    assert_eq!(error.what, "axes");
+    // A fingerprint recorded without axes (older cases) still matches.
+    let older = ScanIdentity {
+        axes: None,
+        ..identity.clone()
+    };
+    assert!(older.check(&ScanIdentity::of(&volume)).is_ok());
 }

@@ -18,6 +18,9 @@ pub enum ScanSource {
         /// SeriesInstanceUID, DICOM only.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         series: Option<String>,
+        /// The patient orientation given for a file that declares none (e.g. `LPI`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        orientation: Option<String>,
     },
     /// A generated phantom (see `endocast phantom`).
     Phantom {
@@ -38,9 +41,14 @@ impl ScanSource {
     /// sources) so the user can choose another.
     pub fn load_with_series(&self) -> Result<(Volume, Vec<SeriesSummary>), String> {
         match self {
-            Self::File { path, series } => {
+            Self::File {
+                path,
+                series,
+                orientation,
+            } => {
                 let mut options = crate::OpenOptions::default();
                 options.series.clone_from(series);
+                options.orientation.clone_from(orientation);
                 crate::open(path, &options)
                     .map(|loaded| (loaded.volume, loaded.source.series_found))
                     .map_err(|e| format!("cannot read the scan: {e}"))
@@ -76,6 +84,10 @@ pub struct IdentityRecord {
     pub spacing_mm: [f64; 3],
     /// World position of the first voxel, mm (LPS).
     pub origin_mm: [f64; 3],
+    /// The world directions of the index axes, column by column (absent in cases written
+    /// before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axes: Option<[f64; 9]>,
     /// Hash of the voxel values (16 hex digits).
     pub voxel_hash: String,
 }
@@ -86,6 +98,7 @@ impl From<&ScanIdentity> for IdentityRecord {
             dims: id.dims,
             spacing_mm: id.spacing_mm,
             origin_mm: id.origin_mm,
+            axes: id.axes,
             voxel_hash: id.voxel_hash.clone(),
         }
     }
@@ -97,6 +110,7 @@ impl From<&IdentityRecord> for ScanIdentity {
             dims: r.dims,
             spacing_mm: r.spacing_mm,
             origin_mm: r.origin_mm,
+            axes: r.axes,
             voxel_hash: r.voxel_hash.clone(),
         }
     }
