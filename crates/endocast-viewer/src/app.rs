@@ -313,7 +313,8 @@ fn side_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     ui.label(format!("view {:7.2} {:7.2} {:7.2}", f.x, f.y, f.z));
 }
 
-/// "Frame 12.3 ms · quarter → 41 ms after input · eye … · wall 4.1 mm".
+/// "frame 12.3 ms · quarter · 41 ms after the request · eye (…) mm · wall 4.1 mm" (a still's
+/// frame time is its frames' mean).
 fn frame_status(ready: &Ready) -> String {
     let session = &ready.session;
     let frame = session.worker().with_latest(|f| {
@@ -324,9 +325,14 @@ fn frame_status(ready: &Ready) -> String {
                 Stage::Full => "full".to_owned(),
                 Stage::Still(n) => format!("still ×{n}"),
             };
+            // A still's time is its frames' sum.
+            let frames = match f.stage {
+                Stage::Still(n) => n.max(1) as f64,
+                _ => 1.0,
+            };
             format!(
                 "frame {:.1} ms · {stage} · {:.0} ms after the request",
-                f.render_time.as_secs_f64() * 1e3,
+                f.render_time.as_secs_f64() * 1e3 / frames,
                 f.since_request.as_secs_f64() * 1e3
             )
         })

@@ -9,6 +9,9 @@ use endocast_viewer::app::{ViewerApp, ViewerOptions};
 use endocast_viewer::scene::ScanSource;
 use std::time::{Duration, Instant};
 
+/// UI frames that outlast egui's animations (a frame without a clock advances it 1/60 s).
+const ANIMATION_FRAMES: usize = 12;
+
 /// The window's size, points.
 pub const SCREEN: Vec2 = Vec2::new(1100.0, 700.0);
 
@@ -143,6 +146,17 @@ impl Window {
         found.into_iter().min_by(|a, b| a.min.y.total_cmp(&b.min.y))
     }
 
+    /// Every text the last frame painted.
+    pub fn painted_texts(&self) -> Vec<String> {
+        let mut all = Vec::new();
+        for clipped in &self.shapes {
+            texts(&clipped.shape, &mut |_, shown, _| {
+                all.push(shown.to_owned())
+            });
+        }
+        all
+    }
+
     /// Clicks the widget that shows `text`, scrolling the control panel down to it.
     pub fn click_text(&mut self, text: &str) {
         for _ in 0..40 {
@@ -164,11 +178,15 @@ impl Window {
         panic!("no {text:?} to click in the window");
     }
 
-    /// A press and release of the primary button at `pos`.
+    /// A press and release of the primary button at `pos`, and the frames that finish what it
+    /// animates (a header unfolding).
     pub fn click(&mut self, pos: Pos2) {
         self.frame(vec![Event::PointerMoved(pos)]);
         self.frame(vec![button(pos, true)]);
         self.frame(vec![button(pos, false)]);
+        for _ in 0..ANIMATION_FRAMES {
+            self.frame(Vec::new());
+        }
     }
 
     /// A drag with the primary button from `from` to `to` in `steps` moves.

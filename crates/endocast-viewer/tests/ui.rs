@@ -1,6 +1,6 @@
 //! The window on a headless egui context: loading, flying with the keys, errors.
 
-use crate::harness::{input, key, options, run_until};
+use crate::harness::{input, key, options, run_until, Window};
 use egui::Key;
 use endocast_core::render::progressive::Stage;
 use endocast_viewer::app::ViewerApp;
@@ -136,4 +136,27 @@ fn the_slices_and_the_overview_arrive_from_their_threads() {
         assert!(start.elapsed() < Duration::from_secs(120), "only {names:?}");
         std::thread::sleep(Duration::from_millis(10));
     }
+}
+
+#[test]
+fn every_text_of_the_window_has_its_glyphs_in_the_font() {
+    let mut window = Window::open(options(ScanSource::Phantom {
+        name: "straight-tube".into(),
+        size: 32,
+    }));
+    window.run_until(|a| a.session().is_some());
+    window.frame(Vec::new());
+    // The folded parts of the panel too.
+    for header in ["Geometry", "Export the flight", "Keys"] {
+        window.click_text(header);
+    }
+    window.frame(Vec::new());
+    let font = egui::FontId::proportional(14.0);
+    let texts = window.painted_texts();
+    assert!(texts.iter().any(|t| t.contains("slide left")), "{texts:?}");
+    let missing: Vec<_> = texts
+        .iter()
+        .filter(|t| !window.ctx.fonts_mut(|f| f.has_glyphs(&font, t)))
+        .collect();
+    assert!(missing.is_empty(), "drawn without glyphs: {missing:?}");
 }
