@@ -72,16 +72,9 @@ impl PeelArgs {
     }
 }
 
-/// `N` (1, 2, 3 …) or `last`.
+/// `N` (1, 2, 3 …) or `last`, as case files name it too.
 fn parse_layer(text: &str) -> Result<PeelLayer, String> {
-    let text = text.trim();
-    if text.eq_ignore_ascii_case("last") {
-        return Ok(PeelLayer::Last);
-    }
-    match text.parse::<u32>() {
-        Ok(n) if n >= 1 => Ok(PeelLayer::Nth(n)),
-        _ => Err(format!("expected 1, 2, 3 … or last, found {text:?}")),
-    }
+    endocast_io::case::peel_layer(text)
 }
 
 #[cfg(test)]

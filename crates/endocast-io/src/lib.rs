@@ -35,6 +35,7 @@ pub mod nifti;
 pub mod nrrd;
 mod open;
 pub mod path_file;
+mod progress;
 pub mod raw;
 pub mod route_file;
 pub mod samples;
@@ -51,5 +52,6 @@ pub use image_out::{
 pub use limits::Limits;
 pub use loaded::{Format, Loaded, OpenOptions, SeriesSummary, SourceInfo};
 pub use open::{open, write};
+pub use progress::{Progress, ReadProgress, ReadStep};
 pub use samples::{ElementType, Endian, Rescale};
 pub use transfer_json::{read_transfer_json, TfPoints};

@@ -3,6 +3,7 @@
 //! reader and [`crate::open()`] share these types, so they live below all of them.
 
 use crate::limits::Limits;
+use crate::progress::Progress;
 use crate::samples::{ElementType, Endian};
 use endocast_core::Volume;
 use std::path::Path;
@@ -67,6 +68,9 @@ pub struct OpenOptions {
     /// the head down. Giving it for a file that declares its own orientation is an error.
     /// Default: none (such files are read as axis-aligned LPS, with a warning).
     pub orientation: Option<String>,
+    /// Where the reader counts how far it is (DICOM folders: headers, then files decoded), for
+    /// a progress bar on another thread. Default: counts nobody looks at.
+    pub progress: Progress,
 }
 
 /// One DICOM series found in a directory.

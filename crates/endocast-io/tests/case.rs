@@ -94,7 +94,7 @@ fn bad_case_files_name_the_file_and_the_problem() {
         ),
         (
             "version.json",
-            text.replace("\"version\": 2", "\"version\": 9"),
+            text.replace("\"version\": 3", "\"version\": 9"),
             "version 9",
         ),
         (

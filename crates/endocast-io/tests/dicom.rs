@@ -6,7 +6,7 @@
 use dicom_dictionary_std::tags;
 use dicom_object::OpenFileOptions;
 use endocast_core::Modality;
-use endocast_io::{dicom, Format, OpenOptions, ReadError};
+use endocast_io::{dicom, Format, OpenOptions, Progress, ReadError, ReadProgress, ReadStep};
 use endocast_testdata::shared_data;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -463,4 +463,53 @@ fn enhanced_multi_frame_file_stacks_its_frames_by_position() {
         loaded.warnings
     );
     assert_eq!(loaded.source.series_found[0].images, 3);
+}
+
+#[test]
+fn a_folder_read_counts_its_files_for_a_progress_bar() {
+    let Some(chest) = shared_data("chest-ct-airways-dicom") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for n in 20..26 {
+        let name = format!("00-slice{n:03}.dcm");
+        std::fs::copy(chest.join(&name), dir.path().join(&name)).unwrap();
+    }
+    std::fs::write(dir.path().join("notes.txt"), "not DICOM").unwrap();
+    let progress = Progress::default();
+    let mut options = OpenOptions::default();
+    options.progress = progress.clone();
+    assert_eq!(progress.get(), None);
+    // A thread looks at the counts while the folder is read, as the viewer's window does.
+    let watcher = {
+        let progress = progress.clone();
+        std::thread::spawn(move || {
+            let mut seen = Vec::new();
+            let start = std::time::Instant::now();
+            while start.elapsed().as_secs() < 60
+                && seen
+                    .last()
+                    .is_none_or(|p: &ReadProgress| p.step != ReadStep::Pixels || p.done < p.total)
+            {
+                if let Some(p) = progress.get().filter(|p| seen.last() != Some(p)) {
+                    assert!(p.done <= p.total, "{p:?}");
+                    seen.push(p);
+                }
+                std::thread::yield_now();
+            }
+            seen
+        })
+    };
+    let loaded = dicom::read(dir.path(), &options).unwrap();
+    assert_eq!(loaded.volume.dims()[2], 6);
+    let seen = watcher.join().unwrap();
+    let done = ReadProgress {
+        step: ReadStep::Pixels,
+        done: 6,
+        total: 6,
+    };
+    assert_eq!(seen.last(), Some(&done));
+    assert!(seen
+        .iter()
+        .all(|p| p.step == ReadStep::Pixels || p.total == 7));
 }

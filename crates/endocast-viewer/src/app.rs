@@ -3,14 +3,15 @@
 //! [`ViewerApp::frame_ui`] draws one UI frame on any [`egui::Context`], so tests run it headlessly
 //! with synthetic input; [`run`] puts it in a native window (eframe, OpenGL).
 
-use crate::case::{Autosave, Case, SessionCase};
+use crate::case::Autosave;
 use crate::flight_ui::FlightTools;
 use crate::geometry_ui::MeshLoader;
 use crate::jobs::Polled;
+use crate::loading::{Loading, Request};
 use crate::mark_tool::MarkTool;
 use crate::overview::OverviewView;
 use crate::panel::controls_ui;
-use crate::scene::{ScanSource, Scene};
+use crate::scene::ScanSource;
 use crate::session::Session;
 use crate::slices::SlicesView;
 use crate::state::{Action, Ready};
@@ -20,9 +21,8 @@ use endocast_core::presets::Preset;
 use endocast_core::render::progressive::Stage;
 use endocast_core::render::Quality;
 use std::path::PathBuf;
-use std::sync::mpsc::{channel, Receiver, TryRecvError};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// How often the case is autosaved when it changed.
 pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(10);
@@ -40,13 +40,6 @@ pub struct ViewerOptions {
     pub case: Option<PathBuf>,
     /// Write a screenshot of the window here once the view has refined, then quit.
     pub screenshot: Option<PathBuf>,
-}
-
-/// A scan being read in the background.
-struct Loading {
-    what: String,
-    started: Instant,
-    result: Receiver<Result<(Session, Option<PathBuf>), String>>,
 }
 
 /// The application.
@@ -81,24 +74,13 @@ impl ViewerApp {
     /// Starts reading `source` (or the scan of the case file `case`) in the background; the
     /// current session stays usable meanwhile and if it fails.
     pub fn start_loading(&mut self, source: ScanSource, case: Option<PathBuf>) {
-        let (send, result) = channel();
-        let ctx = self.ctx.clone();
-        let preset = self.options.preset;
-        let pose = self.options.pose;
-        let what = match &case {
-            Some(path) => format!("case {}", path.display()),
-            None => source.label(),
+        let request = Request {
+            source,
+            case,
+            preset: self.options.preset,
+            pose: self.options.pose,
         };
-        std::thread::spawn(move || {
-            let loaded = load(source, case, preset, pose, &ctx);
-            let _ = send.send(loaded);
-            ctx.request_repaint();
-        });
-        self.loading = Some(Loading {
-            what,
-            started: Instant::now(),
-            result,
-        });
+        self.loading = Some(Loading::start(request, &self.ctx));
     }
 
     /// The open session, once loaded.
@@ -155,6 +137,9 @@ impl ViewerApp {
         } else {
             egui::CentralPanel::default().show(ctx, |ui| {
                 ui.heading("endocast");
+                if let Some(loading) = &self.loading {
+                    ui.horizontal(|ui| loading.ui(ui));
+                }
                 ui.label(&self.message);
             });
         }
@@ -165,19 +150,15 @@ impl ViewerApp {
         let Some(loading) = &self.loading else {
             return;
         };
-        match loading.result.try_recv() {
-            Err(TryRecvError::Empty) => {
+        match loading.poll() {
+            None => {
                 self.ctx.request_repaint_after(Duration::from_millis(200));
             }
-            Err(TryRecvError::Disconnected) => {
-                self.message = format!("reading {} failed", loading.what);
-                self.loading = None;
-            }
-            Ok(Err(e)) => {
+            Some(Err(e)) => {
                 self.message = e;
                 self.loading = None;
             }
-            Ok(Ok((session, case))) => {
+            Some(Ok((session, case))) => {
                 self.message = format!("opened {}", loading.what);
                 let path = case.unwrap_or_else(|| default_case_path(&session.scene().source));
                 self.ready = Some(Ready {
@@ -223,12 +204,7 @@ impl ViewerApp {
     fn status_ui(&self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             if let Some(loading) = &self.loading {
-                ui.spinner();
-                ui.label(format!(
-                    "reading {} … {:.1} s",
-                    loading.what,
-                    loading.started.elapsed().as_secs_f64()
-                ));
+                loading.ui(ui);
             }
             if let Some(ready) = &self.ready {
                 ui.label(frame_status(ready));
@@ -344,7 +320,8 @@ fn side_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     ui.label(format!("view {:7.2} {:7.2} {:7.2}", f.x, f.y, f.z));
 }
 
-/// "Frame 12.3 ms · quarter → 41 ms after input · eye … · wall 4.1 mm".
+/// "frame 12.3 ms · quarter · 41 ms after the request · eye (…) mm · wall 4.1 mm" (a still's
+/// frame time is its frames' mean).
 fn frame_status(ready: &Ready) -> String {
     let session = &ready.session;
     let frame = session.worker().with_latest(|f| {
@@ -355,9 +332,14 @@ fn frame_status(ready: &Ready) -> String {
                 Stage::Full => "full".to_owned(),
                 Stage::Still(n) => format!("still ×{n}"),
             };
+            // A still's time is its frames' sum.
+            let frames = match f.stage {
+                Stage::Still(n) => n.max(1) as f64,
+                _ => 1.0,
+            };
             format!(
                 "frame {:.1} ms · {stage} · {:.0} ms after the request",
-                f.render_time.as_secs_f64() * 1e3,
+                f.render_time.as_secs_f64() * 1e3 / frames,
                 f.since_request.as_secs_f64() * 1e3
             )
         })
@@ -403,29 +385,6 @@ pub fn default_case_path(source: &ScanSource) -> PathBuf {
 fn writable(dir: &std::path::Path) -> bool {
     std::fs::metadata(dir).is_ok_and(|m| !m.permissions().readonly())
         && tempfile::tempfile_in(dir).is_ok()
-}
-
-/// Reads the scan (or the case and its scan) and opens a session on it.
-fn load(
-    source: ScanSource,
-    case: Option<PathBuf>,
-    preset: &'static Preset,
-    pose: Option<Pose>,
-    ctx: &egui::Context,
-) -> Result<(Session, Option<PathBuf>), String> {
-    let case_file = match &case {
-        Some(path) => Some(Case::read(path).map_err(|e| e.to_string())?),
-        None => None,
-    };
-    let source = case_file.as_ref().map_or(source, |c| c.scan.clone());
-    let (volume, series) = source.load_with_series()?;
-    let scene = Arc::new(Scene::new(source, volume).with_series(series));
-    let repaint = ctx.clone();
-    let mut session = Session::new(scene, preset, pose, move || repaint.request_repaint());
-    if let (Some(file), Some(path)) = (&case_file, &case) {
-        file.apply(&mut session, path).map_err(|e| e.to_string())?;
-    }
-    Ok((session, case))
 }
 
 /// Opens the window and runs until it is closed.

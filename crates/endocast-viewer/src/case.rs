@@ -1,5 +1,6 @@
 //! Case files as the viewer uses them: the one case format of `endocast_io::case` (scan
-//! reference and fingerprint, controls, camera, key frames, annotations; written atomically),
+//! reference and fingerprint, controls with the transfer function, peel settings and geometry
+//! toggles, camera, key frames, annotations; written atomically),
 //! made from a session and applied to one, and autosaved.
 
 use crate::controller::FlyCamera;
@@ -11,7 +12,8 @@ use endocast_core::presets::Preset;
 use endocast_core::render::Mode;
 use endocast_core::views::slices::Window;
 pub use endocast_io::case::{
-    Case, CaseCamera, CaseControls, CaseError, CaseKeyFrame, FORMAT, VERSION,
+    Case, CaseCamera, CaseControls, CaseError, CaseGeometry, CaseKeyFrame, CasePeel, CaseTransfer,
+    FORMAT, VERSION,
 };
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -54,6 +56,27 @@ fn controls_of(c: &Controls) -> CaseControls {
         speed_mm_s: c.speed_mm_s,
         window_level_hu: c.window.level_hu,
         window_width_hu: c.window.width_hu,
+        tf: Some(CaseTransfer::from(&c.tf)),
+        peel: Some(CasePeel::of(&c.peel)),
+        geometry: Some(geometry_of(c.geometry)),
+    }
+}
+
+fn geometry_of(t: Toggles) -> CaseGeometry {
+    CaseGeometry {
+        grid: t.grid,
+        endoscope: t.endoscope,
+        markers: t.markers,
+        meshes: t.meshes,
+    }
+}
+
+fn toggles(g: CaseGeometry) -> Toggles {
+    Toggles {
+        grid: g.grid,
+        endoscope: g.endoscope,
+        markers: g.markers,
+        meshes: g.meshes,
     }
 }
 
@@ -77,7 +100,17 @@ impl SessionCase for Case {
         let preset = Preset::find(&c.preset).ok_or_else(|| bad("preset", &c.preset))?;
         let window = Window::new(c.window_level_hu, c.window_width_hu)
             .map_err(|e| CaseError::new(path, e))?;
+        // Cases before version 3 keep none of these: the preset's apply.
         let defaults = preset.settings();
+        let tf = match &c.tf {
+            Some(tf) => tf.transfer_function(),
+            None => Ok(defaults.tf),
+        };
+        let peel = match &c.peel {
+            Some(peel) => peel.apply(&defaults.peel),
+            None => Ok(defaults.peel),
+        };
+        let to_case_error = |e| CaseError::new(path, e);
         Ok(Some(Controls {
             preset,
             mode: Mode::from_name(&c.mode).ok_or_else(|| bad("mode", &c.mode))?,
@@ -89,9 +122,9 @@ impl SessionCase for Case {
             collision: c.collision,
             speed_mm_s: c.speed_mm_s,
             window,
-            tf: defaults.tf,
-            peel: defaults.peel,
-            geometry: Toggles::default(),
+            tf: tf.map_err(to_case_error)?,
+            peel: peel.map_err(to_case_error)?,
+            geometry: c.geometry.map(toggles).unwrap_or_default(),
         }))
     }
 

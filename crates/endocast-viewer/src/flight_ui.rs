@@ -124,12 +124,15 @@ impl FlightTools {
         let mut end = None;
         ui.horizontal(|ui| {
             if ui
-                .add_enabled(self.end_mm.is_some(), egui::Button::new("Plan start → end"))
+                .add_enabled(
+                    self.end_mm.is_some(),
+                    egui::Button::new("Plan start to end"),
+                )
                 .clicked()
             {
                 end = self.end_mm.map(PathEnd::Point);
             }
-            if ui.button("Plan → farthest").clicked() {
+            if ui.button("Plan to the farthest").clicked() {
                 end = Some(PathEnd::Farthest);
             }
         });

@@ -10,15 +10,15 @@ pub const ROLL_RAD_S: f64 = 1.2;
 
 /// The keys, for the help text and the README.
 pub const HELP: &[(&str, &str)] = &[
-    ("W / S or ↑ / ↓", "fly forward / back"),
-    ("A / D or ← / →", "slide left / right"),
+    ("W / S or the up / down arrows", "fly forward / back"),
+    ("A / D or the left / right arrows", "slide left / right"),
     ("R / F", "rise / sink"),
     ("Q / E", "roll left / right"),
     ("Shift", "three times faster"),
     ("drag in the view", "look around"),
     (
         "click in the view",
-        "turn toward that point (or mark it, in mark mode)",
+        "turn toward that point (with a marking tool: label, draw, measure)",
     ),
     ("click in a slice", "jump there"),
     ("K", "record a key frame"),
@@ -26,7 +26,7 @@ pub const HELP: &[(&str, &str)] = &[
     ("C", "collision on / off"),
     ("Z", "centre in the lumen (across the view)"),
     ("H", "back to the start"),
-    ("+ / −", "faster / slower"),
+    ("+ / -", "faster / slower"),
 ];
 
 /// What the held keys ask for during `dt_s` seconds at `speed_mm_s`: a move in the camera's

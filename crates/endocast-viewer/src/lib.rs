@@ -49,6 +49,8 @@ pub mod jobs;
 #[cfg(feature = "window")]
 pub mod keys;
 #[cfg(feature = "window")]
+mod loading;
+#[cfg(feature = "window")]
 mod mark_tool;
 #[cfg(feature = "window")]
 mod marks;

@@ -4,6 +4,7 @@ use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::progressive::Stage;
+use endocast_core::Volume;
 use endocast_viewer::scene::{ScanSource, Scene};
 use endocast_viewer::session::Session;
 use endocast_viewer::worker::{Delivered, STILL_FRAMES};
@@ -21,9 +22,9 @@ pub struct TubeTruth {
     pub radius_mm: f64,
 }
 
-/// A session in the middle of the straight tube (colonoscopy preset), looking across it
-/// (toward the wall) at `64 × 64` pixels.
-pub fn tube_session() -> (Session, TubeTruth) {
+/// The straight tube (`SIZE`), a pose in its middle looking across it (toward the wall), and
+/// where its axis is.
+pub fn tube() -> (Volume, Pose, TubeTruth) {
     let options = PhantomOptions {
         size: SIZE,
         ..PhantomOptions::default()
@@ -35,24 +36,31 @@ pub fn tube_session() -> (Session, TubeTruth) {
     let centre_mm = geometry.world_of(mid);
     let axis = (geometry.world_of(points[1]) - geometry.world_of(points[0])).normalize();
     let across = (geometry.world_of(mid + DVec3::X) - centre_mm).normalize();
-    let source = ScanSource::Phantom {
-        name: "straight-tube".into(),
-        size: SIZE,
-    };
-    let scene = Arc::new(Scene::new(source, volume));
     let pose = Pose {
         eye_mm: centre_mm,
         look_at_mm: centre_mm + across,
         up: axis,
     };
-    let preset = Preset::find("colonoscopy").unwrap();
-    let mut session = Session::new(scene, preset, Some(pose), || {});
-    session.set_view_size([64, 64]);
     let truth = TubeTruth {
         centre_mm,
         axis,
         radius_mm: tube.radius_vox,
     };
+    (volume, pose, truth)
+}
+
+/// A session in the middle of the straight tube (colonoscopy preset), looking across it
+/// (toward the wall) at `64 × 64` pixels.
+pub fn tube_session() -> (Session, TubeTruth) {
+    let (volume, pose, truth) = tube();
+    let source = ScanSource::Phantom {
+        name: "straight-tube".into(),
+        size: SIZE,
+    };
+    let scene = Arc::new(Scene::new(source, volume));
+    let preset = Preset::find("colonoscopy").unwrap();
+    let mut session = Session::new(scene, preset, Some(pose), || {});
+    session.set_view_size([64, 64]);
     (session, truth)
 }
 

@@ -1,7 +1,7 @@
 //! A DICOM folder holding several series: the largest opens, the others are listed, and the
 //! one chosen opens instead (real scans: a few slices of two CT series in one folder).
 
-use crate::ui::{options, run_until};
+use crate::harness::{options, run_until};
 use endocast_testdata::shared_data;
 use endocast_viewer::app::ViewerApp;
 use endocast_viewer::scene::ScanSource;

@@ -6,6 +6,8 @@
 mod case;
 mod common;
 mod flight;
+mod harness;
 mod plan_export;
 mod series;
 mod ui;
+mod ui_case;

@@ -1,49 +1,11 @@
 //! The window on a headless egui context: loading, flying with the keys, errors.
 
-use egui::{Event, Key, Modifiers, Pos2, RawInput, Rect, Vec2};
-use endocast_core::presets::Preset;
+use crate::harness::{input, key, options, run_until, Window};
+use egui::Key;
 use endocast_core::render::progressive::Stage;
-use endocast_viewer::app::{ViewerApp, ViewerOptions};
+use endocast_viewer::app::ViewerApp;
 use endocast_viewer::scene::ScanSource;
 use std::time::{Duration, Instant};
-
-pub fn options(source: ScanSource) -> ViewerOptions {
-    ViewerOptions {
-        source,
-        preset: Preset::find("colonoscopy").unwrap(),
-        pose: None,
-        case: None,
-        screenshot: None,
-    }
-}
-
-fn input(events: Vec<Event>) -> RawInput {
-    RawInput {
-        screen_rect: Some(Rect::from_min_size(Pos2::ZERO, Vec2::new(1100.0, 700.0))),
-        events,
-        ..RawInput::default()
-    }
-}
-
-fn key(key: Key, pressed: bool) -> Event {
-    Event::Key {
-        key,
-        physical_key: None,
-        pressed,
-        repeat: false,
-        modifiers: Modifiers::NONE,
-    }
-}
-
-/// Runs UI frames until `done` or the timeout.
-pub fn run_until(ctx: &egui::Context, app: &mut ViewerApp, done: impl Fn(&ViewerApp) -> bool) {
-    let start = Instant::now();
-    while !done(app) {
-        assert!(start.elapsed() < Duration::from_secs(120), "timed out");
-        let _ = ctx.run(input(Vec::new()), |ctx| app.frame_ui(ctx));
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
 
 #[test]
 fn the_window_opens_a_phantom_shows_frames_and_flies_with_the_keys() {
@@ -175,4 +137,27 @@ fn the_slices_and_the_overview_arrive_from_their_threads() {
         assert!(start.elapsed() < Duration::from_secs(120), "only {names:?}");
         std::thread::sleep(Duration::from_millis(10));
     }
+}
+
+#[test]
+fn every_text_of_the_window_has_its_glyphs_in_the_font() {
+    let mut window = Window::open(options(ScanSource::Phantom {
+        name: "straight-tube".into(),
+        size: 32,
+    }));
+    window.run_until(|a| a.session().is_some());
+    window.frame(Vec::new());
+    // The folded parts of the panel too.
+    for header in ["Geometry", "Export the flight", "Keys"] {
+        window.click_text(header);
+    }
+    window.frame(Vec::new());
+    let font = egui::FontId::proportional(14.0);
+    let texts = window.painted_texts();
+    assert!(texts.iter().any(|t| t.contains("slide left")), "{texts:?}");
+    let missing: Vec<_> = texts
+        .iter()
+        .filter(|t| !window.ctx.fonts_mut(|f| f.has_glyphs(&font, t)))
+        .collect();
+    assert!(missing.is_empty(), "drawn without glyphs: {missing:?}");
 }

@@ -5,23 +5,31 @@
 //! the CLI (`endocast annotate`, `render --case`, `fly --case`) read and write the same files.
 //!
 //! ```json
-//! {"format": "endocast-case", "version": 2,
+//! {"format": "endocast-case", "version": 3,
 //!  "scan": {"kind": "file", "path": "head.nrrd"},
 //!  "identity": {"dims": [256, 256, 99], "spacing_mm": [1, 1, 2], "origin_mm": [0, 0, 0],
 //!               "voxel_hash": "3f0c9a61d2b7e845"},
-//!  "controls": {"preset": "sinus", "mode": "iso", "iso_hu": -400, ...},
+//!  "controls": {"preset": "sinus", "mode": "iso", "iso_hu": -400, ...,
+//!               "tf": {"opacity": [[-1024, 0], ..], "color": [[-1024, 0, 0, 0], ..]},
+//!               "peel": {"layer": "2", "falling": false, "keep": 0, "context": true},
+//!               "geometry": {"grid": true, "endoscope": false, "markers": true, "meshes": false}},
 //!  "camera": {"eye": [0, 0, 0], "forward": [0, 0, 1], "up": [0, -1, 0]},
 //!  "key_frames": [],
 //!  "annotations": [{"id": 1, "kind": "measure", "points": [[..], [..]], "distance_mm": 7.9}]}
 //! ```
 //!
-//! `controls` and `camera` are the viewer's and absent from a case the CLI made. Version 1
-//! (the viewer's first cases: no identity, labelled points only) is still read.
+//! `controls` and `camera` are the viewer's and absent from a case the CLI made. Older versions
+//! are still read: version 2 has no transfer function, peel settings or geometry in its
+//! controls (the preset's apply), version 1 (the viewer's first cases) no identity either and
+//! labelled points only.
 
 mod records;
 mod scan;
 
-pub use records::{AnnotationRecord, CaseCamera, CaseControls, CaseKeyFrame};
+pub use records::{
+    peel_layer, AnnotationRecord, CaseCamera, CaseControls, CaseGeometry, CaseKeyFrame, CasePeel,
+    CaseTransfer,
+};
 pub use scan::{IdentityRecord, ScanSource};
 
 use endocast_core::annotate::{Annotations, ScanIdentity};
@@ -30,8 +38,8 @@ use std::path::{Path, PathBuf};
 
 /// The `"format"` value of case files.
 pub const FORMAT: &str = "endocast-case";
-/// The version this code writes (it reads 1 too).
-pub const VERSION: u32 = 2;
+/// The version this code writes (it reads 1 and 2 too).
+pub const VERSION: u32 = 3;
 /// A case file larger than this is refused unread.
 const MAX_BYTES: u64 = 64 << 20;
 

@@ -2,6 +2,7 @@
 //! annotations, each as the JSON holds it.
 
 use endocast_core::annotate::{Annotation, Shape};
+use endocast_core::render::{PeelLayer, PeelSettings, TransferFunction, Unpeeled};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -21,6 +22,125 @@ pub struct CaseControls {
     pub speed_mm_s: f64,
     pub window_level_hu: f64,
     pub window_width_hu: f64,
+    /// The transfer function (version 3; absent: the preset's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tf: Option<CaseTransfer>,
+    /// How `peel` mode peels (version 3; absent: the preset's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peel: Option<CasePeel>,
+    /// The geometry shown with the scan (version 3; absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry: Option<CaseGeometry>,
+}
+
+/// A transfer function's points as transfer-function files hold them (see
+/// [`crate::transfer_json`]): `[value, opacity per mm]` and `[value, r, g, b]`, values in
+/// physical units, the rest 0–1.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct CaseTransfer {
+    pub opacity: Vec<[f64; 2]>,
+    pub color: Vec<[f64; 4]>,
+}
+
+impl From<&TransferFunction> for CaseTransfer {
+    fn from(tf: &TransferFunction) -> Self {
+        let opacity = tf.opacity_points().iter();
+        let color = tf.color_points().iter();
+        Self {
+            opacity: opacity.map(|(v, a)| [*v, f64::from(*a)]).collect(),
+            color: color
+                .map(|(v, [r, g, b])| [*v, f64::from(*r), f64::from(*g), f64::from(*b)])
+                .collect(),
+        }
+    }
+}
+
+impl CaseTransfer {
+    /// The transfer function, or why these points make none.
+    pub fn transfer_function(&self) -> Result<TransferFunction, String> {
+        let opacity: Vec<(f64, f32)> = self.opacity.iter().map(|[v, a]| (*v, *a as f32)).collect();
+        let color: Vec<(f64, [f32; 3])> = self
+            .color
+            .iter()
+            .map(|[v, r, g, b]| (*v, [*r as f32, *g as f32, *b as f32]))
+            .collect();
+        TransferFunction::from_points(&opacity, &color)
+            .map_err(|e| format!("transfer function: {e}"))
+    }
+}
+
+/// The peel settings of `peel` mode, as `endocast render --peel …` takes them: `layer` is
+/// `"1"`, `"2"`, … or `"last"`; `context`: rays without the peel show the unpeeled volume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct CasePeel {
+    pub layer: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threshold_hu: Option<f64>,
+    pub falling: bool,
+    pub keep: f32,
+    pub context: bool,
+}
+
+impl CasePeel {
+    /// The record of `peel` (its transfer function behind the peel is not recorded).
+    pub fn of(peel: &PeelSettings) -> Self {
+        Self {
+            layer: match peel.layer {
+                PeelLayer::Nth(n) => n.to_string(),
+                PeelLayer::Last => "last".into(),
+            },
+            threshold_hu: peel.threshold_hu,
+            falling: peel.falling,
+            keep: peel.keep,
+            context: peel.unpeeled == Unpeeled::Context,
+        }
+    }
+
+    /// `peel` with these settings (its transfer function behind the peel kept), or what is
+    /// wrong with them.
+    pub fn apply(&self, peel: &PeelSettings) -> Result<PeelSettings, String> {
+        if !(0.0..=1.0).contains(&self.keep) {
+            return Err(format!("peel keep {} is not between 0 and 1", self.keep));
+        }
+        let mut settings = peel.clone();
+        settings.layer = peel_layer(&self.layer)?;
+        settings.threshold_hu = self.threshold_hu;
+        settings.falling = self.falling;
+        settings.keep = self.keep;
+        settings.unpeeled = if self.context {
+            Unpeeled::Context
+        } else {
+            Unpeeled::Discard
+        };
+        Ok(settings)
+    }
+}
+
+/// A peel layer by name: `N` (1, 2, 3 …) or `last`.
+pub fn peel_layer(text: &str) -> Result<PeelLayer, String> {
+    let text = text.trim();
+    if text.eq_ignore_ascii_case("last") {
+        return Ok(PeelLayer::Last);
+    }
+    match text.parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(PeelLayer::Nth(n)),
+        _ => Err(format!("expected 1, 2, 3 … or last, found {text:?}")),
+    }
+}
+
+/// Which geometry the viewer shows with the scan (the mesh files themselves are not recorded).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct CaseGeometry {
+    pub grid: bool,
+    pub endoscope: bool,
+    pub markers: bool,
+    pub meshes: bool,
 }
 
 /// A camera: eye (world mm, LPS), view direction and image up.

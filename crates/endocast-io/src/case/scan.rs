@@ -1,6 +1,6 @@
 //! The scan a case is about: where it comes from, and its fingerprint.
 
-use crate::SeriesSummary;
+use crate::{Progress, SeriesSummary};
 use endocast_core::annotate::ScanIdentity;
 use endocast_core::phantom::{Phantom, PhantomOptions};
 use endocast_core::Volume;
@@ -34,12 +34,16 @@ pub enum ScanSource {
 impl ScanSource {
     /// Reads or generates the volume; the error is one line naming the file and the problem.
     pub fn load(&self) -> Result<Volume, String> {
-        self.load_with_series().map(|(volume, _)| volume)
+        self.load_with_series(&Progress::default())
+            .map(|(volume, _)| volume)
     }
 
     /// Reads or generates the volume, with the series a DICOM folder holds (empty for other
-    /// sources) so the user can choose another.
-    pub fn load_with_series(&self) -> Result<(Volume, Vec<SeriesSummary>), String> {
+    /// sources) so the user can choose another; the reader counts how far it is in `progress`.
+    pub fn load_with_series(
+        &self,
+        progress: &Progress,
+    ) -> Result<(Volume, Vec<SeriesSummary>), String> {
         match self {
             Self::File {
                 path,
@@ -49,6 +53,7 @@ impl ScanSource {
                 let mut options = crate::OpenOptions::default();
                 options.series.clone_from(series);
                 options.orientation.clone_from(orientation);
+                options.progress = progress.clone();
                 crate::open(path, &options)
                     .map(|loaded| (loaded.volume, loaded.source.series_found))
                     .map_err(|e| format!("cannot read the scan: {e}"))

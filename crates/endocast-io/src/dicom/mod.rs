@@ -55,6 +55,7 @@ mod values;
 
 use crate::error::{ReadError, Result};
 use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
+use crate::progress::{Progress, ReadStep};
 use endocast_core::{Modality, Volume};
 use pixels::{FrameStats, SampleMap};
 use rayon::prelude::*;
@@ -72,7 +73,8 @@ use std::path::Path;
 pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let mut warnings = Vec::new();
     let files = scan::list_files(path, &options.limits)?;
-    let scanned = scan::scan_all(&files, &options.limits);
+    options.progress.begin(ReadStep::Headers, files.len());
+    let scanned = scan::scan_all(&files, &options.limits, &options.progress);
     let images = series::images(path, &files, scanned, &mut warnings)?;
     let (chosen, series_found) = series::choose(path, images, options.series.as_deref())?;
     let stack = Stack::build(path, &chosen, &mut warnings)?;
@@ -96,7 +98,16 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         .limits
         .check_dims(path, &[dims[0] as u64, dims[1] as u64, count as u64])?;
     let mut voxels = vec![0u16; total];
-    let stats = decode_all(&chosen, &ts_names, &stack, &mut voxels, slice_len, &map)?;
+    let progress = &options.progress;
+    let stats = decode_all(
+        &chosen,
+        &ts_names,
+        &stack,
+        &mut voxels,
+        slice_len,
+        &map,
+        progress,
+    )?;
     let rescales: Vec<_> = stack.slices.iter().map(|s| s.rescale).collect();
     let value_map = values::unify(
         path,
@@ -132,8 +143,8 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     })
 }
 
-/// Decodes every slice of `stack` into its slot of `voxels`, one file per task, and returns
-/// the statistics of each slice in stack order.
+/// Decodes every slice of `stack` into its slot of `voxels`, one file per task, counting the
+/// files in `progress`, and returns the statistics of each slice in stack order.
 fn decode_all(
     files: &[ImageFile],
     ts_names: &[&str],
@@ -141,6 +152,7 @@ fn decode_all(
     voxels: &mut [u16],
     slice_len: usize,
     map: &SampleMap,
+    progress: &Progress,
 ) -> Result<Vec<FrameStats>> {
     // Hand each file the slots of its frames, so that a multi-frame file is opened once.
     let mut per_file: Vec<Vec<(usize, u32, &mut [u16])>> =
@@ -148,6 +160,10 @@ fn decode_all(
     for (k, (slot, slice)) in voxels.chunks_mut(slice_len).zip(&stack.slices).enumerate() {
         per_file[slice.file].push((k, slice.frame, slot));
     }
+    progress.begin(
+        ReadStep::Pixels,
+        per_file.iter().filter(|f| !f.is_empty()).count(),
+    );
     let decoded = per_file
         .into_par_iter()
         .enumerate()
@@ -158,6 +174,7 @@ fn decode_all(
                 .map(|(k, frame, slot)| (k, (frame, slot)))
                 .unzip();
             let stats = pixels::decode_file(&files[file].path, ts_names[file], slots, map)?;
+            progress.advance();
             Ok(ks.into_iter().zip(stats).collect::<Vec<_>>())
         })
         .collect::<Result<Vec<_>>>()?;

@@ -5,6 +5,7 @@ use super::lengths;
 use crate::error::{ReadError, Result};
 use crate::guard;
 use crate::limits::Limits;
+use crate::progress::Progress;
 use crate::samples::Rescale;
 use dicom_core::Tag;
 use dicom_dictionary_std::tags;
@@ -132,8 +133,15 @@ pub(super) enum Scanned {
 }
 
 /// Reads the headers of all `files` in parallel, in the order given.
-pub(super) fn scan_all(files: &[PathBuf], limits: &Limits) -> Vec<Scanned> {
-    files.par_iter().map(|path| scan(path, limits)).collect()
+pub(super) fn scan_all(files: &[PathBuf], limits: &Limits, progress: &Progress) -> Vec<Scanned> {
+    files
+        .par_iter()
+        .map(|path| {
+            let scanned = scan(path, limits);
+            progress.advance();
+            scanned
+        })
+        .collect()
 }
 
 /// Reads the header of one file, stopping before the pixel data.
