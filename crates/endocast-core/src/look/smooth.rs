@@ -34,39 +34,52 @@ pub fn smooth(gbuffer: &GBuffer, radius: usize) -> GBuffer {
         return gbuffer.clone();
     }
     let (w, h) = (gbuffer.width, gbuffer.height);
-    let texels: Vec<Texel> = (0..gbuffer.len()).map(|i| texel(gbuffer, i)).collect();
     let kernel: Vec<f32> = (0..=radius)
         .map(|k| {
             let sigma = 0.5 * radius as f32 + 0.5;
             (-0.5 * (k as f32 / sigma).powi(2)).exp()
         })
         .collect();
+    // Rows, each gathered into texels once (a row's worth stays in the cache).
     let mut across = vec![[f32::NAN; CHANNELS]; w * h];
     across.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        let texels: Vec<Texel> = (0..w).map(|x| texel(gbuffer, x + w * y)).collect();
         for (x, out) in row.iter_mut().enumerate() {
-            *out = filtered(&texels, &kernel, x + w * y, |k| {
-                let x = usize::try_from(x as isize + k).ok().filter(|&x| x < w)?;
-                Some(x + w * y)
+            *out = filtered(&texels, &kernel, x, |k| {
+                usize::try_from(x as isize + k).ok().filter(|&x| x < w)
             });
         }
     });
-    let mut down = vec![[f32::NAN; CHANNELS]; w * h];
-    down.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.iter_mut().enumerate() {
-            *out = filtered(&across, &kernel, x + w * y, |k| {
-                let y = usize::try_from(y as isize + k).ok().filter(|&y| y < h)?;
-                Some(x + w * y)
-            });
-        }
-    });
-    let mut out = gbuffer.clone();
-    for (i, t) in down.iter().enumerate() {
-        out.depth_mm[i] = t[0];
-        out.hit_mm[i] = [t[1], t[2], t[3]];
-        let n = glam::Vec3::new(t[4], t[5], t[6]).normalize_or_zero();
-        out.normal[i] = n.to_array();
-        out.secretion_mm[i] = t[7];
-    }
+    // Columns, written straight into the smoothed buffer's layers.
+    let n = w * h;
+    let mut out = GBuffer {
+        width: w,
+        height: h,
+        depth_mm: vec![0.0; n],
+        hit_mm: vec![[0.0; 3]; n],
+        normal: vec![[0.0; 3]; n],
+        secretion_mm: vec![0.0; n],
+        stats: gbuffer.stats,
+    };
+    out.depth_mm
+        .par_chunks_mut(w)
+        .zip(out.hit_mm.par_chunks_mut(w))
+        .zip(out.normal.par_chunks_mut(w))
+        .zip(out.secretion_mm.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (((depth, hit), normal), secretion))| {
+            for x in 0..w {
+                let t = filtered(&across, &kernel, x + w * y, |k| {
+                    let y = usize::try_from(y as isize + k).ok().filter(|&y| y < h)?;
+                    Some(x + w * y)
+                });
+                depth[x] = t[0];
+                hit[x] = [t[1], t[2], t[3]];
+                let n = glam::Vec3::new(t[4], t[5], t[6]).normalize_or_zero();
+                normal[x] = n.to_array();
+                secretion[x] = t[7];
+            }
+        });
     out
 }
 
