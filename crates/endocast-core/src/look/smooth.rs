@@ -23,8 +23,21 @@ type Texel = [f32; CHANNELS];
 /// The weight of a neighbour at depth `d` for a centre at depth `centre` (both finite).
 #[inline]
 pub fn depth_weight(d: f32, centre: f32) -> f32 {
-    let r = (d - centre).abs() / (DEPTH_EDGE * centre.abs()).max(1e-3);
-    (2.0 - 2.0 * r).clamp(0.0, 1.0)
+    weight_by_distance(d - centre, inverse_edge(centre))
+}
+
+/// One over the depth difference at which a neighbour of a centre at depth `centre` loses all
+/// weight (computed once per centre).
+#[inline]
+fn inverse_edge(centre: f32) -> f32 {
+    1.0 / (DEPTH_EDGE * centre.abs()).max(1e-3)
+}
+
+/// The weight of a neighbour `difference` deeper than the centre, `inverse` its
+/// [`inverse_edge`].
+#[inline]
+fn weight_by_distance(difference: f32, inverse: f32) -> f32 {
+    (2.0 - 2.0 * difference.abs() * inverse).clamp(0.0, 1.0)
 }
 
 /// `gbuffer` smoothed over a window of `2 · radius + 1` pixels each way (0: unchanged). Pixels
@@ -113,6 +126,7 @@ fn filtered(
         return c;
     }
     let r = kernel.len() as isize - 1;
+    let inverse = inverse_edge(c[0]);
     let (mut sum, mut total) = ([0.0; CHANNELS], 0.0);
     for k in -r..=r {
         let Some(j) = neighbour(k) else { continue };
@@ -120,7 +134,7 @@ fn filtered(
         if t[0].is_nan() {
             continue;
         }
-        let weight = kernel[k.unsigned_abs()] * depth_weight(t[0], c[0]);
+        let weight = kernel[k.unsigned_abs()] * weight_by_distance(t[0] - c[0], inverse);
         if weight > 0.0 {
             for (s, v) in sum.iter_mut().zip(t) {
                 *s += weight * v;
