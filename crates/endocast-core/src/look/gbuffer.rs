@@ -159,29 +159,35 @@ impl RayPass {
     fn continue_to_tissue(&self, camera: &Camera, frame: &mut Frame) -> Vec<f32> {
         let renderer = self.prepared.renderer();
         let on = Continuation::new(renderer, &self.settings);
-        let width = frame.width;
-        let hits: Vec<_> = frame
-            .depth_mm
-            .par_iter()
-            .enumerate()
-            .with_min_len(64)
-            .map(|(i, &t)| {
-                let ray = camera.pixel_ray(i % width, i / width)?;
-                on.tissue_after(ray.origin, ray.dir, t)
-            })
-            .collect();
-        let n = frame.len();
+        let (w, n) = (frame.width, frame.len());
         (frame.hit_mm, frame.normal) = (vec![[f32::NAN; 3]; n], vec![[f32::NAN; 3]; n]);
         let mut secretion = vec![0.0; n];
-        for (i, hit) in hits.into_iter().enumerate() {
-            frame.depth_mm[i] = f32::NAN;
-            if let Some(hit) = hit {
-                frame.depth_mm[i] = hit.depth_mm;
-                frame.hit_mm[i] = hit.hit_mm;
-                frame.normal[i] = hit.normal;
-                secretion[i] = hit.secretion_mm;
-            }
-        }
+        frame
+            .depth_mm
+            .par_chunks_mut(w)
+            .zip(frame.hit_mm.par_chunks_mut(w))
+            .zip(frame.normal.par_chunks_mut(w))
+            .zip(secretion.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(y, (((depth, hit), normal), secretion))| {
+                for x0 in (0..w).step_by(8) {
+                    let lanes = x0..(x0 + 8).min(w);
+                    let rays: [_; 8] = std::array::from_fn(|k| {
+                        let x = Some(x0 + k).filter(|x| *x < w)?;
+                        let ray = camera.pixel_ray(x, y)?;
+                        Some((ray.origin, ray.dir, depth[x]))
+                    });
+                    for (x, found) in lanes.zip(on.tissue_after8(&rays)) {
+                        depth[x] = f32::NAN;
+                        if let Some(found) = found {
+                            depth[x] = found.depth_mm;
+                            hit[x] = found.hit_mm;
+                            normal[x] = found.normal;
+                            secretion[x] = found.secretion_mm;
+                        }
+                    }
+                }
+            });
         frame.stats.iso_hits = frame.depth_mm.iter().filter(|d| !d.is_nan()).count() as u64;
         secretion
     }

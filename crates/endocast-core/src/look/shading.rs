@@ -111,7 +111,11 @@ impl Shading {
     /// How far `secretion_mm` of secretion veils the tissue, 0–1: `1 − exp(−s / fog_mm)`,
     /// rising with the thickness.
     pub fn fog(&self, secretion_mm: f32) -> f32 {
-        1.0 - (-secretion_mm.max(0.0) / self.fog_mm).exp()
+        if secretion_mm > 0.0 {
+            1.0 - (-secretion_mm / self.fog_mm).exp()
+        } else {
+            0.0
+        }
     }
 
     /// The tip's light at `depth_mm`, 0–1.
@@ -141,7 +145,12 @@ impl Shading {
         // The reflected light's alignment with the view, for a light at the eye: 2 cos² − 1.
         let mirror = (2.0 * cos * cos - 1.0).max(0.0);
         let gloss = 1.3 - 0.6 * texel;
-        let highlight = wet * self.specular * gloss * mirror.powf(self.shininess);
+        let strength = wet * self.specular * gloss;
+        let highlight = if strength > 0.0 && mirror > 0.0 {
+            strength * mirror.powf(self.shininess)
+        } else {
+            0.0
+        };
         (tissue.lerp(mucus, fog) + Vec3::splat(highlight)) * self.falloff(depth_mm)
     }
 }

@@ -23,8 +23,21 @@ type Texel = [f32; CHANNELS];
 /// The weight of a neighbour at depth `d` for a centre at depth `centre` (both finite).
 #[inline]
 pub fn depth_weight(d: f32, centre: f32) -> f32 {
-    let r = (d - centre).abs() / (DEPTH_EDGE * centre.abs()).max(1e-3);
-    (2.0 - 2.0 * r).clamp(0.0, 1.0)
+    weight_by_distance(d - centre, inverse_edge(centre))
+}
+
+/// One over the depth difference at which a neighbour of a centre at depth `centre` loses all
+/// weight (computed once per centre).
+#[inline]
+fn inverse_edge(centre: f32) -> f32 {
+    1.0 / (DEPTH_EDGE * centre.abs()).max(1e-3)
+}
+
+/// The weight of a neighbour `difference` deeper than the centre, `inverse` its
+/// [`inverse_edge`].
+#[inline]
+fn weight_by_distance(difference: f32, inverse: f32) -> f32 {
+    (2.0 - 2.0 * difference.abs() * inverse).clamp(0.0, 1.0)
 }
 
 /// `gbuffer` smoothed over a window of `2 · radius + 1` pixels each way (0: unchanged). Pixels
@@ -34,39 +47,52 @@ pub fn smooth(gbuffer: &GBuffer, radius: usize) -> GBuffer {
         return gbuffer.clone();
     }
     let (w, h) = (gbuffer.width, gbuffer.height);
-    let texels: Vec<Texel> = (0..gbuffer.len()).map(|i| texel(gbuffer, i)).collect();
     let kernel: Vec<f32> = (0..=radius)
         .map(|k| {
             let sigma = 0.5 * radius as f32 + 0.5;
             (-0.5 * (k as f32 / sigma).powi(2)).exp()
         })
         .collect();
+    // Rows, each gathered into texels once (a row's worth stays in the cache).
     let mut across = vec![[f32::NAN; CHANNELS]; w * h];
     across.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        let texels: Vec<Texel> = (0..w).map(|x| texel(gbuffer, x + w * y)).collect();
         for (x, out) in row.iter_mut().enumerate() {
-            *out = filtered(&texels, &kernel, x + w * y, |k| {
-                let x = usize::try_from(x as isize + k).ok().filter(|&x| x < w)?;
-                Some(x + w * y)
+            *out = filtered(&texels, &kernel, x, |k| {
+                usize::try_from(x as isize + k).ok().filter(|&x| x < w)
             });
         }
     });
-    let mut down = vec![[f32::NAN; CHANNELS]; w * h];
-    down.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.iter_mut().enumerate() {
-            *out = filtered(&across, &kernel, x + w * y, |k| {
-                let y = usize::try_from(y as isize + k).ok().filter(|&y| y < h)?;
-                Some(x + w * y)
-            });
-        }
-    });
-    let mut out = gbuffer.clone();
-    for (i, t) in down.iter().enumerate() {
-        out.depth_mm[i] = t[0];
-        out.hit_mm[i] = [t[1], t[2], t[3]];
-        let n = glam::Vec3::new(t[4], t[5], t[6]).normalize_or_zero();
-        out.normal[i] = n.to_array();
-        out.secretion_mm[i] = t[7];
-    }
+    // Columns, written straight into the smoothed buffer's layers.
+    let n = w * h;
+    let mut out = GBuffer {
+        width: w,
+        height: h,
+        depth_mm: vec![0.0; n],
+        hit_mm: vec![[0.0; 3]; n],
+        normal: vec![[0.0; 3]; n],
+        secretion_mm: vec![0.0; n],
+        stats: gbuffer.stats,
+    };
+    out.depth_mm
+        .par_chunks_mut(w)
+        .zip(out.hit_mm.par_chunks_mut(w))
+        .zip(out.normal.par_chunks_mut(w))
+        .zip(out.secretion_mm.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (((depth, hit), normal), secretion))| {
+            for x in 0..w {
+                let t = filtered(&across, &kernel, x + w * y, |k| {
+                    let y = usize::try_from(y as isize + k).ok().filter(|&y| y < h)?;
+                    Some(x + w * y)
+                });
+                depth[x] = t[0];
+                hit[x] = [t[1], t[2], t[3]];
+                let n = glam::Vec3::new(t[4], t[5], t[6]).normalize_or_zero();
+                normal[x] = n.to_array();
+                secretion[x] = t[7];
+            }
+        });
     out
 }
 
@@ -100,6 +126,7 @@ fn filtered(
         return c;
     }
     let r = kernel.len() as isize - 1;
+    let inverse = inverse_edge(c[0]);
     let (mut sum, mut total) = ([0.0; CHANNELS], 0.0);
     for k in -r..=r {
         let Some(j) = neighbour(k) else { continue };
@@ -107,7 +134,7 @@ fn filtered(
         if t[0].is_nan() {
             continue;
         }
-        let weight = kernel[k.unsigned_abs()] * depth_weight(t[0], c[0]);
+        let weight = kernel[k.unsigned_abs()] * weight_by_distance(t[0] - c[0], inverse);
         if weight > 0.0 {
             for (s, v) in sum.iter_mut().zip(t) {
                 *s += weight * v;

@@ -98,13 +98,8 @@ impl Texture {
     #[inline]
     pub fn sample(&self, u: f32, v: f32) -> f32 {
         let (w, h) = (self.width, self.height);
-        let x = (u - u.floor()) * w as f32 - 0.5;
-        let y = (v - v.floor()) * h as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let wrap = |i: f32, n: usize| (i as isize).rem_euclid(n as isize) as usize;
-        let (x0, y0) = (wrap(x0, w), wrap(y0, h));
-        let (x1, y1) = ((x0 + 1) % w, (y0 + 1) % h);
+        let (x0, x1, fx) = texel_pair(u, w);
+        let (y0, y1, fy) = texel_pair(v, h);
         let t = |x: usize, y: usize| self.texels[x + w * y];
         let top = t(x0, y0) + (t(x1, y0) - t(x0, y0)) * fx;
         let bottom = t(x0, y1) + (t(x1, y1) - t(x0, y1)) * fx;
@@ -132,6 +127,41 @@ impl Texture {
             value += w.z * self.sample(p.x, p.y);
         }
         value / sum
+    }
+}
+
+/// The two texels either side of tile coordinate `u` on an edge of `n` texels (wrapping) and the
+/// weight of the second: the bilinear filter's footprint along one axis.
+#[inline(always)]
+fn texel_pair(u: f32, n: usize) -> (usize, usize, f32) {
+    // Texel centres lie at (i + 0.5) / n: x in [−0.5, n − 0.5).
+    let x = (u - floor(u)) * n as f32 - 0.5;
+    let x0 = floor(x);
+    let fx = x - x0;
+    // x0 is −1 … n − 1 (NaN gives 0); no division wraps it.
+    let i = x0 as isize;
+    let i0 = if i < 0 {
+        n - 1
+    } else {
+        (i as usize).min(n - 1)
+    };
+    let i1 = if i0 + 1 == n { 0 } else { i0 + 1 };
+    (i0, i1, fx)
+}
+
+/// `x.floor()` without a call into the maths library (the baseline x86-64 target has no
+/// rounding instruction): truncation, one down for negative non-integers; exact for every
+/// `f32` (those of magnitude 2²³ and more are integers already).
+#[inline(always)]
+fn floor(x: f32) -> f32 {
+    if x.is_nan() || x.abs() >= 8_388_608.0 {
+        return x;
+    }
+    let t = x as i32 as f32;
+    if t > x {
+        t - 1.0
+    } else {
+        t
     }
 }
 
@@ -203,6 +233,33 @@ mod tests {
         assert!(Texture::built_in("marble").is_none());
         let grid = Texture::built_in("grid").unwrap();
         assert!(grid.sample(1.0 / 256.0, 0.5) < grid.sample(16.0 / 256.0, 16.0 / 256.0));
+    }
+
+    #[test]
+    fn floor_and_wrapping_match_the_library() {
+        for x in [
+            -2.5f32,
+            -1.0,
+            -0.3,
+            -0.0,
+            0.0,
+            0.7,
+            3.0,
+            1e9,
+            -1e9,
+            8_388_607.5,
+        ] {
+            assert_eq!(floor(x), x.floor(), "{x}");
+        }
+        assert!(floor(f32::NAN).is_nan());
+        let t = Texture::from_luma(3, 1, vec![0.0, 0.5, 1.0]).unwrap();
+        // Between the last texel and the first (wrapped), and at a texel's centre.
+        for u in [0.0, 3.0, -1.0] {
+            assert!((t.sample(u, 0.0) - 0.5).abs() < 1e-5, "{u}");
+        }
+        assert_eq!(t.sample(0.5, 0.0), 0.5);
+        assert_eq!(t.sample(-4.5, 0.0), 0.5);
+        assert!((t.sample(1.0 / 3.0, 0.0) - 0.25).abs() < 1e-5);
     }
 
     #[test]
