@@ -6,7 +6,9 @@
 //! of a small iso render from it hit the wall at depths that organ allows. Each scan is loaded
 //! once.
 
-use endocast_core::navigate::{default_view, DefaultView, Lumen, LumenChoice};
+use endocast_core::navigate::{
+    default_view, find_aorta, DefaultView, Lumen, LumenChoice, LumenSide,
+};
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::{Camera, Mode, RenderSettings, Renderer};
@@ -208,5 +210,36 @@ fn sinus_on_cthead_starts_in_the_nasal_cavity_not_the_mastoid_cells() {
     assert!(
         (0..2).all(|a| lo[a] > 0 && hi[a] + 1 < dims[a]),
         "{lo:?} {hi:?}"
+    );
+}
+
+#[test]
+fn angioscopy_on_the_stent_cta_follows_the_stented_aorta_down_to_the_bifurcation() {
+    let Some(stent) = load("aorta-stent-cta/stent.nrrd") else {
+        return;
+    };
+    let s = start(stent, "angioscopy");
+    assert!(s.what.starts_with("aorta"), "{}", s.what);
+    assert_walled("angioscopy (stent)", &s, (5.0, 120.0));
+    // Measured on the slices (1 mm voxels assumed, world = voxel index; k grows upwards): the
+    // aorta's section centre at (73, 49) in slice 130, (74, 53) in 150, (68, 69) in 200,
+    // (56, 95) at the top (255), oblique and ringed by the stent's struts; it divides into the
+    // iliac arteries at k ≈ 88.
+    for v in [[73, 49, 130], [74, 53, 150], [68, 69, 200]] {
+        assert!(s.lumen.contains(v), "{v:?} not in the aorta");
+    }
+    let eye = s.pose.eye_mm;
+    assert!(eye.z > 200.0, "{eye}: not near the top");
+    assert!(forward(&s.pose).z < -0.6, "{:?}", s.pose);
+    let end = s.end_mm.unwrap();
+    assert!(
+        (75.0..110.0).contains(&end.z),
+        "{end}: not near the bifurcation"
+    );
+    let aorta = find_aorta(stent, 130.0, LumenSide::Above).unwrap();
+    assert!(
+        (8.0..=15.0).contains(&aorta.radius_mm),
+        "radius {} mm",
+        aorta.radius_mm
     );
 }
