@@ -243,3 +243,39 @@ fn angioscopy_on_the_stent_cta_follows_the_stented_aorta_down_to_the_bifurcation
         aorta.radius_mm
     );
 }
+
+#[test]
+fn colonoscopy_on_the_abdomen_starts_in_colon_gas_not_the_lung_nor_the_table() {
+    let Some(abdomen) = load("abdomen-ct-pancreas-dicom") else {
+        return;
+    };
+    let s = start(abdomen, "colonoscopy");
+    assert!(s.what.starts_with("colon"), "{}", s.what);
+    assert_walled("colonoscopy", &s, (2.0, 80.0));
+    let to_voxel = |p: DVec3| {
+        let v = abdomen
+            .geometry()
+            .voxel_from_world()
+            .transform_point3(p)
+            .round();
+        [v.x as usize, v.y as usize, v.z as usize]
+    };
+    // Gas (below −900 HU), not aerated lung (−820 to −900).
+    let [i, j, k] = to_voxel(s.pose.eye_mm);
+    let value = abdomen.physical(i, j, k).unwrap();
+    assert!(value < -900.0, "{value} HU at the eye");
+    // Measured on the slices: the gas-filled right colon (ascending colon to the hepatic
+    // flexure) lies at x −130…−60, y 0…70 mm, z 240…320 mm, below the liver; the lungs end
+    // above it. A hollow in the scanner's table (x −150, y 231, z 461; 47.6 ml), which the
+    // preset took before, lies outside the body.
+    let eye = s.pose.eye_mm;
+    assert!(
+        (-140.0..=-50.0).contains(&eye.x)
+            && (-10.0..=80.0).contains(&eye.y)
+            && (240.0..=320.0).contains(&eye.z),
+        "{eye}: not in the right colon"
+    );
+    assert!(!s
+        .lumen
+        .contains(to_voxel(DVec3::new(-152.54, 231.18, 460.91))));
+}
