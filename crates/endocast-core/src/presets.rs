@@ -113,6 +113,10 @@ pub enum Structure {
     /// The colon: the largest gas component inside the body, not the lung (see
     /// [`crate::navigate::find_colon`]).
     Colon,
+    /// The nasal cavity: the largest air hole of the head's axial slices that crosses its
+    /// mid-sagittal plane, cut off from the outside air at the nostrils (see
+    /// [`crate::navigate::find_nasal_cavity`]).
+    NasalCavity,
 }
 
 /// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
@@ -297,7 +301,7 @@ pub const ALL: &[Preset] = &[
             threshold: -500.0,
             side: LumenSide::Below,
             tissue: "air",
-            structure: Structure::Largest,
+            structure: Structure::NasalCavity,
         }),
         // The bone window: air black, thin sinus walls distinct from soft tissue.
         window: Window {

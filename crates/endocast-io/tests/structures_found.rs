@@ -6,7 +6,9 @@
 //! of a small iso render from it hit the wall at depths that organ allows. Each scan is loaded
 //! once.
 
-use endocast_core::navigate::{default_view, DefaultView, Lumen, LumenChoice};
+use endocast_core::navigate::{
+    default_view, find_aorta, DefaultView, Lumen, LumenChoice, LumenSide,
+};
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::{Camera, Mode, RenderSettings, Renderer};
@@ -15,16 +17,25 @@ use endocast_core::Volume;
 use endocast_io::OpenOptions;
 use endocast_testdata::shared_data;
 use glam::DVec3;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
-/// The scan `name` under shared/data, or `None` (skipping, with a message) when absent.
-fn load(name: &str) -> Option<Volume> {
-    let path = shared_data(name)?;
-    Some(
-        endocast_io::open(&path, &OpenOptions::default())
-            .unwrap()
-            .volume,
-    )
+/// The scan `name` under shared/data, or `None` (skipping, with a message) when absent; each
+/// scan is read once for the whole binary (the abdomen serves two tests).
+fn load(name: &'static str) -> Option<&'static Volume> {
+    static SCANS: Mutex<Vec<(&str, Option<&Volume>)>> = Mutex::new(Vec::new());
+    let mut scans = SCANS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(&(_, volume)) = scans.iter().find(|(n, _)| *n == name) {
+        return volume;
+    }
+    let volume = shared_data(name).map(|path| {
+        &*Box::leak(Box::new(
+            endocast_io::open(&path, &OpenOptions::default())
+                .unwrap()
+                .volume,
+        ))
+    });
+    scans.push((name, volume));
+    volume
 }
 
 /// What a preset found with no point given.
@@ -126,7 +137,7 @@ fn angioscopy_on_the_abdomen_follows_the_aorta_from_the_top() {
     let Some(abdomen) = load("abdomen-ct-pancreas-dicom") else {
         return;
     };
-    let s = start(&abdomen, "angioscopy");
+    let s = start(abdomen, "angioscopy");
     assert!(s.what.starts_with("aorta"), "{}", s.what);
     assert_walled("angioscopy", &s, (5.0, 120.0));
     // Measured: the descending aorta runs down near x = 28, y = 110–135 mm from the top slice
@@ -157,7 +168,7 @@ fn bronchoscopy_on_the_chest_starts_in_the_trachea() {
     let Some(chest) = load("chest-ct-airways-dicom") else {
         return;
     };
-    let s = start(&chest, "bronchoscopy");
+    let s = start(chest, "bronchoscopy");
     assert!(s.what.starts_with("airway tree"), "{}", s.what);
     assert_walled("bronchoscopy", &s, (3.0, 80.0));
     // The trachea near the carina: bench/scenes.json's trachea lies at x −10, y 66 (z 51).
@@ -166,4 +177,105 @@ fn bronchoscopy_on_the_chest_starts_in_the_trachea() {
         (eye.truncate() - glam::DVec2::new(-12.0, 68.0)).length() < 20.0,
         "{eye}"
     );
+}
+
+#[test]
+fn sinus_on_cthead_starts_in_the_nasal_cavity_not_the_mastoid_cells() {
+    let Some(head) = load("head-ct-stanford-cthead/CThead.nhdr") else {
+        return;
+    };
+    let s = start(head, "sinus");
+    assert!(s.what.starts_with("nasal cavity"), "{}", s.what);
+    // The passages are a few millimetres wide: the wall is near.
+    assert_walled("sinus", &s, (1.0, 40.0));
+    // Measured on the slices (1 × 1 × 2 mm voxels, no orientation: read as LPS, k = 0 the
+    // vertex): the nasal cavity from the nostrils (j ≈ 20, k ≈ 57) back to the choanae
+    // (j ≈ 100), between the hard palate (k ≈ 68) and the cribriform plate (k ≈ 38), the
+    // septum at i ≈ 115; the sphenoid sinus behind it (j ≥ 95), the mastoid cells at the sides
+    // (i < 70, i > 185). World mm: x = i, y = j, z = 2k.
+    let eye = s.pose.eye_mm;
+    assert!(
+        (100.0..=135.0).contains(&eye.x)
+            && (20.0..=85.0).contains(&eye.y)
+            && (76.0..=136.0).contains(&eye.z),
+        "{eye}: not in the nasal cavity"
+    );
+    // Looking back along the passages, towards the choanae.
+    assert!(forward(&s.pose).y > 0.8, "{:?}", s.pose);
+    // The largest enclosed air, which the preset took before: a left mastoid cell.
+    assert!(!s.lumen.contains([160, 148, 68]));
+    // Cut off from the air around the head: the mask reaches none of the volume's sides.
+    let (lo, hi) = s.lumen.bounds();
+    let dims = head.dims();
+    assert!(
+        (0..2).all(|a| lo[a] > 0 && hi[a] + 1 < dims[a]),
+        "{lo:?} {hi:?}"
+    );
+}
+
+#[test]
+fn angioscopy_on_the_stent_cta_follows_the_stented_aorta_down_to_the_bifurcation() {
+    let Some(stent) = load("aorta-stent-cta/stent.nrrd") else {
+        return;
+    };
+    let s = start(stent, "angioscopy");
+    assert!(s.what.starts_with("aorta"), "{}", s.what);
+    assert_walled("angioscopy (stent)", &s, (5.0, 120.0));
+    // Measured on the slices (1 mm voxels assumed, world = voxel index; k grows upwards): the
+    // aorta's section centre at (73, 49) in slice 130, (74, 53) in 150, (68, 69) in 200,
+    // (56, 95) at the top (255), oblique and ringed by the stent's struts; it divides into the
+    // iliac arteries at k ≈ 88.
+    for v in [[73, 49, 130], [74, 53, 150], [68, 69, 200]] {
+        assert!(s.lumen.contains(v), "{v:?} not in the aorta");
+    }
+    let eye = s.pose.eye_mm;
+    assert!(eye.z > 200.0, "{eye}: not near the top");
+    assert!(forward(&s.pose).z < -0.6, "{:?}", s.pose);
+    let end = s.end_mm.unwrap();
+    assert!(
+        (75.0..110.0).contains(&end.z),
+        "{end}: not near the bifurcation"
+    );
+    let aorta = find_aorta(stent, 130.0, LumenSide::Above).unwrap();
+    assert!(
+        (8.0..=15.0).contains(&aorta.radius_mm),
+        "radius {} mm",
+        aorta.radius_mm
+    );
+}
+
+#[test]
+fn colonoscopy_on_the_abdomen_starts_in_colon_gas_not_the_lung_nor_the_table() {
+    let Some(abdomen) = load("abdomen-ct-pancreas-dicom") else {
+        return;
+    };
+    let s = start(abdomen, "colonoscopy");
+    assert!(s.what.starts_with("colon"), "{}", s.what);
+    assert_walled("colonoscopy", &s, (2.0, 80.0));
+    let to_voxel = |p: DVec3| {
+        let v = abdomen
+            .geometry()
+            .voxel_from_world()
+            .transform_point3(p)
+            .round();
+        [v.x as usize, v.y as usize, v.z as usize]
+    };
+    // Gas (below −900 HU), not aerated lung (−820 to −900).
+    let [i, j, k] = to_voxel(s.pose.eye_mm);
+    let value = abdomen.physical(i, j, k).unwrap();
+    assert!(value < -900.0, "{value} HU at the eye");
+    // Measured on the slices: the gas-filled right colon (ascending colon to the hepatic
+    // flexure) lies at x −130…−60, y 0…70 mm, z 240…320 mm, below the liver; the lungs end
+    // above it. A hollow in the scanner's table (x −150, y 231, z 461; 47.6 ml), which the
+    // preset took before, lies outside the body.
+    let eye = s.pose.eye_mm;
+    assert!(
+        (-140.0..=-50.0).contains(&eye.x)
+            && (-10.0..=80.0).contains(&eye.y)
+            && (240.0..=320.0).contains(&eye.z),
+        "{eye}: not in the right colon"
+    );
+    assert!(!s
+        .lumen
+        .contains(to_voxel(DVec3::new(-152.54, 231.18, 460.91))));
 }

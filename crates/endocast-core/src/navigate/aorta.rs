@@ -14,9 +14,14 @@ use rayon::prelude::*;
 /// Radius of a candidate section, mm: the aorta's 8–15 mm with a millimetre of slack for
 /// partial volume at the threshold.
 pub const RADIUS_MM: (f64, f64) = (7.0, 16.0);
-/// Smallest roundness of a candidate (see `Section::roundness`): an ellipse 1.6 times as long
-/// as wide passes, a section with a vertebra or a kidney attached does not.
+/// Smallest roundness of a section that starts a chain (see `Section::roundness`): an ellipse
+/// 1.6 times as long as wide passes, a section with a vertebra or a kidney attached does not.
 const MIN_ROUNDNESS: f64 = 0.6;
+/// Smallest roundness of a section that continues a chain: an aorta cut obliquely where it
+/// bends, or ringed by a stent graft whose struts and their halo cling to its section (the
+/// stent CTA), is round to 0.25–0.6 for tens of slices; in line with the chain, of its size,
+/// it is still the aorta.
+const MIN_ROUNDNESS_FOLLOWED: f64 = 0.25;
 /// How far a section's centre may move from the previous one's, in radii.
 const MAX_SHIFT: f64 = 0.6;
 /// How much a section's radius may differ from the previous one's (ratio).
@@ -52,6 +57,8 @@ struct Candidate {
     /// Centroid, in-slice mm from the slice's first pixel.
     at: [f64; 2],
     radius_mm: f64,
+    /// Round enough to start a chain ([`MIN_ROUNDNESS`]); others only continue one.
+    starts: bool,
     section: Section,
 }
 
@@ -113,11 +120,13 @@ fn candidates(volume: &Volume, threshold: f64, side: LumenSide) -> Vec<Candidate
         .flat_map_iter(|k| {
             sections(volume, k, threshold, side, sized)
                 .into_iter()
-                .filter(|s| s.roundness(pixel_mm, nx) >= MIN_ROUNDNESS)
-                .map(move |section| Candidate {
+                .map(|s| (s.roundness(pixel_mm, nx), s))
+                .filter(|(round, _)| *round >= MIN_ROUNDNESS_FOLLOWED)
+                .map(move |(round, section)| Candidate {
                     k,
                     at: [section.mean[0] * pixel_mm[0], section.mean[1] * pixel_mm[1]],
                     radius_mm: section.radius_mm(pixel_mm),
+                    starts: round >= MIN_ROUNDNESS,
                     section,
                 })
                 .collect::<Vec<_>>()
@@ -134,27 +143,34 @@ fn continues(a: &Candidate, b: &Candidate) -> bool {
 }
 
 /// Indices (into `candidates`, which are sorted by slice) of the longest chain of candidates
-/// each continuing the one before within [`MAX_GAP`] skipped slices, by length along the
-/// slices; among equally long ones, the first found.
+/// each continuing the one before within [`MAX_GAP`] skipped slices and holding one that
+/// [`Candidate::starts`], by length along the slices; among equally long ones, the first found.
 fn longest_chain(candidates: &[Candidate]) -> Option<Vec<usize>> {
-    // Per candidate: the slices its longest chain spans, and its predecessor there.
-    let mut best: Vec<(usize, Option<usize>)> = Vec::with_capacity(candidates.len());
+    // Per candidate, of the best chain ending there: whether it holds a starting section, the
+    // slices it spans, and its predecessor. Chains holding a starting section are preferred.
+    let mut best: Vec<(bool, usize, Option<usize>)> = Vec::with_capacity(candidates.len());
     let mut first_of_slice = 0;
     for (n, c) in candidates.iter().enumerate() {
         while candidates[first_of_slice].k + MAX_GAP + 1 < c.k {
             first_of_slice += 1;
         }
+        let through = |p: usize| (best[p].0, best[p].1 + c.k - candidates[p].k);
         let from = (first_of_slice..n)
             .filter(|&p| candidates[p].k < c.k && continues(&candidates[p], c))
-            .max_by_key(|&p| (best[p].0 + c.k - candidates[p].k, std::cmp::Reverse(p)));
+            .max_by_key(|&p| (through(p), std::cmp::Reverse(p)));
         best.push(match from {
-            Some(p) => (best[p].0 + c.k - candidates[p].k, Some(p)),
-            None => (1, None),
+            Some(p) => {
+                let (starts, span) = through(p);
+                (starts || c.starts, span, Some(p))
+            }
+            None => (c.starts, 1, None),
         });
     }
-    let mut end = (0..candidates.len()).max_by_key(|&n| (best[n].0, std::cmp::Reverse(n)))?;
+    let mut end = (0..candidates.len())
+        .filter(|&n| best[n].0)
+        .max_by_key(|&n| (best[n].1, std::cmp::Reverse(n)))?;
     let mut chain = vec![end];
-    while let Some(p) = best[end].1 {
+    while let Some(p) = best[end].2 {
         chain.push(p);
         end = p;
     }

@@ -17,10 +17,18 @@ const MIN_GAS_SHARE: f64 = 0.5;
 const LARGE_MM3: f64 = 200_000.0;
 /// Components tried, largest first.
 const TRIES: usize = 12;
+/// How far outside a component its surroundings are looked at, mm: beyond a bowel wall.
+const SHELL_MM: f64 = 5.0;
+/// The largest share of air (on the lumen side, not the component's own) at [`SHELL_MM`]
+/// outside a component inside the body: a bowel loop is wrapped in tissue and fat, a hollow
+/// in the scanner's table (its walls a few millimetres thick) in the air around it.
+const MAX_AIR_AROUND: f64 = 0.25;
 
 /// The colon below `threshold` (−500 HU): the largest of the largest components that does not
-/// reach the volume's sides (the `i` and `j` faces) and, when it holds [`LARGE_MM3`] or more, is
-/// mostly gas (below `threshold −` [`GAS_BELOW_THRESHOLD`]): not the lung. `None` when none is.
+/// reach the volume's sides (the `i` and `j` faces), is wrapped in tissue (at most
+/// [`MAX_AIR_AROUND`] of air [`SHELL_MM`] outside it: not a hollow in the table) and, when it
+/// holds [`LARGE_MM3`] or more, is mostly gas (below `threshold −` [`GAS_BELOW_THRESHOLD`]):
+/// not the lung. `None` when none is.
 pub fn find_colon(volume: &Volume, threshold: f64) -> Option<Lumen> {
     let gas = threshold - GAS_BELOW_THRESHOLD;
     let dims = volume.dims();
@@ -30,11 +38,44 @@ pub fn find_colon(volume: &Volume, threshold: f64) -> Option<Lumen> {
         let (lo, hi) = lumen.bounds();
         let at_side = (0..2).any(|a| lo[a] == 0 || hi[a] + 1 == dims[a]);
         let large = lumen.voxel_count() as f64 * voxel_mm3 >= LARGE_MM3;
-        !at_side && (!large || gas_share(volume, lumen, gas) >= MIN_GAS_SHARE)
+        !at_side
+            && (!large || gas_share(volume, lumen, gas) >= MIN_GAS_SHARE)
+            && air_around(volume, lumen, threshold) <= MAX_AIR_AROUND
     };
     Lumen::largest_accepted(volume, threshold, LumenSide::Below, TRIES, accept)
         .ok()
         .flatten()
+}
+
+/// The share of the points [`SHELL_MM`] outside `lumen`'s surface (from each surface voxel
+/// along each axis it faces the wall on, within the volume) that are air below `threshold`
+/// and not the lumen's own.
+fn air_around(volume: &Volume, lumen: &Lumen, threshold: f64) -> f64 {
+    let dims = volume.dims();
+    let spacing = volume.geometry().spacing_mm().to_array();
+    let reach = spacing.map(|s| (SHELL_MM / s).ceil().max(1.0) as isize);
+    let (mut air, mut all) = (0usize, 0usize);
+    for v in lumen.voxels() {
+        for (axis, sign) in (0..3).flat_map(|a| [(a, -1isize), (a, 1)]) {
+            let at = |n: isize| {
+                let mut w = v.map(|x| x as isize);
+                w[axis] += sign * n;
+                (w[axis] >= 0 && (w[axis] as usize) < dims[axis]).then(|| w.map(|x| x as usize))
+            };
+            let (Some(next), Some(out)) = (at(1), at(reach[axis])) else {
+                continue;
+            };
+            if lumen.contains(next) {
+                continue;
+            }
+            all += 1;
+            let is_air = volume
+                .physical(out[0], out[1], out[2])
+                .is_some_and(|x| x < threshold);
+            air += usize::from(is_air && !lumen.contains(out));
+        }
+    }
+    air as f64 / all.max(1) as f64
 }
 
 /// The share of `lumen`'s voxels below `gas`.

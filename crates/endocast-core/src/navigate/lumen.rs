@@ -57,6 +57,18 @@ impl BitGrid {
     }
 }
 
+impl BitGrid {
+    /// Clears every bit whose `i` lies outside `range`.
+    pub(crate) fn keep_i(&mut self, range: std::ops::RangeInclusive<usize>) {
+        let [nx, ny, nz] = self.dims;
+        for n in 0..nx * ny * nz {
+            if !range.contains(&(n % nx)) {
+                self.words[n >> 6] &= !(1 << (n & 63));
+            }
+        }
+    }
+}
+
 /// Which stored values lie on the lumen side: a table over all 65 536 `u16` values, so the fill
 /// compares nothing and any value map (even a negative scale) is handled alike.
 struct ValueTest {
@@ -230,6 +242,28 @@ impl Lumen {
             }
         }
         Ok(None)
+    }
+
+    /// The largest component of the voxels on `side` of `threshold` that `allowed` (one bit per
+    /// voxel of the volume) also holds, among those whose inclusive bounding box `accept` takes:
+    /// the nasal cavity among the air holes of a head's slices. `Ok(None)` when it takes none.
+    pub(crate) fn largest_within(
+        volume: &Volume,
+        threshold: f64,
+        side: LumenSide,
+        allowed: &BitGrid,
+        accept: impl Fn([usize; 3], [usize; 3]) -> bool,
+    ) -> Result<Option<Self>, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let test = ValueTest::new(volume.value_map(), threshold, side);
+        let on_side = test.on(volume);
+        let holds = |n: usize| allowed.get_linear(n) && on_side(n);
+        let best = components_where(volume.dims(), holds)
+            .into_iter()
+            .filter(|c| accept(c.lo, c.hi))
+            .max_by_key(|c| c.count);
+        best.map(|c| Self::within(volume, c.seed, threshold, side, allowed))
+            .transpose()
     }
 
     /// The largest component that reaches into the inclusive voxel box `lo..=hi` and does not
@@ -435,16 +469,21 @@ impl<'a> LumenNumbering<'a> {
 
 /// Every component of the voxels on `side` of `threshold`, in the order their first voxel comes.
 fn components(volume: &Volume, threshold: f64, side: LumenSide) -> Vec<Component> {
-    let dims = volume.dims();
     let test = ValueTest::new(volume.value_map(), threshold, side);
+    components_where(volume.dims(), test.on(volume))
+}
+
+/// Every component of the voxels (of a `dims` grid) whose linear index `holds` accepts, in the
+/// order their first voxel comes.
+fn components_where(dims: [usize; 3], holds: impl Fn(usize) -> bool) -> Vec<Component> {
     let mut visited = BitGrid::new(dims);
     let mut found = Vec::new();
-    for (n, &stored) in volume.voxels().iter().enumerate() {
-        if !test.holds(stored) || visited.get_linear(n) {
+    for n in 0..dims[0] * dims[1] * dims[2] {
+        if !holds(n) || visited.get_linear(n) {
             continue;
         }
         let v = [n % dims[0], n / dims[0] % dims[1], n / (dims[0] * dims[1])];
-        found.push(fill(dims, test.on(volume), v, &mut visited));
+        found.push(fill(dims, &holds, v, &mut visited));
     }
     found
 }

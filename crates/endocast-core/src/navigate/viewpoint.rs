@@ -5,6 +5,7 @@ use super::aorta::{find_aorta, Aorta};
 use super::colon::find_colon;
 use super::distance::DistanceField;
 use super::lumen::{Lumen, LumenSide};
+use super::nasal::{find_nasal_cavity, NasalCavity};
 use super::preset::{Central, LumenChoice, LumenChoiceError};
 use super::trachea::find_trachea;
 use crate::camera::framing_pose;
@@ -213,7 +214,33 @@ fn find_structure(
                 )
             })
             .or_else(largest),
+        (None, Some(Structure::NasalCavity), LumenSide::Below) => {
+            find_nasal_cavity(volume, threshold)
+                .map(|nose| nasal_found(volume, nose, threshold))
+                .or_else(largest)
+        }
         _ => largest(),
+    }
+}
+
+/// The camera at the nasal cavity's start looking back (posterior, +y in LPS) along the
+/// passages, the mask the whole air joined to them (sinuses, pharynx).
+fn nasal_found(volume: &Volume, nose: NasalCavity, threshold: f64) -> Found {
+    let s = volume.geometry().spacing_mm();
+    let ml = |lumen: &Lumen| lumen.voxel_count() as f64 * s.x * s.y * s.z / 1000.0;
+    let field = DistanceField::new(&nose.passages, volume.geometry());
+    let radius = field.distance_mm(nose.start_mm).max(1.0);
+    Found {
+        pose: looking_along(nose.start_mm, DVec3::Y, radius),
+        what: format!(
+            "nasal cavity: {:.1} ml with the sinuses and pharynx joined to it ({:.1} ml of \
+             passages near the midline)",
+            ml(&nose.lumen),
+            ml(&nose.passages)
+        ),
+        lumen: nose.lumen,
+        threshold,
+        end_mm: None,
     }
 }
 

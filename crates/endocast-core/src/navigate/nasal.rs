@@ -1,0 +1,201 @@
+//! The nasal cavity with no seed: air inside the head, cut off from the outside air at the
+//! nostrils. Grown on its threshold alone, the nasal cavity joins the air around the head
+//! through the nostrils (and an open mouth). In an axial slice the air around the head reaches
+//! the slice's border, while the nasal cavity above the nostrils, the sinuses, the pharynx and
+//! the mastoid air cells are holes in the head; the nostrils open downwards, so the slices cut
+//! them off. The nasal cavity is the largest 3D component of those holes that crosses the
+//! head's mid-sagittal plane: the mastoid cells lie to the sides.
+
+use super::distance::DistanceField;
+use super::lumen::{BitGrid, Lumen, LumenSide};
+use crate::Volume;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// How far from the mid-sagittal plane the nasal passages reach, mm: the septum lies on it,
+/// the passages and turbinates within about a centimetre either side; the maxillary sinuses
+/// begin further out.
+pub const PASSAGE_HALF_WIDTH_MM: f64 = 10.0;
+
+/// The nasal cavity found in a head.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NasalCavity {
+    /// The air inside the head joined to it: the nasal cavity, the sinuses open to it and the
+    /// pharynx.
+    pub lumen: Lumen,
+    /// Its nasal passages and nasopharynx: the largest component of the same air within
+    /// [`PASSAGE_HALF_WIDTH_MM`] of the mid-sagittal plane, where an endoscope goes.
+    pub passages: Lumen,
+    /// Where an endoscope starts, world mm: the most central point of the passages' front
+    /// [`FRONT_SHARE`] (anterior, −y in LPS), just behind the nostrils.
+    pub start_mm: DVec3,
+}
+
+/// The share of the passages' front-to-back extent in which the start lies: the nasal cavity
+/// proper, before the nasopharynx and the sphenoid sinus behind it, which are wider.
+pub const FRONT_SHARE: f64 = 1.0 / 3.0;
+
+/// The nasal cavity below `threshold` (air, −500 HU): the largest 6-connected component of the
+/// air holes of the axial slices (air not 4-connected to the slice's border within the slice)
+/// whose extent along `i` (left–right) spans the head's middle (the mean `i` of the voxels at
+/// or above `threshold`), and its passages near that middle. `None` when no such component
+/// exists.
+pub fn find_nasal_cavity(volume: &Volume, threshold: f64) -> Option<NasalCavity> {
+    if !threshold.is_finite() {
+        return None;
+    }
+    let (mut holes, middle) = slice_holes(volume, threshold);
+    let middle = middle?;
+    let spans = |lo: [usize; 3], hi: [usize; 3]| (lo[0]..=hi[0]).contains(&middle);
+    let below = LumenSide::Below;
+    let lumen = Lumen::largest_within(volume, threshold, below, &holes, spans).ok()??;
+    let reach = (PASSAGE_HALF_WIDTH_MM / volume.geometry().spacing_mm().x).round() as usize;
+    holes.keep_i(middle.saturating_sub(reach)..=middle + reach);
+    let passages = Lumen::largest_within(volume, threshold, below, &holes, spans).ok()??;
+    let start_mm = front_centre(volume, &passages);
+    Some(NasalCavity {
+        lumen,
+        passages,
+        start_mm,
+    })
+}
+
+/// The most central voxel (largest distance to the wall) of the front [`FRONT_SHARE`] of
+/// `passages` along world `y`, world mm.
+fn front_centre(volume: &Volume, passages: &Lumen) -> DVec3 {
+    let field = DistanceField::new(passages, volume.geometry());
+    let world: Vec<DVec3> = passages.voxels().map(|v| field.world_of_voxel(v)).collect();
+    let (front, back) = world
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.y), hi.max(p.y))
+        });
+    let limit = front + FRONT_SHARE * (back - front);
+    passages
+        .voxels()
+        .zip(&world)
+        .filter(|(_, p)| p.y <= limit)
+        .max_by(|a, b| {
+            field
+                .distance_at_voxel(a.0)
+                .total_cmp(&field.distance_at_voxel(b.0))
+        })
+        .map_or(world[0], |(_, &p)| p)
+}
+
+/// The air holes of every axial slice (one bit per voxel), and the mean `i` of the voxels at or
+/// above `threshold` (`None` when there are none). Slices in parallel.
+fn slice_holes(volume: &Volume, threshold: f64) -> (BitGrid, Option<usize>) {
+    let [nx, ny, nz] = volume.dims();
+    let map = volume.value_map();
+    let air: Vec<bool> = (0..=u16::MAX)
+        .map(|s| map.physical(s) < threshold)
+        .collect();
+    let per_slice: Vec<(Vec<bool>, f64, usize)> = volume
+        .voxels()
+        .par_chunks(nx * ny)
+        .map(|slice| {
+            let open: Vec<bool> = slice.iter().map(|&s| air[usize::from(s)]).collect();
+            let (sum, count) = open
+                .iter()
+                .enumerate()
+                .filter(|(_, &a)| !a)
+                .fold((0.0, 0), |(s, c), (n, _)| (s + (n % nx) as f64, c + 1));
+            (holes_of(&open, nx, ny), sum, count)
+        })
+        .collect();
+    let mut holes = BitGrid::new([nx, ny, nz]);
+    let (mut sum, mut count) = (0.0, 0);
+    for (k, (slice, s, c)) in per_slice.into_iter().enumerate() {
+        sum += s;
+        count += c;
+        for (n, _) in slice.iter().enumerate().filter(|(_, &h)| h) {
+            holes.set([n % nx, n / nx, k]);
+        }
+    }
+    let middle = (count > 0).then(|| (sum / count as f64).round() as usize);
+    (holes, middle)
+}
+
+/// The `open` pixels of an `nx` × `ny` slice that are not 4-connected to its border through
+/// open pixels.
+fn holes_of(open: &[bool], nx: usize, ny: usize) -> Vec<bool> {
+    let mut outside = vec![false; nx * ny];
+    let mut stack: Vec<usize> = (0..nx)
+        .flat_map(|i| [i, i + nx * (ny - 1)])
+        .chain((0..ny).flat_map(|j| [nx * j, nx - 1 + nx * j]))
+        .filter(|&n| open[n])
+        .collect();
+    while let Some(n) = stack.pop() {
+        if outside[n] {
+            continue;
+        }
+        outside[n] = true;
+        let (i, j) = (n % nx, n / nx);
+        let neighbours = [
+            (i > 0).then(|| n - 1),
+            (i + 1 < nx).then_some(n + 1),
+            (j > 0).then(|| n - nx),
+            (j + 1 < ny).then_some(n + nx),
+        ];
+        stack.extend(
+            neighbours
+                .into_iter()
+                .flatten()
+                .filter(|&m| open[m] && !outside[m]),
+        );
+    }
+    open.iter()
+        .zip(&outside)
+        .map(|(&o, &out)| o && !out)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_midline_cavity_is_cut_off_at_its_nostril_and_the_side_pocket_passed_over() {
+        // Tissue (40 HU, stored 1040) framed by air at the i and j sides; a midline cavity
+        // opening to the front air through a nostril in slices 14–15 only; a larger air pocket
+        // to the side (a mastoid's place), enclosed.
+        let dims = [40, 40, 20];
+        let mut voxels = vec![1040u16; dims[0] * dims[1] * dims[2]];
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let frame = i < 3 || j < 3 || i >= 37 || j >= 37;
+                    let cavity =
+                        (17..23).contains(&i) && (8..20).contains(&j) && (5..16).contains(&k);
+                    let nostril = (19..22).contains(&i) && j < 8 && (14..16).contains(&k);
+                    let pocket =
+                        (4..12).contains(&i) && (5..30).contains(&j) && (3..17).contains(&k);
+                    if frame || cavity || nostril || pocket {
+                        voxels[i + dims[0] * (j + dims[1] * k)] = 0;
+                    }
+                }
+            }
+        }
+        let g = crate::Geometry::axis_aligned(dims, DVec3::ONE, DVec3::ZERO).unwrap();
+        let map = crate::ValueMap::new(1.0, -1000.0).unwrap();
+        let volume = Volume::new(g, voxels, map, crate::Modality::Ct).unwrap();
+        // Grown on the threshold alone, the largest enclosed air is the pocket.
+        let largest = Lumen::largest(&volume, -500.0, LumenSide::Below, true)
+            .unwrap()
+            .unwrap();
+        assert!(largest.contains([8, 10, 10]));
+        let nose = find_nasal_cavity(&volume, -500.0).unwrap();
+        assert!(nose.lumen.contains([20, 12, 8]) && !nose.lumen.contains([8, 10, 10]));
+        // The nostril's slices open to the air in front: cut off there.
+        assert!(!nose.lumen.contains([20, 5, 14]) && !nose.lumen.contains([20, 12, 14]));
+        assert_eq!(nose.lumen.voxel_count(), 6 * 12 * 9);
+        // The start lies in the cavity's front third, in the middle of its section.
+        let s = nose.start_mm;
+        assert!(
+            (8.0..12.0).contains(&s.y) && (18.0..=21.0).contains(&s.x),
+            "{s}"
+        );
+        assert!(find_nasal_cavity(&volume, f64::NAN).is_none());
+    }
+}
