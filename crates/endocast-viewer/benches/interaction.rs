@@ -3,6 +3,10 @@
 //! on the colon phantom, through the viewer's own session and render worker.
 //!
 //! `cargo bench -p endocast-viewer --bench interaction [-- SIZE [POSES]]` (defaults 512, 40).
+//!
+//! On Linux it also reports the CPU time the process's threads ran, and waited runnable for a
+//! CPU, from the input to the first frame (`/proc/self/task/*/schedstat`): on a shared machine
+//! the waiting shows how much of the latency the load added.
 
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::Pose;
@@ -49,6 +53,7 @@ fn main() {
     let mut session = Session::new(scene, preset, Some(pose(20.0)), || {});
     session.set_view_size([512, 512]);
     let (mut first, mut full) = (Vec::new(), Vec::new());
+    let (mut ran, mut waited) = (Vec::new(), Vec::new());
     let length = line.length_vox();
     let wait = Duration::from_secs(60);
     for k in 0..poses {
@@ -57,6 +62,7 @@ fn main() {
             continue;
         };
         session.set_camera(camera);
+        let cpu = cpu_times();
         let input = Instant::now();
         let generation = session.sync(true).expect("a new view");
         let preview = session
@@ -64,6 +70,10 @@ fn main() {
             .wait_for(generation, wait, |_| true)
             .expect("a frame");
         first.push((input.elapsed(), preview.stage));
+        if let (Some((run0, wait0)), Some((run1, wait1))) = (cpu, cpu_times()) {
+            ran.push(ms(run1.saturating_sub(run0)));
+            waited.push(ms(wait1.saturating_sub(wait0)));
+        }
         // The camera stops: the same view, refined.
         session.sync(false);
         let still = session.worker().generation();
@@ -73,7 +83,6 @@ fn main() {
             .expect("the full frame");
         full.push(input.elapsed());
     }
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
     let mut first_ms: Vec<f64> = first.iter().map(|(d, _)| ms(*d)).collect();
     let mut full_ms: Vec<f64> = full.iter().map(|d| ms(*d)).collect();
     println!(
@@ -83,6 +92,30 @@ fn main() {
     );
     report("input -> first frame (moving quality)", &mut first_ms);
     report("input -> full-quality frame", &mut full_ms);
+    if !ran.is_empty() {
+        report("  CPU run by all threads, input -> first frame", &mut ran);
+        report(
+            "  waiting runnable for a CPU, input -> first frame",
+            &mut waited,
+        );
+    }
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// CPU time this process's threads have run, and waited runnable for a CPU, so far (Linux's
+/// `/proc/self/task/*/schedstat`); `None` where that is not readable.
+fn cpu_times() -> Option<(Duration, Duration)> {
+    let (mut run, mut wait) = (0, 0);
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let text = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        let mut fields = text.split_whitespace().map(str::parse::<u64>);
+        run += fields.next()?.ok()?;
+        wait += fields.next()?.ok()?;
+    }
+    Some((Duration::from_nanos(run), Duration::from_nanos(wait)))
 }
 
 fn report(what: &str, values: &mut [f64]) {

@@ -79,7 +79,7 @@ pub(crate) fn marks_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     for a in ready.session.annotations() {
         ui.horizontal(|ui| {
             ui.label(describe(a));
-            if ui.small_button("✕").clicked() {
+            if ui.small_button("delete").clicked() {
                 delete = Some(a.id);
             }
         });

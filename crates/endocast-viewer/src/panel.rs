@@ -293,7 +293,7 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
             {
                 go = Some(i);
             }
-            if ui.small_button("✕").clicked() {
+            if ui.small_button("delete").clicked() {
                 delete = Some(i);
             }
         });

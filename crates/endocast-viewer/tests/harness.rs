@@ -157,6 +157,17 @@ impl Window {
         all
     }
 
+    /// Fails naming the texts of the last frame that the font cannot draw.
+    pub fn assert_glyphs(&self) {
+        let font = egui::FontId::proportional(14.0);
+        let missing: Vec<_> = self
+            .painted_texts()
+            .into_iter()
+            .filter(|t| !self.ctx.fonts_mut(|f| f.has_glyphs(&font, t)))
+            .collect();
+        assert!(missing.is_empty(), "drawn without glyphs: {missing:?}");
+    }
+
     /// Clicks the widget that shows `text`, scrolling the control panel down to it.
     pub fn click_text(&mut self, text: &str) {
         for _ in 0..40 {

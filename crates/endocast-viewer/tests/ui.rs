@@ -151,13 +151,11 @@ fn every_text_of_the_window_has_its_glyphs_in_the_font() {
     for header in ["Geometry", "Export the flight", "Keys"] {
         window.click_text(header);
     }
+    // A key frame, listed with its buttons.
+    window.frame(vec![key(Key::K, true), key(Key::K, false)]);
     window.frame(Vec::new());
-    let font = egui::FontId::proportional(14.0);
+    assert_eq!(window.app.session().unwrap().key_frames().len(), 1);
     let texts = window.painted_texts();
     assert!(texts.iter().any(|t| t.contains("slide left")), "{texts:?}");
-    let missing: Vec<_> = texts
-        .iter()
-        .filter(|t| !window.ctx.fonts_mut(|f| f.has_glyphs(&font, t)))
-        .collect();
-    assert!(missing.is_empty(), "drawn without glyphs: {missing:?}");
+    window.assert_glyphs();
 }

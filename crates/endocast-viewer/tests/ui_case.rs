@@ -63,6 +63,8 @@ fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_pic
         "{kinds:?}"
     );
 
+    // The marks' list draws with the font's glyphs.
+    window.assert_glyphs();
     window.click_text("Save case");
     let path = window.app.case_path().unwrap();
     assert!(
