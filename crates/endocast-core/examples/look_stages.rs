@@ -1,8 +1,8 @@
 //! Where the realistic look's time goes, stage by stage, on the colon phantom's fly path (the
 //! `endocast bench --look realistic` protocol): plain iso, the look's first-hit pass alone (the
 //! renderer at the secretion threshold), the whole ray pass with secretion on and off, the
-//! smoothing alone and the deferred stage (smoothing and shading). Median wall-clock ms per
-//! frame of 512×512.
+//! smoothing alone and the deferred stage (smoothing, shading and, below full quality, the
+//! upsampling of the shaded frame). Median wall-clock ms per frame of 512×512.
 //!
 //! ```text
 //! cargo run --release -p endocast-core --example look_stages -- [full|half] [FRAMES] [THREADS]
@@ -11,6 +11,7 @@
 use endocast_core::look::{self, Look, LookKind, PresetLook, RayPass, SecretionMode};
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::fly_through;
+use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{
     Camera, Frame, Mode, Quality, RenderOptions, RenderSettings, Renderer,
 };
@@ -85,14 +86,16 @@ fn stages(
         time(1, &mut || {
             let _ = first.render_with(camera, &options, &mut frame);
         });
+        // Below full quality both stages run at the reduced size (as `endocast bench` does).
+        let small = reduced_camera(camera, quality.reduced_size(camera.size()));
         let mut gbuffer = None;
-        time(2, &mut || gbuffer = Some(pass.trace(camera, quality)));
-        time(3, &mut || drop(dry.trace(camera, quality)));
+        time(2, &mut || gbuffer = Some(pass.trace(&small, Quality::Full)));
+        time(3, &mut || drop(dry.trace(&small, Quality::Full)));
         let gbuffer = gbuffer.ok_or("no G-buffer")?;
         time(4, &mut || drop(look::smooth::smooth(&gbuffer, 2)));
         let mut shaded = Ok(Frame::default());
         time(5, &mut || {
-            shaded = look::shade(&gbuffer, camera, &look.shading)
+            shaded = look::shade_reduced(&gbuffer, camera, &look.shading)
         });
         shaded?;
     }
