@@ -14,6 +14,7 @@ use endocast_core::camera::StereoRig;
 use endocast_core::look::{self, Look, RayPass, Shading};
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
+use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{
     Camera, Frame, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings, Renderer,
     StereoFrames,
@@ -206,8 +207,9 @@ fn measure(
     (Ok(mono), pair)
 }
 
-/// Renders every camera with a look's ray `pass` at `quality` and shades it; returns the
-/// timings of the whole frame and of the deferred stage (smoothing, shading) alone.
+/// Renders every camera with a look's ray `pass` at `quality` and shades it (below full
+/// quality both stages at the reduced size, the shaded frame upsampled); returns the timings of
+/// the whole frame and of the deferred stage (smoothing, shading, upsampling) alone.
 fn measure_look(
     pass: &RayPass,
     shading: &Shading,
@@ -217,9 +219,10 @@ fn measure_look(
     let (mut whole, mut deferred) = (Measured::default(), Measured::default());
     for camera in cameras {
         let start = Instant::now();
-        let gbuffer = pass.trace(camera, quality);
+        let small = reduced_camera(camera, quality.reduced_size(camera.size()));
+        let gbuffer = pass.trace(&small, Quality::Full);
         let shaded = Instant::now();
-        look::shade(&gbuffer, camera, shading).context("invalid look")?;
+        look::shade_reduced(&gbuffer, camera, shading).context("invalid look")?;
         let end = Instant::now();
         whole.ms.push((end - start).as_secs_f64() * 1e3);
         whole.samples += gbuffer.stats.samples;

@@ -16,6 +16,9 @@
 //!    texture ([`Texture`]) and secretion fog. Changing any of it never marches a ray again:
 //!    [`shade`] takes a `&GBuffer` and no renderer.
 //!
+//! Below full quality, [`shade_reduced`] runs the deferred stage at the reduced size of a
+//! G-buffer traced there and upsamples the shaded frame.
+//!
 //! [`LookKind`] names the three looks (`plain` is the renderer's own image; `clinical` and
 //! `realistic` run both stages) and [`Look::of_kind`] builds one from a preset's
 //! [`PresetLook`] (the presets table holds one per procedure). [`still()`] averages jittered
@@ -48,6 +51,7 @@
 
 mod gbuffer;
 mod kind;
+mod reduced;
 mod secretion;
 mod settings;
 mod shading;
@@ -60,6 +64,7 @@ mod tests;
 
 pub use gbuffer::{GBuffer, RayPass};
 pub use kind::{Look, LookKind, PresetLook};
+pub use reduced::shade_reduced;
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::{shade, Shading};
 pub use still::still;

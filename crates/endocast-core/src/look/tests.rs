@@ -3,6 +3,7 @@
 use super::*;
 use crate::phantom::profile::{paint, ramp, AIR_HU, TISSUE_HU};
 use crate::phantom::{layered, rasterize, Layered, PhantomOptions, SECRETION_HU};
+use crate::render::quality::reduced_camera;
 use crate::render::{Camera, Quality, RenderSettings, Renderer};
 use crate::Volume;
 use glam::{DVec3, Vec3};
@@ -336,4 +337,25 @@ fn half_quality_and_stills_give_the_camera_s_size() {
     let single = shade(&full, &camera, &shading).unwrap();
     assert_eq!([converged.width, converged.height], [20, 20]);
     assert_ne!(converged.color, single.color);
+    // Both stages at half size, the shaded frame upsampled: the camera's size, the same
+    // surface at the centre; a G-buffer larger than the camera is refused.
+    let small = reduced_camera(&camera, Quality::Half.reduced_size(camera.size()));
+    let low = pass.trace(&small, Quality::Full);
+    assert_eq!([low.width, low.height], [10, 10]);
+    let reduced = shade_reduced(&low, &camera, &shading).unwrap();
+    assert_eq!([reduced.width, reduced.height], [20, 20]);
+    assert!((reduced.depth_mm[centre] - full.depth_mm[centre]).abs() < 0.5);
+    let (a, b) = (reduced.color[centre].rgb, single.color[centre].rgb);
+    assert!(
+        a.iter().zip(b).all(|(a, b)| (a - b).abs() < 0.1),
+        "{a:?} {b:?}"
+    );
+    assert_eq!(
+        shade_reduced(&full, &camera, &shading).unwrap().color,
+        single.color
+    );
+    assert!(matches!(
+        shade_reduced(&full, &small, &shading),
+        Err(LookError::SizeMismatch { .. })
+    ));
 }
