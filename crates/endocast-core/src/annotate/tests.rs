@@ -19,9 +19,11 @@ fn shell(iso_hu: f64) -> (Prepared, SphereShell, DVec3) {
     });
     let centre = volume.geometry().world_of(shell.centre_vox);
     let renderer = Arc::new(Renderer::new(volume));
-    let mut settings = RenderSettings::default();
-    settings.mode = Mode::Iso;
-    settings.iso_hu = iso_hu;
+    let settings = RenderSettings {
+        mode: Mode::Iso,
+        iso_hu,
+        ..RenderSettings::default()
+    };
     (renderer.prepare(&settings).unwrap(), shell, centre)
 }
 
