@@ -58,7 +58,7 @@ impl SceneArgs {
         for spec in &self.mesh {
             let (path, material) = mesh_spec(spec)?;
             let mesh = endocast_io::mesh::read_mesh(&path).context("cannot read the mesh")?;
-            scene.add_mesh(mesh, material);
+            scene.add_mesh(&mesh, material);
         }
         if let Some(spec) = &self.grid {
             scene.add_grid(self.grid(spec)?, Material::GRID);

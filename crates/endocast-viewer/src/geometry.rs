@@ -131,6 +131,6 @@ impl Geometry {
 pub fn with_mesh(mut meshes: Scene, path: &Path) -> Result<Scene, String> {
     let mesh =
         endocast_io::mesh::read_mesh(path).map_err(|e| format!("cannot read the mesh: {e}"))?;
-    meshes.add_mesh(mesh, Material::MESH);
+    meshes.add_mesh(&mesh, Material::MESH);
     Ok(meshes)
 }

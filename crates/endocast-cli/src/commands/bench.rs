@@ -65,6 +65,10 @@ pub struct BenchArgs {
     /// Print one JSON line per measured setting instead of the table.
     #[arg(long)]
     json: bool,
+    /// Measure only the settings (table rows) whose name contains this text, e.g. "iso only"
+    /// or "complex TF". Repeatable: a row named by any of them is measured.
+    #[arg(long, value_name = "TEXT")]
+    rows: Vec<String>,
     /// Geometry drawn in every frame (the cost of meshes, a grid, the endoscope).
     #[command(flatten)]
     scene: SceneArgs,
@@ -91,10 +95,19 @@ struct Measured {
 /// Runs `endocast bench`.
 pub fn run(args: &BenchArgs) -> Result<()> {
     let preset = args.look.preset()?;
-    let (renderer, poses, cells) = match &args.volume {
+    let (renderer, poses, mut cells) = match &args.volume {
         None => paper_protocol(args)?,
         Some(volume) => one_setting(args, volume)?,
     };
+    if !args.rows.is_empty() {
+        cells.retain(|c| args.rows.iter().any(|r| c.name.contains(r.as_str())));
+        if cells.is_empty() {
+            bail!(
+                "--rows {:?}: no setting of the benchmark has such a name",
+                args.rows
+            );
+        }
+    }
     let (lo, hi) = renderer.volume().geometry().world_bounds();
     let optics = args
         .lens

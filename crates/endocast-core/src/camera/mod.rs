@@ -445,7 +445,12 @@ impl Camera {
         let (x, y) = (x + self.pixel_offset[0], y + self.pixel_offset[1]);
         let a = 2.0 * x / w - 1.0;
         let b = 1.0 - 2.0 * y / h;
-        let s = self.lens.undistort_scale((a * w / h).hypot(b))?;
+        // An ideal lens leaves the radius as it is (and skips the `hypot`).
+        let s = if self.lens.is_ideal() {
+            1.0
+        } else {
+            self.lens.undistort_scale((a * w / h).hypot(b))?
+        };
         let eye = self.eye_origin();
         match self.projection {
             Projection::Pinhole => {

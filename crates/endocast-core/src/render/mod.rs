@@ -94,7 +94,7 @@ use glam::{DAffine3, DVec3, Vec3};
 use integrate::{Classified, Integrator, Params, PeelParams, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
-use scene_pass::SceneRow;
+use scene_pass::{SceneRow, SceneScratch};
 #[cfg(target_arch = "x86_64")]
 use simd::rays4::RaySetup;
 use std::sync::Arc;
@@ -507,7 +507,7 @@ impl Prepared {
         let width = camera.size()[0];
         let missed = self.pixel_of(&PixelOut::default());
         let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
-        let mut others = Vec::new();
+        let mut scratch = SceneScratch::default();
         for y in rect.y0..rect.y1 {
             columns.clear();
             tasks.clear();
@@ -530,16 +530,15 @@ impl Prepared {
                     options,
                     y,
                 };
-                others.clear();
                 let xs = rect.x0..rect.x1;
                 self.add_scene(
                     integrator,
                     &scene_row,
                     xs,
                     (&columns, &mut tasks),
-                    &mut others,
+                    &mut scratch,
                 );
-                for (x, out) in &mut others {
+                for (x, out) in &mut scratch.others {
                     vignette(camera, *x, y, out);
                     tile.pixels[row + *x - rect.x0] = self.pixel_of(out);
                 }

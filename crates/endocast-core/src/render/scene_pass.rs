@@ -22,7 +22,7 @@ use super::sample::Accum;
 use super::settings::Mode;
 use super::traverse::VoxelRay;
 use super::{adjust, Camera, Prepared, RenderOptions};
-use crate::scene::{Hit, PlacedScene, Scene};
+use crate::scene::{Hit, PlacedScene, Scene, Traced};
 use glam::{Vec3, Vec3A};
 use std::ops::Range;
 use std::sync::Arc;
@@ -34,6 +34,19 @@ pub(super) struct SceneRow<'r, 'a> {
     pub camera: &'r Camera,
     pub options: &'r RenderOptions<'r>,
     pub y: usize,
+}
+
+/// A tile's buffers for [`Prepared::add_scene`], kept from row to row.
+#[derive(Default)]
+pub(super) struct SceneScratch {
+    /// The row's rays and their intervals.
+    rays: Vec<Traced>,
+    /// Each ray's column and the index of its rendered task (`None`: it misses the volume).
+    pixels: Vec<(usize, Option<usize>)>,
+    /// Each ray's surfaces.
+    hits: Vec<Vec<Hit>>,
+    /// The surfaces of pixels whose ray misses the volume: `(column, result)`.
+    pub others: Vec<(usize, PixelOut)>,
 }
 
 impl Prepared {
@@ -51,44 +64,58 @@ impl Prepared {
 
     /// Adds the scene to the rays of row `row.y`, columns `xs`: the rendered `tasks` of
     /// `columns` in place, and for pixels whose ray misses the volume, their surfaces into
-    /// `others` as `(column, result)`.
+    /// `scratch.others` as `(column, result)`. The row's rays are traced together.
     pub(super) fn add_scene(
         &self,
         integrator: &Integrator<'_>,
         row: &SceneRow<'_, '_>,
         xs: Range<usize>,
         (columns, tasks): (&[usize], &mut [RayTask]),
-        others: &mut Vec<(usize, PixelOut)>,
+        scratch: &mut SceneScratch,
     ) {
-        let mut hits = Vec::new();
-        let mut rendered = columns.iter().zip(tasks.iter_mut()).peekable();
+        scratch.others.clear();
+        scratch.rays.clear();
+        scratch.pixels.clear();
+        let mut rendered = columns.iter().enumerate().peekable();
         let width = row.camera.size()[0];
         for x in xs {
-            let task = rendered.next_if(|(&c, _)| c == x).map(|(_, task)| task);
+            let task = rendered.next_if(|(_, &c)| c == x).map(|(i, _)| i);
             let Some(ray) = row.camera.pixel_ray(x, row.y) else {
                 continue;
             };
             let near = row.camera.near_distance_along(ray.dir);
-            let mut bound = task
-                .as_ref()
-                .map_or(f64::INFINITY, |t| self.volume_bound(t));
+            let mut bound = task.map_or(f64::INFINITY, |i| self.volume_bound(&tasks[i]));
             if let Some(max) = row.options.max_distance_mm {
                 let limit = f64::from(max[x + width * row.y]);
                 bound = if limit < bound { limit } else { bound };
             }
-            row.scene.trace(&ray, near, bound, &mut hits);
+            scratch.rays.push(Traced {
+                ray,
+                t_min: near,
+                t_max: bound,
+            });
+            scratch.pixels.push((x, task));
+        }
+        let n = scratch.rays.len();
+        if scratch.hits.len() < n {
+            scratch.hits.resize_with(n, Vec::new);
+        }
+        row.scene.trace_many(&scratch.rays, &mut scratch.hits);
+        for ((&(x, task), traced), hits) in
+            scratch.pixels.iter().zip(&scratch.rays).zip(&scratch.hits)
+        {
             if hits.is_empty() {
                 continue;
             }
             match task {
-                Some(task) => self.with_hits(integrator, row, x, &hits, task),
+                Some(i) => self.with_hits(integrator, row, x, hits, &mut tasks[i]),
                 None => {
                     let mut out = PixelOut::default();
-                    for hit in &hits {
-                        add_hit(integrator, &mut out.accum, hit, ray.dir.as_vec3());
+                    for hit in hits {
+                        add_hit(integrator, &mut out.accum, hit, traced.ray.dir.as_vec3());
                     }
                     out.depth_mm = hits[0].t_mm;
-                    others.push((x, out));
+                    scratch.others.push((x, out));
                 }
             }
         }

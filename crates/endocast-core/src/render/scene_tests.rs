@@ -133,7 +133,7 @@ fn an_opaque_mesh_hides_the_wall_exactly_where_it_covers_it() {
     let mesh = TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2]]).unwrap();
     for mode in [Mode::Iso, Mode::Dvr, Mode::Hybrid] {
         let mut scene = Scene::new();
-        scene.add_mesh(mesh.clone(), Material::MESH);
+        scene.add_mesh(&mesh, Material::MESH);
         let with = render(&renderer, mode, Some(scene), &camera);
         let without = render(&renderer, mode, None, &camera);
         let mut covered = 0;
@@ -323,7 +323,7 @@ fn the_colon_mesh_is_watertight_on_the_isosurface_and_drawn_where_the_wall_is() 
     invisible.tf = TransferFunction::ramp(5000.0, 6000.0);
     let mut prepared = renderer.prepare(&invisible).unwrap();
     let mut scene = Scene::new();
-    scene.add_mesh(mesh, Material::MESH);
+    scene.add_mesh(&mesh, Material::MESH);
     prepared.set_scene(Some(Arc::new(scene)));
     let drawn = prepared.render(&camera);
     let (mut compared, mut off) = (0, 0);
@@ -368,7 +368,7 @@ fn a_translucent_wall_just_in_front_of_opaque_geometry_is_still_found() {
         prepared.render(&camera)
     };
     let mut scene = Scene::new();
-    scene.add_mesh(plane, Material::MESH);
+    scene.add_mesh(&plane, Material::MESH);
     let (with, without) = (draw(Some(scene)), draw(None));
     let (mut walls, mut close) = (0, 0);
     for y in 0..px {

@@ -33,7 +33,7 @@ pub use aids::{Capsule, Endoscope, GridPlane, Marker, DEFAULT_INSTRUMENT_LENGTH_
 pub use mesh::{MeshError, TriangleMesh};
 
 use crate::camera::{Camera, Ray};
-use bvh::Bvh;
+use bvh::{Bvh, PacketRay, PACKET};
 use glam::{DVec3, Vec3};
 use std::sync::Arc;
 use thiserror::Error;
@@ -115,16 +115,10 @@ pub struct Hit {
     pub opacity: f32,
 }
 
-/// A mesh with its hierarchy, shared between copies of a scene.
-#[derive(Debug)]
-struct TracedMesh {
-    mesh: TriangleMesh,
-    bvh: Bvh,
-}
-
 #[derive(Debug, Clone)]
 enum Shape {
-    Mesh(Arc<TracedMesh>),
+    /// A mesh's hierarchy (it keeps what tracing needs), shared between copies of a scene.
+    Mesh(Arc<Bvh>),
     Grid(GridPlane),
     Marker(Marker),
 }
@@ -154,9 +148,8 @@ impl Scene {
     }
 
     /// Adds a mesh (its hierarchy is built here: about a second per million triangles).
-    pub fn add_mesh(&mut self, mesh: TriangleMesh, material: Material) {
-        let bvh = Bvh::new(&mesh);
-        let shape = Shape::Mesh(Arc::new(TracedMesh { mesh, bvh }));
+    pub fn add_mesh(&mut self, mesh: &TriangleMesh, material: Material) {
+        let shape = Shape::Mesh(Arc::new(Bvh::new(mesh)));
         self.objects.push(Object { shape, material });
     }
 
@@ -212,37 +205,100 @@ pub struct PlacedScene<'a> {
     instruments: Vec<Capsule>,
 }
 
+/// A ray and the open interval of distances traced along it, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Traced {
+    /// The ray.
+    pub ray: Ray,
+    /// Surfaces count from above this distance.
+    pub t_min: f64,
+    /// Surfaces count below this distance.
+    pub t_max: f64,
+}
+
 impl PlacedScene<'_> {
     /// The surfaces `ray` meets with `t_min < t < t_max` (mm), into `hits` (cleared first) in
     /// depth order: every translucent one in front of the nearest opaque one, then that one
     /// (where there is one: then it is the last hit). Surfaces of opacity 0 are left out.
     pub fn trace(&self, ray: &Ray, t_min: f64, t_max: f64, hits: &mut Vec<Hit>) {
-        hits.clear();
-        let (o, d) = (ray.origin, ray.dir);
-        let mut opaque: Option<Hit> = None;
-        let mut bound = t_max;
-        for capsule in &self.instruments {
-            if let Some(t) = capsule.hit(o, d, t_min, bound) {
-                bound = t;
-                opaque = Some(hit(t, capsule.normal(ray.at(t)), &Material::STEEL));
+        let traced = Traced {
+            ray: *ray,
+            t_min,
+            t_max,
+        };
+        self.trace_many(&[traced], std::slice::from_mut(hits));
+    }
+
+    /// [`Self::trace`] for many rays, `rays[i]`'s surfaces into `hits[i]`: the same hits, but
+    /// neighbouring rays (a row of pixels) walk a mesh's hierarchy together, for less than
+    /// their walks one by one.
+    ///
+    /// # Panics
+    ///
+    /// When `hits` is shorter than `rays`.
+    pub fn trace_many(&self, rays: &[Traced], hits: &mut [Vec<Hit>]) {
+        assert!(hits.len() >= rays.len(), "one list of hits per ray");
+        for (chunk, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
+            self.trace_packet(chunk, hits);
+        }
+    }
+
+    /// [`Self::trace_many`] for at most [`PACKET`] rays.
+    fn trace_packet(&self, rays: &[Traced], hits: &mut [Vec<Hit>]) {
+        let mut opaque: [Option<Hit>; PACKET] = [None; PACKET];
+        let mut bound = [0.0; PACKET];
+        for (i, traced) in rays.iter().enumerate() {
+            hits[i].clear();
+            bound[i] = traced.t_max;
+            let (o, d) = (traced.ray.origin, traced.ray.dir);
+            for capsule in &self.instruments {
+                if let Some(t) = capsule.hit(o, d, traced.t_min, bound[i]) {
+                    bound[i] = t;
+                    let normal = capsule.normal(traced.ray.at(t));
+                    opaque[i] = Some(hit(t, normal, &Material::STEEL));
+                }
             }
         }
         let objects = &self.scene.objects;
         for object in objects.iter().filter(|o| o.material.is_opaque()) {
-            if let Some((t, normal)) = nearest(&object.shape, ray, t_min, bound) {
-                bound = t;
-                opaque = Some(hit(t, normal, &object.material));
+            let nearest = nearest_each(&object.shape, rays, &bound[..rays.len()]);
+            for (i, found) in nearest.into_iter().enumerate().take(rays.len()) {
+                if let Some((t, normal)) = found {
+                    bound[i] = t;
+                    opaque[i] = Some(hit(t, normal, &object.material));
+                }
             }
         }
         for object in objects
             .iter()
             .filter(|o| !o.material.is_opaque() && o.material.opacity > 0.0)
         {
-            every_hit(&object.shape, ray, t_min, bound, &object.material, hits);
+            every_hit(object, rays, &bound[..rays.len()], hits);
         }
-        hits.sort_by(|a, b| a.t_mm.total_cmp(&b.t_mm));
-        hits.extend(opaque);
+        for (hits, opaque) in hits.iter_mut().zip(opaque) {
+            hits.sort_by(|a, b| a.t_mm.total_cmp(&b.t_mm));
+            hits.extend(opaque);
+        }
     }
+}
+
+/// `rays` as a packet for a mesh's hierarchy, each up to its `bound`.
+fn packet(rays: &[Traced], bound: &[f64]) -> [PacketRay; PACKET] {
+    let mut packet = [PacketRay {
+        origin: Vec3::ZERO,
+        dir: Vec3::X,
+        t_min: 0.0,
+        t_max: 0.0,
+    }; PACKET];
+    for ((p, traced), &t_max) in packet.iter_mut().zip(rays).zip(bound) {
+        *p = PacketRay {
+            origin: traced.ray.origin.as_vec3(),
+            dir: traced.ray.dir.as_vec3(),
+            t_min: traced.t_min as f32,
+            t_max: t_max as f32,
+        };
+    }
+    packet
 }
 
 fn hit(t: f64, normal: DVec3, m: &Material) -> Hit {
@@ -254,16 +310,32 @@ fn hit(t: f64, normal: DVec3, m: &Material) -> Hit {
     }
 }
 
-/// The nearest hit of `shape` in `(t_min, t_max)`: distance and unit normal.
-fn nearest(shape: &Shape, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64, DVec3)> {
+/// The nearest hit of `shape` along each of `rays` (at most [`PACKET`]) between its `t_min` and
+/// its `bound`: distance and unit normal.
+fn nearest_each(shape: &Shape, rays: &[Traced], bound: &[f64]) -> [Option<(f64, DVec3)>; PACKET] {
+    let mut found = [None; PACKET];
+    if let Shape::Mesh(m) = shape {
+        let mut packet = packet(rays, bound);
+        let mut best = [None; PACKET];
+        let n = rays.len();
+        m.nearest_each(&mut packet[..n], &mut best[..n]);
+        for (f, b) in found.iter_mut().zip(best) {
+            *f = b.map(|(t, tri)| (f64::from(t), m.normal(tri).as_dvec3()));
+        }
+        return found;
+    }
+    for ((f, traced), &t_max) in found.iter_mut().zip(rays).zip(bound) {
+        *f = nearest_aid(shape, &traced.ray, traced.t_min, t_max);
+    }
+    found
+}
+
+/// The nearest hit of a procedural aid (not a mesh) in `(t_min, t_max)`: distance and unit
+/// normal.
+fn nearest_aid(shape: &Shape, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64, DVec3)> {
     let (o, d) = (ray.origin, ray.dir);
     match shape {
-        Shape::Mesh(m) => {
-            let (t, tri) = m
-                .bvh
-                .nearest(o.as_vec3(), d.as_vec3(), t_min as f32, t_max as f32)?;
-            Some((f64::from(t), m.bvh.normal(&m.mesh, tri).as_dvec3()))
-        }
+        Shape::Mesh(_) => None,
         Shape::Grid(g) => g.hit(o, d, t_min, t_max).map(|t| (t, g.normal())),
         Shape::Marker(s) => {
             let (t0, t1) = s.crossings(o, d)?;
@@ -273,39 +345,41 @@ fn nearest(shape: &Shape, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64, DVe
     }
 }
 
-/// Every hit of `shape` in `(t_min, t_max)`, appended to `hits` unsorted.
-fn every_hit(
-    shape: &Shape,
-    ray: &Ray,
-    t_min: f64,
-    t_max: f64,
-    material: &Material,
-    hits: &mut Vec<Hit>,
-) {
-    let (o, d) = (ray.origin, ray.dir);
-    match shape {
+/// Every hit of `object` along each of `rays` (at most [`PACKET`]) between its `t_min` and its
+/// `bound`, appended to its list in `hits`: a mesh's in the order of distance, then triangle.
+fn every_hit(object: &Object, rays: &[Traced], bound: &[f64], hits: &mut [Vec<Hit>]) {
+    let material = &object.material;
+    match &object.shape {
         Shape::Mesh(m) => {
-            m.bvh.traverse(
-                o.as_vec3(),
-                d.as_vec3(),
-                t_min as f32,
-                t_max as f32,
-                |t, tri| {
-                    let normal = m.bvh.normal(&m.mesh, tri).as_dvec3();
-                    hits.push(hit(f64::from(t), normal, material));
-                    t_max as f32
-                },
-            );
+            let n = rays.len();
+            let mut packet = packet(rays, bound);
+            let mut found = Vec::new();
+            m.traverse_packet(&mut packet[..n], |ray, t, tri| {
+                found.push((ray, t, tri));
+                bound[ray] as f32
+            });
+            found.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
+            for (ray, t, tri) in found {
+                let normal = m.normal(tri).as_dvec3();
+                hits[ray].push(hit(f64::from(t), normal, material));
+            }
         }
         Shape::Grid(_) => {
-            if let Some((t, normal)) = nearest(shape, ray, t_min, t_max) {
-                hits.push(hit(t, normal, material));
+            for (i, traced) in rays.iter().enumerate() {
+                let (ray, t_min) = (&traced.ray, traced.t_min);
+                if let Some((t, normal)) = nearest_aid(&object.shape, ray, t_min, bound[i]) {
+                    hits[i].push(hit(t, normal, material));
+                }
             }
         }
         Shape::Marker(s) => {
-            if let Some((t0, t1)) = s.crossings(o, d) {
-                for t in [t0, t1].into_iter().filter(|&t| t > t_min && t < t_max) {
-                    hits.push(hit(t, (ray.at(t) - s.centre_mm) / s.radius_mm, material));
+            for (i, traced) in rays.iter().enumerate() {
+                let (ray, t_min) = (&traced.ray, traced.t_min);
+                if let Some((t0, t1)) = s.crossings(ray.origin, ray.dir) {
+                    for t in [t0, t1].into_iter().filter(|&t| t > t_min && t < bound[i]) {
+                        let normal = (ray.at(t) - s.centre_mm) / s.radius_mm;
+                        hits[i].push(hit(t, normal, material));
+                    }
                 }
             }
         }

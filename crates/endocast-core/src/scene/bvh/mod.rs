@@ -1,5 +1,6 @@
 //! A bounding-volume hierarchy over a mesh's triangles: binned surface-area-heuristic build
-//! (12 bins, leaves of up to four triangles), flat nodes, a stack traversal nearer child first.
+//! (12 bins, leaves of up to four triangles), flat nodes, a stack traversal nearer child first,
+//! one ray or a packet of neighbouring rays at a time ([`packet`]).
 //!
 //! Our own rather than a crate's: the tracer needs *every* hit along a ray up to a distance
 //! that shrinks as opaque hits are found (translucent meshes are composited in depth order),
@@ -7,8 +8,26 @@
 //! the ray meet" (the nearest hit, let alone all hits, is left to the caller) and brings
 //! nalgebra with it; this file is about 250 lines.
 
+mod packet;
+
+pub use packet::PACKET;
+
 use super::mesh::TriangleMesh;
 use glam::Vec3;
+
+/// A ray of a packet ([`Bvh::traverse_packet`]): `origin + t·dir` for `t_min < t < t_max`
+/// (world mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PacketRay {
+    /// Start, world mm.
+    pub origin: Vec3,
+    /// Direction (unit for distances in mm).
+    pub dir: Vec3,
+    /// Distances looked at lie above this.
+    pub t_min: f32,
+    /// Distances looked at lie below this (lowered as the walk's caller asks).
+    pub t_max: f32,
+}
 
 /// Triangles per leaf at most.
 const LEAF_SIZE: usize = 4;
@@ -111,6 +130,8 @@ pub struct Bvh {
     tris: Vec<Tri>,
     /// Original triangle index of each reordered triangle.
     order: Vec<u32>,
+    /// Unit normal of each original triangle (computed in `f64`).
+    normals: Vec<Vec3>,
 }
 
 impl Bvh {
@@ -146,7 +167,18 @@ impl Bvh {
                 }
             })
             .collect();
-        Self { nodes, tris, order }
+        let normals = (0..n)
+            .map(|i| {
+                let [a, b, c] = mesh.corners(i);
+                (b - a).cross(c - a).normalize_or_zero().as_vec3()
+            })
+            .collect();
+        Self {
+            nodes,
+            tris,
+            order,
+            normals,
+        }
     }
 
     /// Calls `on_hit(t, triangle)` for every triangle the ray `origin + t·dir` meets with
@@ -157,87 +189,35 @@ impl Bvh {
         origin: Vec3,
         dir: Vec3,
         t_min: f32,
-        mut t_max: f32,
+        t_max: f32,
         mut on_hit: impl FnMut(f32, u32) -> f32,
     ) {
-        let inv_dir = dir.recip();
-        let mut stack = [0u32; 64];
-        let mut top = 0usize;
-        let mut node = 0usize;
-        if self.nodes[0]
-            .bounds
-            .entry(origin, inv_dir, t_min, t_max)
-            .is_none()
-        {
-            return;
-        }
-        loop {
-            let n = self.nodes[node];
-            if n.count > 0 {
-                let first = n.index as usize;
-                for k in first..first + n.count as usize {
-                    if let Some(t) = self.tris[k].hit(origin, dir, t_min, t_max) {
-                        t_max = on_hit(t, self.order[k]);
-                    }
-                }
-            } else {
-                let (l, r) = (n.index as usize, n.index as usize + 1);
-                let tl = self.nodes[l].bounds.entry(origin, inv_dir, t_min, t_max);
-                let tr = self.nodes[r].bounds.entry(origin, inv_dir, t_min, t_max);
-                match (tl, tr) {
-                    (Some(a), Some(b)) => {
-                        let (near, far) = if a <= b { (l, r) } else { (r, l) };
-                        if top < stack.len() {
-                            stack[top] = far as u32;
-                            top += 1;
-                        }
-                        node = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        node = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = r;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
-            }
-            // Pop the next subtree still in reach.
-            loop {
-                if top == 0 {
-                    return;
-                }
-                top -= 1;
-                let next = stack[top] as usize;
-                if self.nodes[next]
-                    .bounds
-                    .entry(origin, inv_dir, t_min, t_max)
-                    .is_some()
-                {
-                    node = next;
-                    break;
-                }
-            }
-        }
+        let mut ray = [PacketRay {
+            origin,
+            dir,
+            t_min,
+            t_max,
+        }];
+        self.traverse_packet(&mut ray, |_, t, tri| on_hit(t, tri));
     }
 
-    /// The nearest hit in `(t_min, t_max)`: distance and triangle.
+    /// The nearest hit in `(t_min, t_max)`: distance and triangle (the lower index between hits
+    /// at the same distance, as [`Bvh::nearest_each`]).
     pub fn nearest(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<(f32, u32)> {
-        let mut best = None;
-        self.traverse(origin, dir, t_min, t_max, |t, tri| {
-            best = Some((t, tri));
-            t
-        });
-        best
+        let mut ray = [PacketRay {
+            origin,
+            dir,
+            t_min,
+            t_max,
+        }];
+        let mut best = [None];
+        self.nearest_each(&mut ray, &mut best);
+        best[0]
     }
 
     /// The geometric unit normal of (original) triangle `tri` (right-handed corner order).
-    pub fn normal(&self, mesh: &TriangleMesh, tri: u32) -> Vec3 {
-        let [a, b, c] = mesh.corners(tri as usize);
-        (b - a).cross(c - a).normalize_or_zero().as_vec3()
+    pub fn normal(&self, tri: u32) -> Vec3 {
+        self.normals[tri as usize]
     }
 }
 
@@ -417,6 +397,69 @@ mod tests {
             all.sort_by(|a, b| a.0.total_cmp(&b.0));
             assert_eq!(all, expected);
             assert_eq!(bvh.nearest(o, d, 0.0, 1e9), expected.first().copied());
+        }
+    }
+
+    #[test]
+    fn a_packet_of_rays_finds_what_each_ray_finds_alone() {
+        let mut s = 5;
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for k in 0..2000u32 {
+            let c = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) * 40.0;
+            for _ in 0..3 {
+                let d = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) - 0.5;
+                vertices.push(c + d * 4.0);
+            }
+            triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        let mesh = TriangleMesh::new(vertices, triangles).unwrap();
+        let bvh = Bvh::new(&mesh);
+        let eye = Vec3::new(-5.0, 20.0, 20.0);
+        // Rows of a fan of rays (longer than a packet), bounds varying along the row.
+        for row in 0..40 {
+            let mut rays: Vec<PacketRay> = (0..37)
+                .map(|col| PacketRay {
+                    origin: eye,
+                    dir: Vec3::new(1.0, (col as f32 - 18.0) * 0.02, (row as f32 - 20.0) * 0.02)
+                        .normalize(),
+                    t_min: 0.5,
+                    t_max: 20.0 + col as f32,
+                })
+                .collect();
+            let alone: Vec<_> = rays
+                .iter()
+                .map(|r| bvh.nearest(r.origin, r.dir, r.t_min, r.t_max))
+                .collect();
+            let every: Vec<Vec<(f32, u32)>> = rays
+                .iter()
+                .map(|r| {
+                    let mut all = Vec::new();
+                    bvh.traverse(r.origin, r.dir, r.t_min, r.t_max, |t, i| {
+                        all.push((t, i));
+                        r.t_max
+                    });
+                    all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                    all
+                })
+                .collect();
+            let mut packet_every = vec![Vec::new(); rays.len()];
+            let bounds: Vec<f32> = rays.iter().map(|r| r.t_max).collect();
+            bvh.traverse_packet(&mut rays.clone(), |ray, t, i| {
+                packet_every[ray].push((t, i));
+                bounds[ray]
+            });
+            for all in &mut packet_every {
+                all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            }
+            assert_eq!(packet_every, every, "row {row}");
+            let mut best = vec![None; rays.len()];
+            bvh.nearest_each(&mut rays, &mut best);
+            assert_eq!(best, alone, "row {row}");
+            assert!(
+                best.iter().filter(|b| b.is_some()).count() > 3,
+                "row {row} meets little"
+            );
         }
     }
 }
