@@ -121,7 +121,24 @@ fn a_dashboard_flight_writes_one_wide_png_per_frame_and_coverage_grows_backward(
     assert!(forward > 0.3 && forward < 0.99, "forward {forward}");
     assert!(both > forward, "forward {forward}, both {both}");
     assert!(dir.path().join("frames.coverage.png").exists());
-    assert!(dir.path().join("frames.coverage.nii.gz").exists());
+    // The mask counts what the summary counts, pass by pass: 1 seen flying forward, 2 seen
+    // only flying back, 3 never seen.
+    let mask = endocast_io::open(
+        &dir.path().join("frames.coverage.nii.gz"),
+        &endocast_io::OpenOptions::default(),
+    )
+    .unwrap()
+    .volume;
+    let map = mask.value_map();
+    let count = |label: f64| {
+        let here = |s: &&u16| map.physical(**s) == label;
+        mask.voxels().iter().filter(here).count() as u64
+    };
+    let figure = |key: &str| report[key].as_u64().unwrap();
+    let (forward_only, back_only, unseen) = (count(1.0), count(2.0), count(3.0));
+    assert_eq!(forward_only, figure("seen_forward"));
+    assert_eq!(forward_only + back_only, figure("seen_forward_backward"));
+    assert_eq!(forward_only + back_only + unseen, figure("wall_voxels"));
 }
 
 /// The number of samples in an MP4's `stsz` box.

@@ -44,7 +44,7 @@ pub use colon::find_colon;
 pub use distance::DistanceField;
 pub use error::NavError;
 pub use lumen::{Lumen, LumenSide};
-pub use nasal::{find_nasal_cavity, NasalCavity, PASSAGE_HALF_WIDTH_MM};
+pub use nasal::{find_nasal_cavity, NasalCavity, FRONT_SHARE, PASSAGE_HALF_WIDTH_MM};
 pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
 pub use trachea::find_trachea;
