@@ -8,6 +8,7 @@ mod lumen;
 mod optics;
 mod parse;
 mod peel;
+mod pose_args;
 mod progress;
 mod scene_args;
 mod structure;

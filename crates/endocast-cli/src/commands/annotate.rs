@@ -5,6 +5,7 @@
 use crate::look::{in_pool, LookArgs};
 use crate::optics::LensArgs;
 use crate::parse::{parse_size, parse_vec3};
+use crate::pose_args::PoseArgs;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use endocast_core::annotate::{Annotation, Annotations, ScanIdentity, Shape, SurfaceView};
@@ -94,15 +95,8 @@ struct AddArgs {
 /// The view pixels are picked in.
 #[derive(Args, Debug)]
 struct PickView {
-    /// Eye position of the view, world mm.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    eye: Option<[f64; 3]>,
-    /// Point the view looks at, world mm.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    look_at: Option<[f64; 3]>,
-    /// Up direction of the view (default: superior, +z; posterior looking up or down).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    up: Option<[f64; 3]>,
+    #[command(flatten)]
+    pose: PoseArgs,
     /// Field of view, degrees (default: the preset's, else 90).
     #[arg(long, value_name = "DEG")]
     fov: Option<f64>,
@@ -223,12 +217,13 @@ fn annotation(add: &AddArgs, points: &[DVec3]) -> Result<Annotation> {
 
 /// The surface points seen at `pixels` of the view `view` describes.
 fn pick(pixels: &[[f64; 2]], view: &PickView, volume: &Volume) -> Result<Vec<DVec3>> {
-    let (Some(eye), Some(look_at)) = (view.eye, view.look_at) else {
+    let (Some(eye), Some(look_at)) = (view.pose.eye, view.pose.look_at) else {
         bail!("--pixel needs the view: --eye and --look-at");
     };
     let (eye, look_at) = (DVec3::from(eye), DVec3::from(look_at));
     let look = view.look.on_scan(volume)?;
     let up = view
+        .pose
         .up
         .map_or_else(|| default_up(look_at - eye), DVec3::from);
     let (lo, hi) = volume.geometry().world_bounds();

@@ -5,7 +5,8 @@ use crate::input::InputArgs;
 use crate::look::{in_pool, LookArgs};
 use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
-use crate::parse::{parse_pixel, parse_size, parse_vec3};
+use crate::parse::{parse_pixel, parse_size};
+use crate::pose_args::PoseArgs;
 use crate::scene_args::SceneArgs;
 use crate::structure;
 use anyhow::{bail, Context, Result};
@@ -47,17 +48,8 @@ pub struct RenderArgs {
     scene: SceneArgs,
     #[command(flatten)]
     case: CaseArgs,
-    /// Eye position, world mm (LPS, as `endocast info` reports). Without it, an endoscopic
-    /// preset looks along the largest lumen from its most central point; otherwise the view
-    /// frames the whole volume from the front.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    eye: Option<[f64; 3]>,
-    /// Point looked at, world mm (needed with --eye).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    look_at: Option<[f64; 3]>,
-    /// Up direction (default: superior, +z; posterior when looking up or down).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    up: Option<[f64; 3]>,
+    #[command(flatten)]
+    pose: PoseArgs,
     /// Vertical field of view in degrees: 10–170 for a pinhole, up to 360 for a fisheye
     /// (default: the preset's, else 90; fisheye 170); view height in mm for orthographic.
     #[arg(long, value_name = "DEG")]
@@ -212,7 +204,7 @@ fn camera(
     let fov_deg = args
         .fov
         .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
-    let (eye, look_at, up, view) = match (args.eye, args.look_at) {
+    let (eye, look_at, up, view) = match (args.pose.eye, args.pose.look_at) {
         (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None, None),
         (None, None) => {
             let view = default_pose(args, preset, volume, settings, fov_deg);
@@ -222,6 +214,7 @@ fn camera(
         _ => bail!("--eye and --look-at go together"),
     };
     let up = args
+        .pose
         .up
         .map(DVec3::from)
         .or(up)

@@ -1,7 +1,7 @@
 //! `endocast view`: the interactive workstation (see the `endocast-viewer` crate).
 
 use crate::look::find_preset;
-use crate::parse::parse_vec3;
+use crate::pose_args::PoseArgs;
 use anyhow::{bail, Result};
 use clap::Args;
 use endocast_core::pose::Pose;
@@ -30,15 +30,8 @@ pub struct ViewArgs {
     /// Reopen a case file (its scan, view, key frames and marks); it is autosaved there.
     #[arg(long, value_name = "FILE.json")]
     case: Option<PathBuf>,
-    /// Start with the eye here, world mm (default: inside the preset's largest lumen).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    eye: Option<[f64; 3]>,
-    /// The point looked at first, world mm (with --eye).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    look_at: Option<[f64; 3]>,
-    /// Up direction of the first view (default: superior, +z).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
-    up: Option<[f64; 3]>,
+    #[command(flatten)]
+    pose: PoseArgs,
     /// Write a screenshot of the window (PNG) once the view has refined, then quit.
     #[arg(long, value_name = "FILE.png")]
     screenshot: Option<PathBuf>,
@@ -64,11 +57,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         },
         (None, None, None) => bail!("give a scan, --phantom NAME or --case FILE"),
     };
-    let pose = match (args.eye, args.look_at) {
+    let pose = match (args.pose.eye, args.pose.look_at) {
         (Some(eye), Some(at)) => Some(Pose {
             eye_mm: DVec3::from_array(eye),
             look_at_mm: DVec3::from_array(at),
-            up: DVec3::from_array(args.up.unwrap_or([0.0, 0.0, 1.0])),
+            up: DVec3::from_array(args.pose.up.unwrap_or([0.0, 0.0, 1.0])),
         }),
         (None, None) => None,
         _ => bail!("--eye and --look-at go together"),
