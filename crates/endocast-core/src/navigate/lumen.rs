@@ -134,19 +134,8 @@ impl Lumen {
         threshold: f64,
         side: LumenSide,
     ) -> Result<Self, NavError> {
-        check_finite("threshold", threshold, false)?;
+        check_seed(volume, seed, threshold, side, || true)?;
         let dims = volume.dims();
-        let value = volume
-            .physical(seed[0], seed[1], seed[2])
-            .ok_or(NavError::SeedOutside { seed, dims })?;
-        if !side.holds(value, threshold) {
-            return Err(NavError::SeedInWall {
-                seed,
-                value,
-                side,
-                threshold,
-            });
-        }
         let test = ValueTest::new(volume.value_map(), threshold, side);
         let mut visited = BitGrid::new(dims);
         let component = fill(dims, test.on(volume), seed, &mut visited);
@@ -166,19 +155,8 @@ impl Lumen {
         side: LumenSide,
         allowed: &BitGrid,
     ) -> Result<Self, NavError> {
-        check_finite("threshold", threshold, false)?;
+        check_seed(volume, seed, threshold, side, || allowed.get(seed))?;
         let dims = volume.dims();
-        let value = volume
-            .physical(seed[0], seed[1], seed[2])
-            .ok_or(NavError::SeedOutside { seed, dims })?;
-        if !side.holds(value, threshold) || !allowed.get(seed) {
-            return Err(NavError::SeedInWall {
-                seed,
-                value,
-                side,
-                threshold,
-            });
-        }
         let test = ValueTest::new(volume.value_map(), threshold, side);
         let on_side = test.on(volume);
         let mut visited = BitGrid::new(dims);
@@ -543,6 +521,31 @@ fn fill(
         }
     }
     c
+}
+
+/// Checks that `seed` lies in the volume and in the lumen: on `side` of a finite `threshold`
+/// and where `inside` (asked only for a seed in the volume) says the lumen may be.
+fn check_seed(
+    volume: &Volume,
+    seed: [usize; 3],
+    threshold: f64,
+    side: LumenSide,
+    inside: impl FnOnce() -> bool,
+) -> Result<(), NavError> {
+    check_finite("threshold", threshold, false)?;
+    let dims = volume.dims();
+    let value = volume
+        .physical(seed[0], seed[1], seed[2])
+        .ok_or(NavError::SeedOutside { seed, dims })?;
+    if !side.holds(value, threshold) || !inside() {
+        return Err(NavError::SeedInWall {
+            seed,
+            value,
+            side,
+            threshold,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
