@@ -27,6 +27,8 @@ pub mod pose;
 pub mod presets;
 pub mod render;
 pub mod scene;
+#[cfg(test)]
+mod test_rng;
 pub mod tissue;
 pub mod views;
 pub mod volume;

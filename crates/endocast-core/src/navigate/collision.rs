@@ -104,8 +104,8 @@ impl<'a> Collider<'a> {
 mod tests {
     use super::*;
     use crate::navigate::lumen::{Lumen, LumenSide};
-    use crate::navigate::test_util::Rng;
     use crate::phantom::{self, PhantomOptions, Tube};
+    use crate::test_rng::Rng;
     use crate::Volume;
 
     fn tube(size: usize) -> (Volume, Tube, DistanceField) {

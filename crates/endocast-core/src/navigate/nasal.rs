@@ -8,6 +8,7 @@
 
 use super::distance::DistanceField;
 use super::lumen::{BitGrid, Lumen, LumenSide};
+use super::section::neighbours4;
 use crate::Volume;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -131,13 +132,7 @@ fn holes_of(open: &[bool], nx: usize, ny: usize) -> Vec<bool> {
             continue;
         }
         outside[n] = true;
-        let (i, j) = (n % nx, n / nx);
-        let neighbours = [
-            (i > 0).then(|| n - 1),
-            (i + 1 < nx).then_some(n + 1),
-            (j > 0).then(|| n - nx),
-            (j + 1 < ny).then_some(n + nx),
-        ];
+        let neighbours = neighbours4(n, nx, ny);
         stack.extend(
             neighbours
                 .into_iter()

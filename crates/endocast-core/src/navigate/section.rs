@@ -86,13 +86,7 @@ pub(crate) fn sections(
         let mut stack = vec![start];
         while let Some(n) = stack.pop() {
             pixels.push(n);
-            let (i, j) = (n % nx, n / nx);
-            let neighbours = [
-                (i > 0).then(|| n - 1),
-                (i + 1 < nx).then_some(n + 1),
-                (j > 0).then(|| n - nx),
-                (j + 1 < ny).then_some(n + nx),
-            ];
+            let neighbours = neighbours4(n, nx, ny);
             for m in neighbours.into_iter().flatten() {
                 if open[m] && !seen[m] {
                     seen[m] = true;
@@ -145,6 +139,17 @@ pub(crate) fn top_is_last(volume: &Volume) -> bool {
     let g = volume.geometry();
     let last = volume.dims()[2].saturating_sub(1) as f64;
     g.world_of(glam::DVec3::new(0.0, 0.0, last)).z > g.world_of(glam::DVec3::ZERO).z
+}
+
+/// The 4-connected neighbours of pixel `n` in an `nx` × `ny` slice (`None` past its border).
+pub(crate) fn neighbours4(n: usize, nx: usize, ny: usize) -> [Option<usize>; 4] {
+    let (i, j) = (n % nx, n / nx);
+    [
+        (i > 0).then(|| n - 1),
+        (i + 1 < nx).then_some(n + 1),
+        (j > 0).then(|| n - nx),
+        (j + 1 < ny).then_some(n + nx),
+    ]
 }
 
 #[cfg(test)]

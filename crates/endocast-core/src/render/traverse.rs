@@ -173,15 +173,7 @@ pub(crate) fn ray_f32(ray: &VoxelRay) -> (Vec3, Vec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Splitmix64: a deterministic stream for the property test.
-    fn random(state: &mut u64) -> f64 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::test_rng::Rng;
 
     fn check_walk(ray: &VoxelRay, dims: [usize; 3]) {
         let extent = DVec3::from(dims.map(|n| (n - 1) as f64));
@@ -220,10 +212,10 @@ mod tests {
 
     #[test]
     fn segments_are_contiguous_and_cover_the_box_interval() {
-        let mut state = 7;
+        let mut rng = Rng::new(7);
         let dims = [37, 20, 29];
         for _ in 0..2000 {
-            let mut r = || random(&mut state);
+            let mut r = || rng.unit();
             let origin = DVec3::new(r() * 60.0 - 10.0, r() * 40.0 - 10.0, r() * 50.0 - 10.0);
             let direction = DVec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize() * (0.5 + r());
             check_walk(&VoxelRay { origin, direction }, dims);

@@ -341,26 +341,18 @@ impl Builder<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rng::Rng;
     use glam::DVec3;
-
-    /// Splitmix64 in [0, 1).
-    fn random(state: &mut u64) -> f64 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
 
     #[test]
     fn every_hit_equals_brute_force() {
-        let mut s = 11;
+        let mut s = Rng::new(11);
         let mut vertices = Vec::new();
         let mut triangles = Vec::new();
         for k in 0..500u32 {
-            let c = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) * 40.0;
+            let c = DVec3::new(s.unit(), s.unit(), s.unit()) * 40.0;
             for _ in 0..3 {
-                let d = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) - 0.5;
+                let d = DVec3::new(s.unit(), s.unit(), s.unit()) - 0.5;
                 vertices.push(c + d * 6.0);
             }
             triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
@@ -378,9 +370,8 @@ mod tests {
             })
             .collect();
         for _ in 0..300 {
-            let o = (DVec3::new(random(&mut s), random(&mut s), random(&mut s)) * 60.0 - 10.0)
-                .as_vec3();
-            let d = (DVec3::new(random(&mut s), random(&mut s), random(&mut s)) - 0.5)
+            let o = (DVec3::new(s.unit(), s.unit(), s.unit()) * 60.0 - 10.0).as_vec3();
+            let d = (DVec3::new(s.unit(), s.unit(), s.unit()) - 0.5)
                 .normalize()
                 .as_vec3();
             let mut expected: Vec<(f32, u32)> = tris
@@ -402,13 +393,13 @@ mod tests {
 
     #[test]
     fn a_packet_of_rays_finds_what_each_ray_finds_alone() {
-        let mut s = 5;
+        let mut s = Rng::new(5);
         let mut vertices = Vec::new();
         let mut triangles = Vec::new();
         for k in 0..2000u32 {
-            let c = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) * 40.0;
+            let c = DVec3::new(s.unit(), s.unit(), s.unit()) * 40.0;
             for _ in 0..3 {
-                let d = DVec3::new(random(&mut s), random(&mut s), random(&mut s)) - 0.5;
+                let d = DVec3::new(s.unit(), s.unit(), s.unit()) - 0.5;
                 vertices.push(c + d * 4.0);
             }
             triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
