@@ -86,9 +86,9 @@ fn main() {
     let mut first_ms: Vec<f64> = first.iter().map(|(d, _)| ms(*d)).collect();
     let mut full_ms: Vec<f64> = full.iter().map(|d| ms(*d)).collect();
     println!(
-        "colon phantom {size}, 512x512, {} poses along the centreline, first stage {:?}",
+        "colon phantom {size}, 512x512, {} poses along the centreline, first stages: {}",
         first.len(),
-        first.first().map(|f| f.1)
+        stage_counts(first.iter().map(|f| f.1))
     );
     report("input -> first frame (moving quality)", &mut first_ms);
     report("input -> full-quality frame", &mut full_ms);
@@ -128,4 +128,17 @@ fn report(what: &str, values: &mut [f64]) {
         q(0.9),
         q(1.0)
     );
+}
+
+/// "Preview(Eighth) ×29, Preview(Quarter) ×1": how often each stage came first.
+fn stage_counts(stages: impl Iterator<Item = Stage>) -> String {
+    let mut counts: Vec<(String, usize)> = Vec::new();
+    for stage in stages.map(|s| format!("{s:?}")) {
+        match counts.iter_mut().find(|(s, _)| *s == stage) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((stage, 1)),
+        }
+    }
+    let parts: Vec<String> = counts.iter().map(|(s, n)| format!("{s} ×{n}")).collect();
+    parts.join(", ")
 }

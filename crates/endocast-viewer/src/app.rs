@@ -19,7 +19,6 @@ use crate::view::view_ui;
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::progressive::Stage;
-use endocast_core::render::Quality;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
@@ -327,7 +326,6 @@ fn frame_status(ready: &Ready) -> String {
     let frame = session.worker().with_latest(|f| {
         f.map(|f| {
             let stage = match f.stage {
-                Stage::Preview(Quality::Quarter) => "quarter".to_owned(),
                 Stage::Preview(q) => q.name().to_owned(),
                 Stage::Full => "full".to_owned(),
                 Stage::Still(n) => format!("still ×{n}"),

@@ -11,7 +11,7 @@
 use crate::geometry::SceneRef;
 use crate::jobs::Notify;
 use endocast_core::camera::StereoRig;
-use endocast_core::render::progressive::{progressive, ProgressiveOptions, Stage};
+use endocast_core::render::progressive::{progressive, PreviewPlanner, ProgressiveOptions, Stage};
 use endocast_core::render::{
     Camera, Cancelled, Frame, Layers, Prepared, Progress, Quality, RenderOptions, RenderSettings,
     Renderer,
@@ -28,6 +28,10 @@ type Deliver<'a> = dyn Fn(Stage, Image, &[f32], Duration) + 'a;
 
 /// Frames averaged into the still when the view stands (the full frame included).
 pub const STILL_FRAMES: usize = 8;
+
+/// The time the first preview after an input may take: a mode whose quarter-resolution frame
+/// is predicted to take longer starts at an eighth of the resolution.
+pub const PREVIEW_BUDGET: Duration = Duration::from_millis(25);
 
 /// What the UI wants on screen.
 #[derive(Debug, Clone, PartialEq)]
@@ -210,6 +214,7 @@ impl Drop for RenderWorker {
 fn run(shared: &Shared, renderer: &Arc<Renderer>) {
     let mut prepared: Option<Prepared> = None;
     let mut scene = SceneRef::default();
+    let mut planner = PreviewPlanner::default();
     while let Some(request) = next_request(shared) {
         let settings = &request.view.settings;
         let ready = match prepared.as_mut() {
@@ -230,7 +235,7 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
         }
         if let Some(p) = &prepared {
             // A superseded frame simply ends; the next request is already waiting.
-            let _ = render_request(shared, p, &request);
+            let _ = render_request(shared, p, &request, &mut planner);
         }
     }
 }
@@ -256,6 +261,7 @@ fn render_request(
     shared: &Shared,
     prepared: &Prepared,
     request: &Request,
+    planner: &mut PreviewPlanner,
 ) -> Result<(), Cancelled> {
     let view = &request.view;
     let deliver = |stage: Stage, image: Image, depth_mm: &[f32], time: Duration| {
@@ -280,7 +286,7 @@ fn render_request(
         None => {
             let options = ProgressiveOptions {
                 previews: if view.moving {
-                    vec![Quality::Quarter, Quality::Half]
+                    planner.previews(view.camera.size(), PREVIEW_BUDGET)
                 } else {
                     vec![Quality::Half]
                 },
@@ -294,6 +300,7 @@ fn render_request(
                 request.generation,
                 &options,
                 |stage, frame| {
+                    planner.observe(stage, frame);
                     if let Ok(image) = Image::from_frame(frame, background) {
                         deliver(stage, image, &frame.depth_mm, frame.stats.time);
                     }

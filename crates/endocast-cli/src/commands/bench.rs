@@ -51,7 +51,7 @@ pub struct BenchArgs {
     /// Vertical field of view in degrees (default: the preset's, else 90).
     #[arg(long, value_name = "DEG")]
     fov: Option<f64>,
-    /// Cast rays at full, half or quarter resolution (upsampled to --image, edge-aware).
+    /// Cast rays at full, half, quarter or eighth resolution (upsampled to --image, edge-aware).
     #[arg(long, default_value = "full", value_parser = parse_quality)]
     quality: Quality,
     #[command(flatten)]
@@ -246,7 +246,8 @@ fn measure_look(
 
 /// A `--quality` level by name.
 fn parse_quality(name: &str) -> Result<Quality, String> {
-    Quality::from_name(name).ok_or_else(|| format!("{name:?}: expected full, half or quarter"))
+    Quality::from_name(name)
+        .ok_or_else(|| format!("{name:?}: expected full, half, quarter or eighth"))
 }
 
 /// The colon phantom, its fly path, and the paper's table cells.

@@ -422,3 +422,42 @@ fn reduced_quality_takes_any_size_and_field_of_view() {
         }
     }
 }
+
+#[test]
+fn the_preview_planner_starts_an_expensive_view_at_an_eighth() {
+    use super::progressive::PreviewPlanner;
+    use std::time::Duration;
+    let budget = Duration::from_millis(25);
+    let mut planner = PreviewPlanner::default();
+    // Nothing measured yet: quarter first.
+    assert_eq!(
+        planner.previews([512, 512], budget),
+        [Quality::Quarter, Quality::Half]
+    );
+    let frame = |time_ms: u64| Frame {
+        width: 512,
+        height: 512,
+        stats: RenderStats {
+            time: Duration::from_millis(time_ms),
+            ..RenderStats::default()
+        },
+        ..Frame::default()
+    };
+    // A full frame of 800 ms: a quarter would take 50 ms, over the budget.
+    planner.observe(Stage::Full, &frame(800));
+    assert_eq!(
+        planner.predict(Quality::Quarter, [512, 512]),
+        Some(Duration::from_millis(50))
+    );
+    assert_eq!(
+        planner.previews([512, 512], budget),
+        [Quality::Eighth, Quality::Quarter, Quality::Half]
+    );
+    // The mode became cheap: a 3 ms eighth predicts a 12 ms quarter.
+    planner.observe(Stage::Preview(Quality::Eighth), &frame(3));
+    assert_eq!(planner.previews([512, 512], budget)[0], Quality::Quarter);
+    // Stills and empty frames teach nothing.
+    planner.observe(Stage::Still(4), &frame(10_000));
+    planner.observe(Stage::Full, &frame(0));
+    assert_eq!(planner.previews([512, 512], budget)[0], Quality::Quarter);
+}

@@ -81,7 +81,7 @@ use crate::camera::Ray;
 pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
 pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
 pub use options::{Cancelled, Progress, Quality, RenderOptions};
-pub use progressive::progressive;
+pub use progressive::{progressive, PreviewPlanner};
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
 pub use settings::{
     Crossing, Mode, PeelLayer, PeelSettings, RenderSettings, SettingsError, Unpeeled,

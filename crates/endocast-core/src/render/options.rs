@@ -33,18 +33,22 @@ pub enum Quality {
     Half,
     /// A quarter of the width and height (a sixteenth of the rays).
     Quarter,
+    /// An eighth of the width and height (a sixty-fourth of the rays): the first preview of
+    /// an expensive view while the camera moves.
+    Eighth,
 }
 
 impl Quality {
     /// Every level, coarsest first.
-    pub const ALL: [Quality; 3] = [Self::Quarter, Self::Half, Self::Full];
+    pub const ALL: [Quality; 4] = [Self::Eighth, Self::Quarter, Self::Half, Self::Full];
 
-    /// How many full-resolution pixels one ray stands for along each edge: 1, 2 or 4.
+    /// How many full-resolution pixels one ray stands for along each edge: 1, 2, 4 or 8.
     pub fn factor(self) -> usize {
         match self {
             Self::Full => 1,
             Self::Half => 2,
             Self::Quarter => 4,
+            Self::Eighth => 8,
         }
     }
 
@@ -54,12 +58,13 @@ impl Quality {
         [width.div_ceil(f).max(1), height.div_ceil(f).max(1)]
     }
 
-    /// The name the CLI uses: `full`, `half`, `quarter`.
+    /// The name the CLI uses: `full`, `half`, `quarter`, `eighth`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Full => "full",
             Self::Half => "half",
             Self::Quarter => "quarter",
+            Self::Eighth => "eighth",
         }
     }
 

@@ -38,6 +38,7 @@ use super::options::{Cancelled, Progress, Quality, RenderOptions};
 use super::still::Still;
 use super::{Camera, Prepared};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Duration;
 
 /// A finished level the driver delivers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -114,4 +115,51 @@ pub fn progressive(
         deliver(Stage::Still(still.frames()), still.frame());
     }
     Ok(())
+}
+
+/// Picks the previews of a moving view from what the last frames cost, so that the first
+/// picture after an input arrives within a time budget whatever the mode: a cheap opaque wall
+/// starts at a quarter of the resolution, an expensive translucent view at an eighth.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PreviewPlanner {
+    /// Wall seconds per cast pixel of the last frame observed (none before the first).
+    seconds_per_pixel: Option<f64>,
+}
+
+impl PreviewPlanner {
+    /// Learns the cost of a delivered frame rendered at `quality` (its time over the pixels
+    /// cast at that level). Stills say nothing new and are ignored.
+    pub fn observe(&mut self, stage: Stage, frame: &Frame) {
+        let quality = match stage {
+            Stage::Preview(quality) => quality,
+            Stage::Full => Quality::Full,
+            Stage::Still(_) => return,
+        };
+        let [w, h] = quality.reduced_size([frame.width, frame.height]);
+        let seconds = frame.stats.time.as_secs_f64();
+        if w * h > 0 && seconds.is_finite() && seconds > 0.0 {
+            self.seconds_per_pixel = Some(seconds / (w * h) as f64);
+        }
+    }
+
+    /// The predicted wall time of a frame of `size` at `quality` (none before the first
+    /// observation).
+    pub fn predict(&self, quality: Quality, size: [usize; 2]) -> Option<Duration> {
+        let [w, h] = quality.reduced_size(size);
+        let seconds = self.seconds_per_pixel? * (w * h) as f64;
+        Duration::try_from_secs_f64(seconds).ok()
+    }
+
+    /// The previews before the full frame of a moving view of `size`: quarter then half, led
+    /// by an eighth when a quarter is predicted to take longer than `budget`.
+    pub fn previews(&self, size: [usize; 2], budget: Duration) -> Vec<Quality> {
+        let slow = self
+            .predict(Quality::Quarter, size)
+            .is_some_and(|t| t > budget);
+        let mut previews = vec![Quality::Quarter, Quality::Half];
+        if slow {
+            previews.insert(0, Quality::Eighth);
+        }
+        previews
+    }
 }
