@@ -31,7 +31,10 @@ pub struct GBuffer {
     pub normal: Vec<[f32; 3]>,
     /// Secretion in front of the tissue along the ray, mm: the distance from the first
     /// secretion hit to the tissue ([`SecretionMode::On`]) or the length of the ray above the
-    /// secretion threshold ([`SecretionMode::Accumulate`]); 0 without secretion.
+    /// secretion threshold ([`SecretionMode::Accumulate`]); 0 without secretion. The tissue's
+    /// own blurred edge, which passes both thresholds on the way into bare tissue too, is not
+    /// counted: a last stretch into the tissue no longer than a bare edge's (from the value's
+    /// slope at the hit) is left out, so bare walls carry no film of secretion.
     pub secretion_mm: Vec<f32>,
     /// The ray pass's counters (its time included).
     pub stats: RenderStats,

@@ -12,6 +12,15 @@ use glam::{DAffine3, DVec3, Vec3};
 /// stop at 1/32 voxel), far below the 0.1 voxel the secretion must be measured to.
 const REFINE_STEPS: u32 = 4;
 
+/// A last stretch into the tissue up to this many times a bare edge's crossing of the band
+/// between the thresholds is the tissue's own edge, not secretion (a Gaussian-blurred edge
+/// takes about 0.9 of the linear estimate).
+const EDGE_MAX: f32 = 1.2;
+
+/// From this many times a bare edge's crossing on, the last stretch is all secretion (the
+/// layered phantom's thinnest layer, 3 voxels between two 2-voxel ramps, takes 1.56).
+const LAYER_MIN: f32 = 1.5;
+
 /// The tissue behind a secretion hit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct TissueHit {
@@ -84,11 +93,14 @@ impl<'a> Continuation<'a> {
         std::array::from_fn(|k| {
             let (origin, dir, t_secretion) = lanes.found[k].then_some(rays[k]?)?;
             let t_hit = t_hit[k];
-            let secretion_mm = if self.accumulate {
+            let measured = if self.accumulate {
                 lanes.inside[k] + self.inside_secretion(lanes.before[k], (t_hit, self.tissue))
             } else {
                 t_hit - t_secretion
             };
+            let edge = t_hit - lanes.entered[k];
+            let slope = gradients[k].dot(lanes.d[k]);
+            let secretion_mm = (measured - self.own_edge(edge, slope)).max(0.0);
             let hit = origin + dir * f64::from(t_hit);
             Some(TissueHit {
                 depth_mm: t_hit,
@@ -145,6 +157,9 @@ impl<'a> Continuation<'a> {
                     if self.accumulate {
                         lanes.inside[k] += self.inside_secretion(here, next);
                     }
+                    if !self.past(here.1, self.secretion) && self.past(next.1, self.secretion) {
+                        lanes.entered[k] = crossing(here, next, self.secretion);
+                    }
                     (lanes.t[k], lanes.v[k]) = next;
                 }
             }
@@ -166,16 +181,25 @@ impl<'a> Continuation<'a> {
                 }
             }
         }
-        std::array::from_fn(|k| {
-            let (before, after) = (before[k], after[k]);
-            let (dv, iso) = (after.1 - before.1, self.tissue);
-            let f = if dv == 0.0 {
-                1.0
-            } else {
-                ((iso - before.1) / dv).clamp(0.0, 1.0)
-            };
-            before.0 + f * (after.0 - before.0)
-        })
+        std::array::from_fn(|k| crossing(before[k], after[k], self.tissue))
+    }
+
+    /// How much of the last stretch into the tissue, `edge_mm` long (from where the ray last
+    /// crossed the secretion threshold to the tissue's), is the tissue's own edge rather than
+    /// secretion, given the value's `slope` along the ray at the tissue (stored units per mm).
+    ///
+    /// A scan blurs every air–tissue boundary, so the value passes both thresholds on the way
+    /// into bare tissue too: a film of "secretion" on every wall, thickest where the ray meets
+    /// the wall obliquely or the voxels are coarse. A bare edge crosses the band between the
+    /// thresholds at about the slope it has at the tissue, in `|tissue − secretion| / slope`;
+    /// a real layer lingers between them (a plateau) and takes longer. The stretch counts as
+    /// secretion once it takes over [`LAYER_MIN`] times a bare edge's crossing, not at all
+    /// under [`EDGE_MAX`] times, smoothly between.
+    fn own_edge(&self, edge_mm: f32, slope: f32) -> f32 {
+        let bare = (self.tissue - self.secretion).abs() / slope.abs().max(f32::MIN_POSITIVE);
+        let x = ((edge_mm / bare - EDGE_MAX) / (LAYER_MIN - EDGE_MAX)).clamp(0.0, 1.0);
+        let layer = x * x * (3.0 - 2.0 * x);
+        (1.0 - layer) * edge_mm.max(0.0)
     }
 
     /// Whether stored value `v` lies past threshold `iso` on the tissue's side.
@@ -203,6 +227,18 @@ impl<'a> Continuation<'a> {
     }
 }
 
+/// Where the value, taken as linear from `before` to `after` (distance, value), reaches
+/// `iso` (`after`'s distance when it does not change).
+fn crossing(before: (f32, f32), after: (f32, f32), iso: f32) -> f32 {
+    let dv = after.1 - before.1;
+    let f = if dv == 0.0 {
+        1.0
+    } else {
+        ((iso - before.1) / dv).clamp(0.0, 1.0)
+    };
+    before.0 + f * (after.0 - before.0)
+}
+
 /// Eight rays' continuations in lockstep.
 #[derive(Default)]
 struct Lanes8 {
@@ -222,6 +258,9 @@ struct Lanes8 {
     after: [(f32, f32); 8],
     /// Length inside the secretion so far ([`SecretionMode::Accumulate`]).
     inside: [f32; 8],
+    /// Where the ray last crossed into the secretion: its first secretion hit, or later
+    /// where it came back into it after a stretch of air.
+    entered: [f32; 8],
 }
 
 impl Lanes8 {
@@ -229,6 +268,7 @@ impl Lanes8 {
     fn start(&mut self, k: usize, lane: Option<(Vec3, Vec3, f32, f64)>) {
         if let Some((o, d, t, t_end)) = lane {
             (self.o[k], self.d[k], self.t[k], self.t_end[k]) = (o, d, t, t_end);
+            self.entered[k] = t;
             self.marching[k] = true;
         }
     }
