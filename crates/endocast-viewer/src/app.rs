@@ -157,8 +157,11 @@ impl ViewerApp {
                 self.message = e;
                 self.loading = None;
             }
-            Some(Ok((session, case))) => {
+            Some(Ok((session, case, problems))) => {
                 self.message = format!("opened {}", loading.what);
+                for problem in problems {
+                    self.message += &format!("; mesh not read: {problem}");
+                }
                 let path = case.unwrap_or_else(|| default_case_path(&session.scene().source));
                 self.ready = Some(Ready {
                     session,

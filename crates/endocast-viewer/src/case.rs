@@ -4,7 +4,7 @@
 //! made from a session and applied to one, and autosaved.
 
 use crate::controller::FlyCamera;
-use crate::geometry::Toggles;
+use crate::geometry::{with_mesh, Toggles};
 use crate::session::{Controls, Session};
 use endocast_core::animation::KeyFrame;
 use endocast_core::camera::Projection;
@@ -43,7 +43,7 @@ fn fly_camera(c: &CaseCamera) -> Option<FlyCamera> {
     FlyCamera::new(v(c.eye), v(c.forward), v(c.up))
 }
 
-fn controls_of(c: &Controls) -> CaseControls {
+fn controls_of(c: &Controls, mesh_files: &[PathBuf]) -> CaseControls {
     CaseControls {
         preset: c.preset.name.into(),
         mode: c.mode.name().into(),
@@ -58,20 +58,21 @@ fn controls_of(c: &Controls) -> CaseControls {
         window_width_hu: c.window.width_hu,
         tf: Some(CaseTransfer::from(&c.tf)),
         peel: Some(CasePeel::of(&c.peel)),
-        geometry: Some(geometry_of(c.geometry)),
+        geometry: Some(geometry_of(c.geometry, mesh_files)),
     }
 }
 
-fn geometry_of(t: Toggles) -> CaseGeometry {
+fn geometry_of(t: Toggles, mesh_files: &[PathBuf]) -> CaseGeometry {
     CaseGeometry {
         grid: t.grid,
         endoscope: t.endoscope,
         markers: t.markers,
         meshes: t.meshes,
+        mesh_files: mesh_files.to_vec(),
     }
 }
 
-fn toggles(g: CaseGeometry) -> Toggles {
+fn toggles(g: &CaseGeometry) -> Toggles {
     Toggles {
         grid: g.grid,
         endoscope: g.endoscope,
@@ -84,7 +85,8 @@ impl SessionCase for Case {
     fn of(session: &Session, revision: u64) -> Self {
         let scene = session.scene();
         let mut case = Case::new(scene.source.clone(), Some(&scene.identity));
-        case.controls = Some(controls_of(&session.controls));
+        let mesh_files = session.geometry().mesh_files();
+        case.controls = Some(controls_of(&session.controls, mesh_files));
         case.camera = Some(camera_of(session.fly_camera()));
         case.key_frames = session.key_frames().iter().map(key_to_case).collect();
         case.set_annotations(session.marks());
@@ -124,7 +126,7 @@ impl SessionCase for Case {
             window,
             tf: tf.map_err(to_case_error)?,
             peel: peel.map_err(to_case_error)?,
-            geometry: c.geometry.map(toggles).unwrap_or_default(),
+            geometry: c.geometry.as_ref().map(toggles).unwrap_or_default(),
         }))
     }
 
@@ -154,6 +156,22 @@ impl SessionCase for Case {
         session.set_marks(marks);
         Ok(())
     }
+}
+
+/// Reads again the meshes `case` lists into `session` (after [`SessionCase::apply`]; slow for
+/// large meshes, so off the UI thread). A mesh that cannot be read is skipped, not fatal: the
+/// case still opens, and the returned lines say which and why.
+pub fn read_case_meshes(case: &Case, session: &mut Session) -> Vec<String> {
+    let files = case.controls.as_ref().and_then(|c| c.geometry.as_ref());
+    let mut problems = Vec::new();
+    for file in files.map_or(&[][..], |g| &g.mesh_files) {
+        let meshes = session.geometry_mut().meshes().clone();
+        match with_mesh(meshes, file) {
+            Ok(meshes) => session.geometry_mut().set_meshes(meshes, file.clone()),
+            Err(e) => problems.push(format!("{}: {e}", file.display())),
+        }
+    }
+    problems
 }
 
 fn key_to_case(k: &KeyFrame) -> CaseKeyFrame {

@@ -63,10 +63,11 @@ impl Geometry {
         &self.meshes
     }
 
-    /// Takes `meshes` (the old ones and the one read from `file`, from [`with_mesh`]).
+    /// Takes `meshes` (the old ones and the one read from `file`, from [`with_mesh`]); the
+    /// file is kept absolute, so that a case saved elsewhere still finds it.
     pub fn set_meshes(&mut self, meshes: Scene, file: PathBuf) {
         self.meshes = meshes;
-        self.files.push(file);
+        self.files.push(std::path::absolute(&file).unwrap_or(file));
     }
 
     /// The files of the meshes read.

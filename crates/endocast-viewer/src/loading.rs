@@ -2,7 +2,7 @@
 //! meanwhile: what is read and for how long, for a DICOM folder how many of its files are
 //! done, then the view being prepared. The window stays usable (the open session too).
 
-use crate::case::{Case, SessionCase};
+use crate::case::{read_case_meshes, Case, SessionCase};
 use crate::scene::{ScanSource, Scene};
 use crate::session::Session;
 use endocast_core::pose::Pose;
@@ -14,8 +14,9 @@ use std::sync::mpsc::{channel, Receiver, TryRecvError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// A session opened, and the case file it came from.
-pub(crate) type Opened = (Session, Option<PathBuf>);
+/// A session opened, the case file it came from, and what of the case could not be restored
+/// (a mesh file gone).
+pub(crate) type Opened = (Session, Option<PathBuf>, Vec<String>);
 
 /// What to open: a scan, or a case file and its scan.
 pub(crate) struct Request {
@@ -142,10 +143,12 @@ fn load(
     let scene = Arc::new(Scene::new(source, volume).with_series(series));
     let repaint = ctx.clone();
     let mut session = Session::new(scene, preset, pose, move || repaint.request_repaint());
+    let mut problems = Vec::new();
     if let (Some(file), Some(path)) = (&case_file, &case) {
         file.apply(&mut session, path).map_err(|e| e.to_string())?;
+        problems = read_case_meshes(file, &mut session);
     }
-    Ok((session, case))
+    Ok((session, case, problems))
 }
 
 #[cfg(test)]

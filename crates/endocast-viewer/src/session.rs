@@ -257,6 +257,11 @@ impl Session {
         })
     }
 
+    /// The meshes read and the scene last built from the geometry toggles.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
     /// The meshes read and the scene built from the geometry toggles.
     pub fn geometry_mut(&mut self) -> &mut Geometry {
         &mut self.geometry

@@ -263,3 +263,55 @@ fn killing_during_autosave_loses_nothing_saved_before() {
         );
     }
 }
+
+#[test]
+fn a_case_reads_its_meshes_again_and_opens_without_one_that_is_gone() {
+    use endocast_core::scene::TriangleMesh;
+    use endocast_viewer::case::read_case_meshes;
+    use endocast_viewer::geometry::with_mesh;
+    let dir = tempfile::tempdir().unwrap();
+    let (path, stl) = (
+        dir.path().join("mesh.endocast-case.json"),
+        dir.path().join("t.stl"),
+    );
+    let (mut session, _) = tube_session();
+    // A triangle across the view, 3 mm ahead of the eye.
+    let camera = session.fly_camera();
+    let (eye, f, u) = (camera.eye_mm(), camera.forward(), camera.up());
+    let r = f.cross(u);
+    let ahead = eye + f * 3.0;
+    let corners = vec![ahead - r - u, ahead + r - u, ahead + u];
+    let mesh = TriangleMesh::new(corners, vec![[0, 1, 2]]).unwrap();
+    endocast_io::mesh::write_mesh(&stl, &mesh).unwrap();
+    let without = settled(&mut session);
+    let meshes = with_mesh(session.geometry_mut().meshes().clone(), &stl).unwrap();
+    session.geometry_mut().set_meshes(meshes, stl.clone());
+    session.controls.geometry.meshes = true;
+    let shown = settled(&mut session);
+    assert!(
+        shown.image.rgb() != without.image.rgb(),
+        "the mesh is not in view"
+    );
+    Autosave::new(path.clone(), Duration::ZERO)
+        .tick(&session, true)
+        .unwrap();
+
+    let case = Case::read(&path).unwrap();
+    let mut reopened = reopen(&path);
+    assert!(read_case_meshes(&case, &mut reopened).is_empty());
+    assert_eq!(reopened.geometry().mesh_files(), std::slice::from_ref(&stl));
+    let again = settled(&mut reopened);
+    assert!(
+        again.image.rgb() == shown.image.rgb(),
+        "the reopened view lost its mesh"
+    );
+
+    // The mesh file gone: the case opens all the same, and the problem names the file.
+    std::fs::remove_file(&stl).unwrap();
+    let mut reopened = reopen(&path);
+    let problems = read_case_meshes(&case, &mut reopened);
+    assert_eq!(problems.len(), 1);
+    assert!(problems[0].contains("t.stl"), "{problems:?}");
+    assert!(reopened.geometry().mesh_files().is_empty());
+    assert_eq!(reopened.controls, session.controls);
+}

@@ -12,7 +12,8 @@
 //!  "controls": {"preset": "sinus", "mode": "iso", "iso_hu": -400, ...,
 //!               "tf": {"opacity": [[-1024, 0], ..], "color": [[-1024, 0, 0, 0], ..]},
 //!               "peel": {"layer": "2", "falling": false, "keep": 0, "context": true},
-//!               "geometry": {"grid": true, "endoscope": false, "markers": true, "meshes": false}},
+//!               "geometry": {"grid": true, "endoscope": false, "markers": true, "meshes": true,
+//!                            "mesh_files": ["/data/head/septum.stl"]}},
 //!  "camera": {"eye": [0, 0, 0], "forward": [0, 0, 1], "up": [0, -1, 0]},
 //!  "key_frames": [],
 //!  "annotations": [{"id": 1, "kind": "measure", "points": [[..], [..]], "distance_mm": 7.9}]}

@@ -5,6 +5,7 @@ use endocast_core::annotate::{Annotation, Shape};
 use endocast_core::render::{PeelLayer, PeelSettings, TransferFunction, Unpeeled};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// The viewer's controls by name, so the file reads as the CLI's options do.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -132,8 +133,9 @@ pub fn peel_layer(text: &str) -> Result<PeelLayer, String> {
     }
 }
 
-/// Which geometry the viewer shows with the scan (the mesh files themselves are not recorded).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// Which geometry the viewer shows with the scan, and the mesh files it read (read again when
+/// the case is reopened).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct CaseGeometry {
@@ -141,6 +143,10 @@ pub struct CaseGeometry {
     pub endoscope: bool,
     pub markers: bool,
     pub meshes: bool,
+    /// The meshes' files, absolute where they could be made so, in the order read (absent:
+    /// none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mesh_files: Vec<PathBuf>,
 }
 
 /// A camera: eye (world mm, LPS), view direction and image up.
