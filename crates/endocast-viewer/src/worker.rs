@@ -307,17 +307,19 @@ fn render_request(
                 },
             )
         }
-        Some(rig) => render_anaglyph(shared, prepared, request, &rig, &deliver),
+        Some(rig) => render_anaglyph(shared, prepared, request, &rig, planner, &deliver),
     }
 }
 
-/// Stereo: both eyes at a quarter, then at full quality, each pair combined into a red/cyan
+/// Stereo: both eyes at a preview level (a quarter, or an eighth where the planner predicts a
+/// pair of quarters over the budget), then at full quality, each pair combined into a red/cyan
 /// anaglyph.
 fn render_anaglyph(
     shared: &Shared,
     prepared: &Prepared,
     request: &Request,
     rig: &StereoRig,
+    planner: &mut PreviewPlanner,
     deliver: &Deliver<'_>,
 ) -> Result<(), Cancelled> {
     let Ok(eyes) = rig.eyes(&request.view.camera) else {
@@ -331,8 +333,10 @@ fn render_anaglyph(
         }
     };
     let background = request.view.settings.background;
+    let size = request.view.camera.size();
+    let preview = planner.previews(size, PREVIEW_BUDGET / 2)[0];
     for (quality, stage) in [
-        (Quality::Quarter, Stage::Preview(Quality::Quarter)),
+        (preview, Stage::Preview(preview)),
         (Quality::Full, Stage::Full),
     ] {
         let options = RenderOptions::new()
@@ -343,6 +347,7 @@ fn render_anaglyph(
         let mut frames = [Frame::default(), Frame::default()];
         for (eye, frame) in eyes.iter().zip(&mut frames) {
             prepared.render_with(eye, &options, frame)?;
+            planner.observe(stage, frame);
         }
         let images = frames
             .iter()
