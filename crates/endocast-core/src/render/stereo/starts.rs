@@ -138,7 +138,8 @@ struct RowBounds {
     three_rows: Vec<f32>,
     /// Per left column `j`: the conservative empty depth `Z_j` (mm).
     depth: Vec<f64>,
-    /// Suffix minima of `g_j = j − K/Z_j`: `suffix[j] = min over i ≥ j`, non-decreasing.
+    /// Suffix minima of `g_j = j − K/Z_j`: `suffix[j] = min over i ≥ j`, non-decreasing (the
+    /// `g_j` themselves while they are filled in).
     suffix: Vec<f64>,
     /// The right eye's secants of the row.
     secant: Vec<f64>,
@@ -155,29 +156,33 @@ impl RowBounds {
     }
 
     /// Takes row `y` of the forward `depths`: each column's depth is the minimum over the 3×3
-    /// pixels around it, less the margin.
+    /// pixels around it, less the margin. (The depths hold no NaN, so the minima are plain
+    /// comparisons, which vectorise.)
     fn fill(&mut self, depths: &[f32], [w, h]: [usize; 2], y: usize, geometry: Geometry) {
         let (first, last) = (y.saturating_sub(1), (y + 1).min(h - 1));
-        self.three_rows.copy_from_slice(&depths[first * w..][..w]);
+        let rows = &mut self.three_rows;
+        rows.copy_from_slice(&depths[first * w..][..w]);
         for r in first + 1..=last {
-            for (m, d) in self.three_rows.iter_mut().zip(&depths[r * w..][..w]) {
-                *m = m.min(*d);
+            for (m, &d) in rows.iter_mut().zip(&depths[r * w..][..w]) {
+                *m = smaller(*m, d);
             }
         }
-        for j in 0..w {
-            let around = &self.three_rows[j.saturating_sub(1)..=(j + 1).min(w - 1)];
-            let nearest = around.iter().copied().fold(f32::INFINITY, f32::min);
-            self.depth[j] = f64::from(nearest) - geometry.margin;
-        }
-        let mut running = f64::INFINITY;
-        for j in (0..w).rev() {
-            let g = if self.depth[j] > 0.0 {
-                j as f64 - geometry.k / self.depth[j]
+        let nearest = |j: usize| {
+            let (a, b) = (rows[j.saturating_sub(1)], rows[(j + 1).min(w - 1)]);
+            smaller(smaller(a, rows[j]), b)
+        };
+        for (j, (depth, g)) in self.depth.iter_mut().zip(&mut self.suffix).enumerate() {
+            *depth = f64::from(nearest(j)) - geometry.margin;
+            *g = if *depth > 0.0 {
+                j as f64 - geometry.k / *depth
             } else {
                 f64::NEG_INFINITY
             };
-            running = running.min(g);
-            self.suffix[j] = running;
+        }
+        let mut running = f64::INFINITY;
+        for g in self.suffix.iter_mut().rev() {
+            running = if *g < running { *g } else { running };
+            *g = running;
         }
     }
 
@@ -208,7 +213,8 @@ impl RowWalker<'_> {
         if w as f64 - q <= 0.0 {
             return None;
         }
-        let lo = (q.floor().max(0.0) as usize).min(w);
+        // `floor(q)` or 0 (truncation is the floor from 0 up).
+        let lo = (q.max(0.0) as usize).min(w);
         // The largest column j ≥ lo with g_j ≤ q: the last suffix minimum ≤ q (non-decreasing
         // in j, and the answer non-decreasing in q).
         while self.below < w && suffix[self.below] <= q {
@@ -225,6 +231,16 @@ impl RowWalker<'_> {
             f64::INFINITY
         };
         (z_safe > z_enter).then_some(z_safe)
+    }
+}
+
+/// The smaller of `a` and `b`, neither NaN.
+#[inline]
+fn smaller(a: f32, b: f32) -> f32 {
+    if b < a {
+        b
+    } else {
+        a
     }
 }
 
