@@ -12,9 +12,12 @@
 //! (conservative, see below) depth `Z_j`, the ray leaves the known-empty region at the first
 //! column `j`, walking left from the image's right edge, with `g_j ≤ x + ½ − K/f`: a
 //! suffix-minimum search, `O(log w)` per pixel. The part of the right ray nearer than where
-//! it enters the left image's field (`x_L = w`, a fraction of a millimetre for most pixels) is
-//! checked sample by sample; the search then starts a margin before the end of the empty part,
-//! on the ray's own sample grid, so it finds the crossing it would have found from the eye.
+//! it enters the left image's field (`x_L = w`, a fraction of a millimetre for most pixels)
+//! needs no check where it lies in a ball around the eye whose samples all lie on the eye's
+//! side (no iso-active brick in it, or its voxels all on that side: `clear`), and is checked
+//! sample by sample elsewhere; the search then starts a margin before the end of the empty
+//! part, on the ray's own sample grid, so it finds the crossing it would have found from the
+//! eye. The start-up itself (`starts`) is two parallel passes over the image.
 //!
 //! Conservative depth: `Z_j` is the smallest forward depth of the left hits in the 3×3 pixels
 //! around `(j, y)`, less a margin of half a voxel and two sample steps (the refined hit's error,
