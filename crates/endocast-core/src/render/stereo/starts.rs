@@ -271,10 +271,12 @@ mod tests {
     #[test]
     fn forward_depths_are_rounded_down_and_close() {
         let camera = Camera::look_at(DVec3::ZERO, DVec3::Z, DVec3::Y, 90.0, [64, 48]).unwrap();
-        let mut frame = Frame::default();
-        frame.depth_mm = (0..64 * 48)
-            .map(|i| 1.0 + (i % 997) as f32 * 0.37)
-            .collect();
+        let mut frame = Frame {
+            depth_mm: (0..64 * 48)
+                .map(|i| 1.0 + (i % 997) as f32 * 0.37)
+                .collect(),
+            ..Default::default()
+        };
         frame.depth_mm[5] = f32::NAN;
         let mut out = Vec::new();
         forward_depths(&camera, &frame, &mut out);
