@@ -12,9 +12,12 @@
 //! (conservative, see below) depth `Z_j`, the ray leaves the known-empty region at the first
 //! column `j`, walking left from the image's right edge, with `g_j ≤ x + ½ − K/f`: a
 //! suffix-minimum search, `O(log w)` per pixel. The part of the right ray nearer than where
-//! it enters the left image's field (`x_L = w`, a fraction of a millimetre for most pixels) is
-//! checked sample by sample; the search then starts a margin before the end of the empty part,
-//! on the ray's own sample grid, so it finds the crossing it would have found from the eye.
+//! it enters the left image's field (`x_L = w`, a fraction of a millimetre for most pixels)
+//! needs no check where it lies in a ball around the eye whose samples all lie on the eye's
+//! side (no iso-active brick in it, or its voxels all on that side: `clear`), and is checked
+//! sample by sample elsewhere; the search then starts a margin before the end of the empty
+//! part, on the ray's own sample grid, so it finds the crossing it would have found from the
+//! eye. The start-up itself (`starts`) is two parallel passes over the image.
 //!
 //! Conservative depth: `Z_j` is the smallest forward depth of the left hits in the 3×3 pixels
 //! around `(j, y)`, less a margin of half a voxel and two sample steps (the refined hit's error,
@@ -23,6 +26,9 @@
 //! not a pinhole with an ideal lens, a near plane, an eye outside the volume or on the far side
 //! of the isovalue, or a mode that composites in front of the surface (DVR, two-iso, MIP) —
 //! the eyes share only the prepared state.
+
+mod clear;
+mod starts;
 
 #[cfg(target_arch = "x86_64")]
 use super::simd::rays4::LateStarts;
@@ -47,16 +53,16 @@ pub struct StereoFrames {
 /// Where each pixel's isosurface search of the second eye may start (see the module doc).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SearchStarts {
-    /// The eye in voxel space, and the radius (voxels) of a ball around it that holds no
-    /// iso-active brick: samples inside it need no check.
+    /// The eye in voxel space, and the radius (voxels) of a ball around it in which every
+    /// sample lies on the eye's side of the isovalue (it holds no iso-active brick, or its
+    /// voxels all lie on that side, see `clear`): samples inside it need no check.
     pub clear: (Vec3, f32),
     width: usize,
     /// Per pixel: the distance along the ray (mm) up to which samples must be checked one by
     /// one, and the distance from which the search may start; NaN where it starts at the eye.
     starts: Vec<[f32; 2]>,
-    /// Working buffers: the left eye's depths along its view axis, and their three-row minima.
-    depths: Vec<f64>,
-    minima: Vec<f64>,
+    /// The start-up's working buffers.
+    buffers: starts::Buffers,
 }
 
 impl SearchStarts {
@@ -104,7 +110,7 @@ impl Prepared {
         self.render_into(&left, left_frame);
         if self.shares_emptiness(&left, &right) {
             let starts = &mut pair.starts;
-            self.search_starts(&left, &right, rig, left_frame, starts);
+            self.search_starts((&left, left_frame), &right, rig, starts);
             let options = RenderOptions::new().search_starts(starts);
             // Without a cancel flag nothing can cancel it.
             let _ = self.render_with(&right, &options, right_frame);
@@ -202,95 +208,35 @@ impl Prepared {
         })
     }
 
-    /// The right eye's per-pixel search starts from the left eye's depth image.
+    /// The right eye's per-pixel search starts from the left eye's depth image, and the clear
+    /// ball around the right eye.
     fn search_starts(
         &self,
-        left: &Camera,
+        (left, left_frame): (&Camera, &Frame),
         right: &Camera,
         rig: &StereoRig,
-        left_frame: &Frame,
         out: &mut SearchStarts,
     ) {
-        let [w, h] = right.size();
+        let [_, h] = right.size();
         let tan_half = (right.fov_deg().to_radians() / 2.0).tan();
-        let k = rig.eye_separation_mm / tan_half * h as f64 / 2.0;
         let spacing = self.renderer.volume.geometry().spacing_mm().max_element();
-        let margin = 0.5 * spacing + 2.0 * self.step_mm;
-        pinhole_forward_depths(left, left_frame, &mut out.depths);
-        column_minima(&out.depths, [w, h], &mut out.minima);
-        let cosines = PinholeCosines::of(right);
-        out.starts.clear();
-        out.starts.resize(w * h, [f32::NAN; 2]);
-        let minima = &out.minima;
-        out.starts.par_chunks_mut(w).enumerate().for_each_init(
-            || RowBounds::with_width(w),
-            |bounds, (y, row)| {
-                bounds.fill(&minima[y * w..][..w], k, margin);
-                let mut walker = bounds.walker();
-                for (x, start) in row.iter_mut().enumerate() {
-                    let q = x as f64 + 0.5 - k / rig.focus_mm;
-                    let Some((z_enter, z_safe)) = walker.empty_span(q, k) else {
-                        continue;
-                    };
-                    let cos = cosines.at(x, y);
-                    let (check, skip) = (z_enter / cos, z_safe / cos);
-                    if skip > check + 2.0 * self.step_mm {
-                        *start = [check as f32, skip as f32];
-                    }
-                }
-            },
-        );
+        let geometry = starts::Geometry {
+            k: rig.eye_separation_mm / tan_half * h as f64 / 2.0,
+            focus_mm: rig.focus_mm,
+            margin: 0.5 * spacing + 2.0 * self.step_mm,
+            min_gain: 2.0 * self.step_mm,
+        };
+        let left = (left, left_frame);
+        starts::fill(left, right, geometry, &mut out.buffers, &mut out.starts);
         let eye = right.shared_origin().unwrap_or_else(|| right.eye_mm());
         let eye = self.voxel_from_world.transform_point3(eye).as_vec3();
-        out.clear = (eye, self.clear_radius_vox(eye));
-        out.width = w;
+        // The eye's side: the one its searches start from (`shares_emptiness`).
+        let iso = self.params.lower.iso;
+        let below = self.renderer.sampler().value(eye) < iso;
+        let voxels = clear::clear_radius(&self.renderer.volume, eye, iso, below);
+        out.clear = (eye, self.clear_radius_vox(eye).max(voxels));
+        out.width = right.size()[0];
     }
-}
-
-/// The cosine between a pinhole camera's pixel rays and its view axis, in closed form (the
-/// rays pass through `forward + right·sx + up·sy`).
-struct PinholeCosines {
-    /// `sx` of column 0 and its step per column; `sy` of row 0 and its step per row.
-    sx: (f64, f64),
-    sy: (f64, f64),
-}
-
-impl PinholeCosines {
-    fn of(camera: &Camera) -> Self {
-        let [w, h] = camera.size().map(|n| n as f64);
-        let tan = (camera.fov_deg().to_radians() / 2.0).tan();
-        let shift = camera.eye_shift().map_or(0.0, |e| e.offset_mm / e.focus_mm);
-        Self {
-            sx: ((1.0 / w - 1.0) * tan * w / h - shift, 2.0 * tan / h),
-            sy: ((1.0 - 1.0 / h) * tan, -2.0 * tan / h),
-        }
-    }
-
-    #[inline]
-    fn at(&self, x: usize, y: usize) -> f64 {
-        let sx = self.sx.0 + self.sx.1 * x as f64;
-        let sy = self.sy.0 + self.sy.1 * y as f64;
-        1.0 / (1.0 + sx * sx + sy * sy).sqrt()
-    }
-}
-
-/// A pinhole's hit depths along its view axis (mm) into `out`; `+∞` where a ray hit nothing.
-fn pinhole_forward_depths(camera: &Camera, frame: &Frame, out: &mut Vec<f64>) {
-    let [w, _] = camera.size();
-    let cosines = PinholeCosines::of(camera);
-    out.clear();
-    out.resize(frame.depth_mm.len(), 0.0);
-    out.par_chunks_mut(w)
-        .zip(frame.depth_mm.par_chunks(w))
-        .enumerate()
-        .for_each(|(y, (row, depths))| {
-            for (x, (z, &d)) in row.iter_mut().zip(depths).enumerate() {
-                *z = match d.is_finite() {
-                    true => f64::from(d) * cosines.at(x, y),
-                    false => f64::INFINITY,
-                };
-            }
-        });
 }
 
 /// Any camera's hit depths along its view axis (mm); `+∞` where a ray hit nothing.
@@ -305,125 +251,4 @@ fn forward_depths(camera: &Camera, frame: &Frame) -> Vec<f64> {
             _ => f64::INFINITY,
         })
         .collect()
-}
-
-/// Per pixel, the smallest forward depth of its column of three rows (`y − 1 ..= y + 1`), into
-/// `out`.
-fn column_minima(depths: &[f64], [w, h]: [usize; 2], out: &mut Vec<f64>) {
-    out.clear();
-    out.resize(w * h, f64::INFINITY);
-    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for r in y.saturating_sub(1)..=(y + 1).min(h - 1) {
-            for (m, d) in row.iter_mut().zip(&depths[r * w..][..w]) {
-                *m = m.min(*d);
-            }
-        }
-    });
-}
-
-/// One row of the left image as the right rays of that row see it (buffers reused from row to
-/// row).
-struct RowBounds {
-    /// Per left column `j`: the conservative empty depth `Z_j` (mm).
-    depth: Vec<f64>,
-    /// Suffix minima of `g_j = j − K/Z_j`: `suffix[j] = min over i ≥ j`, non-decreasing.
-    suffix: Vec<f64>,
-}
-
-impl RowBounds {
-    fn with_width(w: usize) -> Self {
-        Self {
-            depth: vec![0.0; w],
-            suffix: vec![0.0; w],
-        }
-    }
-
-    /// Takes a row of three-row column minima: each column's depth is the minimum over it and
-    /// its two neighbours, less `margin`.
-    fn fill(&mut self, column_min: &[f64], k: f64, margin: f64) {
-        let w = column_min.len();
-        for j in 0..w {
-            let around = &column_min[j.saturating_sub(1)..=(j + 1).min(w - 1)];
-            self.depth[j] = around.iter().copied().fold(f64::INFINITY, f64::min) - margin;
-        }
-        let mut running = f64::INFINITY;
-        for j in (0..w).rev() {
-            let g = if self.depth[j] > 0.0 {
-                j as f64 - k / self.depth[j]
-            } else {
-                f64::NEG_INFINITY
-            };
-            running = running.min(g);
-            self.suffix[j] = running;
-        }
-    }
-
-    /// A walk along the row's pixels, left to right.
-    fn walker(&self) -> RowWalker<'_> {
-        RowWalker {
-            bounds: self,
-            below: 0,
-        }
-    }
-}
-
-/// The right rays of one row, taken left to right (`q` growing), so the suffix-minimum search
-/// moves one way: `O(w)` a row.
-struct RowWalker<'a> {
-    bounds: &'a RowBounds,
-    /// How many leading suffix minima are ≤ the last `q` (they are non-decreasing).
-    below: usize,
-}
-
-impl RowWalker<'_> {
-    /// For the right ray with `q = x + ½ − K/f` (not smaller than the last call's): the depth
-    /// where it enters the left image (`x_L = w`) and the depth where it leaves the
-    /// known-empty region; `None` where it never enters or leaves at once.
-    fn empty_span(&mut self, q: f64, k: f64) -> Option<(f64, f64)> {
-        let (depth, suffix) = (&self.bounds.depth, &self.bounds.suffix);
-        let w = depth.len();
-        if w as f64 - q <= 0.0 {
-            return None;
-        }
-        let z_enter = k / (w as f64 - q);
-        let lo = (q.floor().max(0.0) as usize).min(w);
-        // The largest column j ≥ lo with g_j ≤ q: the last suffix minimum ≤ q (non-decreasing
-        // in j, and the answer non-decreasing in q).
-        while self.below < w && suffix[self.below] <= q {
-            self.below += 1;
-        }
-        let z_safe = if self.below > lo {
-            let j = self.below - 1;
-            let z_entry = k / (j as f64 + 1.0 - q);
-            z_entry.max(depth[j])
-        } else if q < 0.0 {
-            // Leaves the left image through its left edge.
-            k / -q
-        } else {
-            f64::INFINITY
-        };
-        (z_safe > z_enter).then_some((z_enter, z_safe))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::DVec3;
-
-    #[test]
-    fn closed_form_cosines_are_the_rays() {
-        let camera = Camera::look_at(DVec3::ZERO, DVec3::Z, DVec3::Y, 75.0, [37, 20]).unwrap();
-        let rig = StereoRig {
-            eye_separation_mm: 1.0,
-            focus_mm: 9.0,
-        };
-        for eye in [camera, rig.eyes(&camera).unwrap()[1]] {
-            let cosines = PinholeCosines::of(&eye);
-            for (x, y) in [(0, 0), (36, 19), (18, 3)] {
-                let cos = eye.pixel_ray(x, y).unwrap().dir.dot(eye.forward());
-                assert!((cosines.at(x, y) - cos).abs() < 1e-12);
-            }
-        }
-    }
 }

@@ -55,7 +55,8 @@ pub(crate) struct LaneRay {
 pub(crate) struct LateStarts {
     pub check: [f32; 4],
     pub start: [f32; 4],
-    /// Radius of the ball around the eye that holds no iso-active brick, voxels.
+    /// Radius of the ball around the eye in which every sample lies on the eye's side of the
+    /// isovalue, voxels.
     pub clear: f32,
     /// Sample step, mm (the sample after `check` must lie in the ball too).
     pub step: f32,
