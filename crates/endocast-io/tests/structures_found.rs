@@ -161,6 +161,39 @@ fn angioscopy_on_the_abdomen_follows_the_aorta_from_the_top() {
     assert!(forward(&s.pose).z < -0.8, "{:?}", s.pose);
     let end = s.end_mm.unwrap();
     assert!(eye.z - end.z > 150.0, "{end}");
+    // The whole abdominal aorta, past the coeliac, mesenteric and renal origins, where its
+    // section joins the branches' (and through the left renal artery the kidney's), down to
+    // its division. Measured on the slices (3 mm apart, z = 85.91 + 3k): round from the top
+    // (z 484.9, radius 13.6 mm at 130 HU) to z 286.9 (7.7–10.5 mm); the left renal artery
+    // joins it to the kidney at z 280.9–283.9 (centre x 21.5, y 94.8); 6.7–7.6 mm below; a
+    // figure of eight at z 190.9 and two iliac sections of 4–4.5 mm radius from z 187.9.
+    let aorta = find_aorta(abdomen, 130.0, LumenSide::Above).unwrap();
+    assert!(aorta.top_mm.z > 484.0, "top {}", aorta.top_mm);
+    assert!(
+        (190.0..200.0).contains(&aorta.bottom_mm.z),
+        "bottom {}: not at the bifurcation",
+        aorta.bottom_mm
+    );
+    let to_voxel = |p: DVec3| {
+        let v = abdomen
+            .geometry()
+            .voxel_from_world()
+            .transform_point3(p)
+            .round();
+        [v.x as usize, v.y as usize, v.z as usize]
+    };
+    let renal = DVec3::new(21.5, 94.8, 280.91);
+    let kidney = DVec3::new(74.1, 122.7, 280.91);
+    assert!(aorta.lumen.contains(to_voxel(renal)) && !aorta.lumen.contains(to_voxel(kidney)));
+    for (c, r) in aorta.centres_mm.iter().zip(&aorta.radii_mm) {
+        let plausible = if c.z > 300.0 { 8.0..15.0 } else { 5.5..11.0 };
+        assert!(plausible.contains(r), "radius {r} mm at {c}");
+    }
+    assert!(
+        (9.0..12.0).contains(&aorta.radius_mm),
+        "{}",
+        aorta.radius_mm
+    );
 }
 
 #[test]
@@ -242,6 +275,10 @@ fn angioscopy_on_the_stent_cta_follows_the_stented_aorta_down_to_the_bifurcation
         "radius {} mm",
         aorta.radius_mm
     );
+    // A branch joins its section at k 235–237 (one region of 14–16 mm radius, roundness
+    // 0.1): followed by its core through them to the top slice (it stopped at 234 before).
+    assert!(aorta.top_mm.z >= 254.0, "top {}", aorta.top_mm);
+    assert!(s.lumen.contains([55, 92, 236]) && s.lumen.contains([56, 95, 255]));
 }
 
 #[test]

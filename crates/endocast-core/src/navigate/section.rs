@@ -105,7 +105,7 @@ pub(crate) fn sections(
 
 /// The section of `pixels` (linear indices in an `nx` × `ny` slice), or `None` when it touches
 /// the slice's border.
-fn section_of(pixels: &[usize], nx: usize, ny: usize) -> Option<Section> {
+pub(crate) fn section_of(pixels: &[usize], nx: usize, ny: usize) -> Option<Section> {
     let ij = |n: usize| [n % nx, n / nx];
     let (mut lo, mut hi) = ([usize::MAX; 2], [0; 2]);
     let mut sum = [0.0; 2];
