@@ -96,13 +96,14 @@ use glam::{DAffine3, DVec3, Vec3};
 use integrate::{Classified, Integrator, Params, PeelParams, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
-use scene_pass::{SceneRow, SceneScratch};
+use scene_pass::SceneScratch;
 #[cfg(target_arch = "x86_64")]
 use simd::rays4::RaySetup;
+use std::cell::RefCell;
 use std::sync::Arc;
 use std::time::Instant;
 use stereo::SearchStarts;
-use tiles::{Control, Extra, Pixel, Tile, TileRect, Tiling, TILE};
+use tiles::{Control, Extra, Pixel, Tile, TileRect, Tiling};
 use traverse::{BrickDda, VoxelRay};
 
 use crate::scene::{PlacedScene, Scene};
@@ -445,7 +446,8 @@ impl Prepared {
         Tiling::new(camera.size()).render_into(tile, frame, options.layers, control)
     }
 
-    /// Renders the pixels of `rect`, each row's rays as one group.
+    /// Renders the pixels of `rect`, each row's rays as one group; with a scene, the whole
+    /// tile's rays then meet it in square packets ([`Prepared::add_scene`]).
     fn tile(
         &self,
         integrator: &Integrator<'_>,
@@ -456,66 +458,90 @@ impl Prepared {
     ) -> Tile {
         let pixels = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
         let mut tile = Tile {
-            pixels: Vec::with_capacity(pixels),
+            pixels: vec![self.pixel_of(&PixelOut::default()); pixels],
             extras: Vec::new(),
             stats: RenderStats::default(),
         };
-        let layers = options.layers;
-        if !layers.is_empty() {
+        if !options.layers.is_empty() {
             tile.extras = vec![Extra::default(); pixels];
         }
-        let width = camera.size()[0];
-        let missed = self.pixel_of(&PixelOut::default());
-        let (mut columns, mut tasks) = (Vec::with_capacity(TILE), Vec::with_capacity(TILE));
-        let mut scratch = SceneScratch::default();
+        let view = TileView {
+            camera,
+            options,
+            rect,
+        };
+        // Without a scene each row is finished at once and its buffers reused.
+        let mut rows: Vec<RowTasks> = Vec::with_capacity(rect.y1 - rect.y0);
+        let mut spare = RowTasks::with_capacity(rect.x1 - rect.x0);
         for y in rect.y0..rect.y1 {
-            columns.clear();
-            tasks.clear();
-            // A still frame's shifted grid is not the one the starts were checked on.
-            let late = options.starts.filter(|_| options.grid_shift == 0.0);
-            let late = late.map(|starts| (integrator, starts));
-            self.row_tasks(camera, y, rect.x0..rect.x1, late, &mut columns, &mut tasks);
-            if options.grid_shift != 0.0 || options.max_distance_mm.is_some() {
-                for (&x, task) in columns.iter().zip(&mut tasks) {
-                    adjust(&mut task.march, options, x + width * y);
+            let mut row = match scene {
+                Some(_) => RowTasks::with_capacity(rect.x1 - rect.x0),
+                None => std::mem::take(&mut spare),
+            };
+            row.y = y;
+            self.volume_row(integrator, &view, &mut row);
+            match scene {
+                Some(_) => rows.push(row),
+                None => {
+                    self.finish_row(integrator, &view, &mut row, &mut tile);
+                    spare = row;
                 }
             }
-            integrator.run_group(&mut tasks);
-            let row = tile.pixels.len();
-            tile.pixels.resize(row + rect.x1 - rect.x0, missed);
-            if let Some(scene) = scene {
-                let scene_row = SceneRow {
-                    scene,
-                    camera,
-                    options,
-                    y,
-                };
-                let xs = rect.x0..rect.x1;
-                self.add_scene(
-                    integrator,
-                    &scene_row,
-                    xs,
-                    (&columns, &mut tasks),
-                    &mut scratch,
-                );
-                for (x, out) in &mut scratch.others {
-                    vignette(camera, *x, y, out);
-                    tile.pixels[row + *x - rect.x0] = self.pixel_of(out);
+        }
+        if let Some(scene) = scene {
+            SCENE_SCRATCH.with_borrow_mut(|scratch| {
+                self.add_scene(integrator, scene, &view, &mut rows, scratch);
+                for (x, y, out) in &mut scratch.others {
+                    vignette(camera, *x, *y, out);
+                    tile.pixels[rect.index(*x, *y)] = self.pixel_of(out);
                 }
-            }
-            for (&x, task) in columns.iter().zip(&mut tasks) {
-                vignette(camera, x, y, &mut task.out);
-                let task = &*task;
-                let i = row + x - rect.x0;
-                tile.pixels[i] = self.pixel_of(&task.out);
-                count_ray(&mut tile.stats, task);
-                if !layers.is_empty() {
-                    let extra = &mut tile.extras[i];
-                    self.extra(integrator, camera, options, (x, y), task, extra);
-                }
+            });
+            for row in &mut rows {
+                self.finish_row(integrator, &view, row, &mut tile);
             }
         }
         tile
+    }
+
+    /// Casts row `row.y`'s rays of the tile through the volume into `row` (cleared first).
+    fn volume_row(&self, integrator: &Integrator<'_>, view: &TileView<'_>, row: &mut RowTasks) {
+        let (options, rect, y) = (view.options, view.rect, row.y);
+        let width = view.camera.size()[0];
+        row.columns.clear();
+        row.tasks.clear();
+        // A still frame's shifted grid is not the one the starts were checked on.
+        let late = options.starts.filter(|_| options.grid_shift == 0.0);
+        let late = late.map(|starts| (integrator, starts));
+        let (columns, tasks) = (&mut row.columns, &mut row.tasks);
+        self.row_tasks(view.camera, y, rect.x0..rect.x1, late, columns, tasks);
+        if options.grid_shift != 0.0 || options.max_distance_mm.is_some() {
+            for (&x, task) in columns.iter().zip(tasks.iter_mut()) {
+                adjust(&mut task.march, options, x + width * y);
+            }
+        }
+        integrator.run_group(tasks);
+    }
+
+    /// Writes row `row`'s rendered rays into `tile`: pixels, counters and optional layers.
+    fn finish_row(
+        &self,
+        integrator: &Integrator<'_>,
+        view: &TileView<'_>,
+        row: &mut RowTasks,
+        tile: &mut Tile,
+    ) {
+        let (camera, y) = (view.camera, row.y);
+        for (&x, task) in row.columns.iter().zip(&mut row.tasks) {
+            vignette(camera, x, y, &mut task.out);
+            let task = &*task;
+            let i = view.rect.index(x, y);
+            tile.pixels[i] = self.pixel_of(&task.out);
+            count_ray(&mut tile.stats, task);
+            if !view.options.layers.is_empty() {
+                let extra = &mut tile.extras[i];
+                self.extra(integrator, camera, view.options, (x, y), task, extra);
+            }
+        }
     }
 
     /// The optional layers of pixel `(x, y)`, whose ray `task` has been rendered.
@@ -713,6 +739,38 @@ impl Prepared {
             },
             depth_mm: out.depth_mm,
             value: (f64::from(out.value) * map.scale() + map.offset()) as f32,
+        }
+    }
+}
+
+thread_local! {
+    /// Each worker thread's buffers for the scene pass, kept from tile to tile.
+    static SCENE_SCRATCH: RefCell<SceneScratch> = RefCell::new(SceneScratch::default());
+}
+
+/// What every row of one tile shares: the frame's camera and options, and the tile.
+#[derive(Clone, Copy)]
+struct TileView<'r> {
+    camera: &'r Camera,
+    options: &'r RenderOptions<'r>,
+    rect: TileRect,
+}
+
+/// One row of a tile: the columns whose rays meet the volume (ascending) and their tasks.
+#[derive(Default)]
+struct RowTasks {
+    y: usize,
+    columns: Vec<usize>,
+    tasks: Vec<RayTask>,
+}
+
+impl RowTasks {
+    /// Empty buffers for a row of `width` pixels.
+    fn with_capacity(width: usize) -> Self {
+        Self {
+            y: 0,
+            columns: Vec::with_capacity(width),
+            tasks: Vec::with_capacity(width),
         }
     }
 }

@@ -94,6 +94,13 @@ pub(crate) struct TileRect {
     pub y1: usize,
 }
 
+impl TileRect {
+    /// Where pixel `(x, y)` of the image lies in the tile's pixels (row by row).
+    pub fn index(&self, x: usize, y: usize) -> usize {
+        (x - self.x0) + (self.x1 - self.x0) * (y - self.y0)
+    }
+}
+
 impl Tiling {
     /// The tiling of an image of `[width, height]` pixels.
     pub fn new([width, height]: [usize; 2]) -> Self {

@@ -230,7 +230,7 @@ impl PlacedScene<'_> {
     }
 
     /// [`Self::trace`] for many rays, `rays[i]`'s surfaces into `hits[i]`: the same hits, but
-    /// neighbouring rays (a row of pixels) walk a mesh's hierarchy together, for less than
+    /// neighbouring rays (a block of pixels) walk a mesh's hierarchy together, for less than
     /// their walks one by one.
     ///
     /// # Panics

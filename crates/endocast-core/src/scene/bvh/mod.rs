@@ -69,16 +69,6 @@ impl Aabb {
         let d = (self.hi - self.lo).max(Vec3::ZERO);
         d.x * d.y + d.y * d.z + d.z * d.x
     }
-
-    /// Where the ray enters the box, if it meets it within `(t_min, t_max)`.
-    #[inline]
-    fn entry(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
-        let a = (self.lo - origin) * inv_dir;
-        let b = (self.hi - origin) * inv_dir;
-        let near = a.min(b).max_element().max(t_min);
-        let far = a.max(b).min_element().min(t_max);
-        (near <= far).then_some(near)
-    }
 }
 
 /// A node: its box, and either two children (`count == 0`: the left child is `index`, the
@@ -407,15 +397,17 @@ mod tests {
         let mesh = TriangleMesh::new(vertices, triangles).unwrap();
         let bvh = Bvh::new(&mesh);
         let eye = Vec3::new(-5.0, 20.0, 20.0);
-        // Rows of a fan of rays (longer than a packet), bounds varying along the row.
+        // Rows of a fan of rays (a packet and part of one: a group of lanes only partly
+        // filled), bounds varying along the row.
+        let columns = PACKET + 13;
         for row in 0..40 {
-            let mut rays: Vec<PacketRay> = (0..37)
+            let mut rays: Vec<PacketRay> = (0..columns)
                 .map(|col| PacketRay {
                     origin: eye,
-                    dir: Vec3::new(1.0, (col as f32 - 18.0) * 0.02, (row as f32 - 20.0) * 0.02)
+                    dir: Vec3::new(1.0, (col as f32 - 38.0) * 0.01, (row as f32 - 20.0) * 0.02)
                         .normalize(),
                     t_min: 0.5,
-                    t_max: 20.0 + col as f32,
+                    t_max: 20.0 + col as f32 / 2.0,
                 })
                 .collect();
             let alone: Vec<_> = rays

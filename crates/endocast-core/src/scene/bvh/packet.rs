@@ -1,5 +1,5 @@
-//! Rays traced through the hierarchy together (a row of pixels: neighbouring rays visit nearly
-//! the same nodes). The packet walks the tree once: a node is entered when any of its rays
+//! Rays traced through the hierarchy together (a block of pixels: neighbouring rays visit
+//! nearly the same nodes). The packet walks the tree once: a node is entered when any of its rays
 //! meets the node's box, and each ray still meets a leaf's triangles only where it meets the
 //! leaf's box, with its own distance bound — so every ray finds exactly the hits it finds alone.
 //!
@@ -7,17 +7,18 @@
 //! the parent, and bounds only shrink): in a coherent packet the first try usually answers.
 //! Before that, the packet's bounds (the ranges of its rays' starts, inverse directions and
 //! distances) rule out at once the boxes that no ray of it can meet, with a margin that keeps
-//! the test on the safe side of rounding.
+//! the test on the safe side of rounding. Boxes are tested against four rays at a time
+//! (`Lanes`, in SSE registers through `glam::Vec4`).
 
 use super::{Aabb, Bvh, PacketRay};
-use glam::{BVec3A, Vec3, Vec3A};
+use glam::{BVec3A, Vec3, Vec3A, Vec4};
 
 /// Relative margin of [`Bounds::misses`]: a box is ruled out only when every ray misses it by
 /// more than this share of the distances involved (far above `f32` rounding).
 const MARGIN: f32 = 1e-4;
 
 /// Rays walked through the tree as one packet at most (longer slices go in parts).
-pub const PACKET: usize = 16;
+pub const PACKET: usize = 64;
 
 impl Bvh {
     /// [`Bvh::traverse`] for many rays at once: calls `on_hit(ray, t, triangle)` for every
@@ -58,28 +59,25 @@ impl Bvh {
             *inv = ray.dir.recip();
         }
         let mut packet = Bounds::of(rays, &inv_dir[..n]);
+        let mut lanes = Lanes::of(rays, &inv_dir[..n]);
         // The first ray, from `from` on, that meets node `node`'s box, and where it enters it.
-        let enters = |node: usize, from: usize, rays: &[PacketRay], packet: &Option<Bounds>| {
+        let enters = |node: usize, from: usize, lanes: &Lanes, packet: &Option<Bounds>| {
             let bounds = &self.nodes[node].bounds;
             if packet.as_ref().is_some_and(|p| p.misses(bounds)) {
                 return None;
             }
-            (from..n).find_map(|l| {
-                let r = &rays[l];
-                let entry = bounds.entry(r.origin, inv_dir[l], r.t_min, r.t_max)?;
-                Some((l, entry))
-            })
+            lanes.first_meeting(bounds, from)
         };
         let mut stack = [(0u32, 0u32); 64];
         let mut top = 0usize;
-        let Some((mut first, _)) = enters(0, 0, rays, &packet) else {
+        let Some((mut first, _)) = enters(0, 0, &lanes, &packet) else {
             return;
         };
         let mut node = 0usize;
         loop {
             let nd = self.nodes[node];
             if nd.count > 0 {
-                if self.leaf(node, first, rays, &inv_dir, on_hit) {
+                if self.leaf(node, first, rays, &mut lanes, on_hit) {
                     if let Some(p) = &mut packet {
                         p.t_max = rays.iter().fold(f32::NEG_INFINITY, |m, r| m.max(r.t_max));
                     }
@@ -87,8 +85,8 @@ impl Bvh {
             } else {
                 let (l, r) = (nd.index as usize, nd.index as usize + 1);
                 match (
-                    enters(l, first, rays, &packet),
-                    enters(r, first, rays, &packet),
+                    enters(l, first, &lanes, &packet),
+                    enters(r, first, &lanes, &packet),
                 ) {
                     (Some((fl, tl)), Some((fr, tr))) => {
                         let ((near, fnear), far) = if tl <= tr {
@@ -121,7 +119,7 @@ impl Bvh {
                 }
                 top -= 1;
                 let (next, from) = (stack[top].0 as usize, stack[top].1 as usize);
-                if let Some((f, _)) = enters(next, from, rays, &packet) {
+                if let Some((f, _)) = enters(next, from, &lanes, &packet) {
                     (node, first) = (next, f);
                     break;
                 }
@@ -136,29 +134,97 @@ impl Bvh {
         node: usize,
         first: usize,
         rays: &mut [PacketRay],
-        inv_dir: &[Vec3; PACKET],
+        lanes: &mut Lanes,
         on_hit: &mut dyn FnMut(usize, f32, u32) -> f32,
     ) -> bool {
         let nd = self.nodes[node];
         let mut any = false;
         let tris = nd.index as usize..(nd.index + nd.count) as usize;
-        for (l, ray) in rays.iter_mut().enumerate().skip(first) {
-            let (o, d) = (ray.origin, ray.dir);
-            if nd
-                .bounds
-                .entry(o, inv_dir[l], ray.t_min, ray.t_max)
-                .is_none()
-            {
-                continue;
-            }
-            for k in tris.clone() {
-                if let Some(t) = self.tris[k].hit(o, d, ray.t_min, ray.t_max) {
-                    ray.t_max = on_hit(l, t, self.order[k]);
-                    any = true;
+        for group in first / LANES..lanes.groups {
+            let mut mask = lanes.meet(group, &nd.bounds, first).0;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let l = LANES * group + lane;
+                let ray = &mut rays[l];
+                let (o, d) = (ray.origin, ray.dir);
+                for k in tris.clone() {
+                    if let Some(t) = self.tris[k].hit(o, d, ray.t_min, ray.t_max) {
+                        ray.t_max = on_hit(l, t, self.order[k]);
+                        lanes.t_max[group][lane] = ray.t_max;
+                        any = true;
+                    }
                 }
             }
         }
         any
+    }
+}
+
+/// Rays per group of [`Lanes`].
+const LANES: usize = 4;
+/// Groups of a packet.
+const GROUPS: usize = PACKET / LANES;
+
+/// A packet's rays four at a time (a structure of arrays): one box against four rays at once.
+/// Lanes past the packet's rays meet nothing.
+struct Lanes {
+    origin: [[Vec4; 3]; GROUPS],
+    inv_dir: [[Vec4; 3]; GROUPS],
+    t_min: [Vec4; GROUPS],
+    t_max: [Vec4; GROUPS],
+    /// Groups holding rays.
+    groups: usize,
+}
+
+impl Lanes {
+    /// The lanes of `rays` (with their inverse directions).
+    fn of(rays: &[PacketRay], inv_dir: &[Vec3]) -> Self {
+        let mut lanes = Self {
+            origin: [[Vec4::ZERO; 3]; GROUPS],
+            inv_dir: [[Vec4::ZERO; 3]; GROUPS],
+            t_min: [Vec4::INFINITY; GROUPS],
+            t_max: [Vec4::NEG_INFINITY; GROUPS],
+            groups: rays.len().div_ceil(LANES),
+        };
+        for (l, (ray, inv)) in rays.iter().zip(inv_dir).enumerate() {
+            let (g, k) = (l / LANES, l % LANES);
+            for axis in 0..3 {
+                lanes.origin[g][axis][k] = ray.origin[axis];
+                lanes.inv_dir[g][axis][k] = inv[axis];
+            }
+            lanes.t_min[g][k] = ray.t_min;
+            lanes.t_max[g][k] = ray.t_max;
+        }
+        lanes
+    }
+
+    /// Which rays of group `group`, from ray `from` of the packet on, meet `bounds` within
+    /// their intervals (bit `k`: lane `k`), and where each enters it.
+    #[inline]
+    fn meet(&self, group: usize, bounds: &Aabb, from: usize) -> (u32, Vec4) {
+        let (o, inv) = (&self.origin[group], &self.inv_dir[group]);
+        let (mut near, mut far) = (self.t_min[group], self.t_max[group]);
+        for axis in 0..3 {
+            let t0 = (Vec4::splat(bounds.lo[axis]) - o[axis]) * inv[axis];
+            let t1 = (Vec4::splat(bounds.hi[axis]) - o[axis]) * inv[axis];
+            // A NaN (a ray in the plane of a slab, along it) leaves the interval as it is:
+            // `min`/`max` return their second operand where either is NaN.
+            near = t0.min(t1).max(near);
+            far = t0.max(t1).min(far);
+        }
+        let mask = near.cmple(far).bitmask();
+        let skip = from.saturating_sub(LANES * group).min(LANES);
+        (mask & (0xf << skip) & 0xf, near)
+    }
+
+    /// The first ray, from ray `from` on, that meets `bounds`, and where it enters it.
+    fn first_meeting(&self, bounds: &Aabb, from: usize) -> Option<(usize, f32)> {
+        (from / LANES..self.groups).find_map(|group| {
+            let (mask, near) = self.meet(group, bounds, from);
+            let lane = mask.trailing_zeros() as usize;
+            (mask != 0).then(|| (LANES * group + lane, near[lane]))
+        })
     }
 }
 
