@@ -471,35 +471,37 @@ impl Prepared {
             rect,
         };
         // Without a scene each row is finished at once and its buffers reused.
-        let mut rows: Vec<RowTasks> = Vec::with_capacity(rect.y1 - rect.y0);
-        let mut spare = RowTasks::with_capacity(rect.x1 - rect.x0);
+        let height = if scene.is_some() {
+            rect.y1 - rect.y0
+        } else {
+            1
+        };
+        let mut rows = ROWS.take();
+        if rows.len() < height {
+            rows.resize_with(height, RowTasks::default);
+        }
+        let rows_used = &mut rows[..height];
         for y in rect.y0..rect.y1 {
-            let mut row = match scene {
-                Some(_) => RowTasks::with_capacity(rect.x1 - rect.x0),
-                None => std::mem::take(&mut spare),
-            };
+            let row = &mut rows_used[(y - rect.y0) % height];
             row.y = y;
-            self.volume_row(integrator, &view, &mut row);
-            match scene {
-                Some(_) => rows.push(row),
-                None => {
-                    self.finish_row(integrator, &view, &mut row, &mut tile);
-                    spare = row;
-                }
+            self.volume_row(integrator, &view, row);
+            if scene.is_none() {
+                self.finish_row(integrator, &view, row, &mut tile);
             }
         }
         if let Some(scene) = scene {
             SCENE_SCRATCH.with_borrow_mut(|scratch| {
-                self.add_scene(integrator, scene, &view, &mut rows, scratch);
+                self.add_scene(integrator, scene, &view, rows_used, scratch);
                 for (x, y, out) in &mut scratch.others {
                     vignette(camera, *x, *y, out);
                     tile.pixels[rect.index(*x, *y)] = self.pixel_of(out);
                 }
             });
-            for row in &mut rows {
+            for row in rows_used {
                 self.finish_row(integrator, &view, row, &mut tile);
             }
         }
+        ROWS.set(rows);
         tile
     }
 
@@ -744,6 +746,8 @@ impl Prepared {
 }
 
 thread_local! {
+    /// Each worker thread's row buffers, kept from tile to tile.
+    static ROWS: RefCell<Vec<RowTasks>> = RefCell::default();
     /// Each worker thread's buffers for the scene pass, kept from tile to tile.
     static SCENE_SCRATCH: RefCell<SceneScratch> = RefCell::new(SceneScratch::default());
 }
@@ -762,17 +766,6 @@ struct RowTasks {
     y: usize,
     columns: Vec<usize>,
     tasks: Vec<RayTask>,
-}
-
-impl RowTasks {
-    /// Empty buffers for a row of `width` pixels.
-    fn with_capacity(width: usize) -> Self {
-        Self {
-            y: 0,
-            columns: Vec::with_capacity(width),
-            tasks: Vec::with_capacity(width),
-        }
-    }
 }
 
 /// Darkens a ray's colour by the camera lens's vignetting at pixel `(x, y)`.

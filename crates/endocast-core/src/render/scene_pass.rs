@@ -24,6 +24,7 @@ use super::sample::Accum;
 use super::settings::Mode;
 use super::traverse::VoxelRay;
 use super::{adjust, Prepared, RowTasks, TileView};
+use crate::camera::Ray;
 use crate::scene::bvh::PACKET;
 use crate::scene::{Hit, PlacedScene, Scene, Traced};
 use glam::{Vec3, Vec3A};
@@ -98,13 +99,23 @@ impl Prepared {
         scratch.rays.clear();
         scratch.pixels.clear();
         let (camera, width) = (view.camera, view.camera.size()[0]);
+        let origin = camera.shared_origin();
         for y in ys {
             let row = &rows[y - view.rect.y0];
             for x in xs.clone() {
-                let Some(ray) = camera.pixel_ray(x, y) else {
+                let task = row.columns.binary_search(&x).ok();
+                // A rendered ray's direction is the camera's, rounded to `f32` (as a mesh's
+                // hierarchy takes it): no second set-up of the ray.
+                let ray = match (task, origin) {
+                    (Some(i), Some(origin)) => Some(Ray {
+                        origin,
+                        dir: row.tasks[i].dir_world.as_dvec3(),
+                    }),
+                    _ => camera.pixel_ray(x, y),
+                };
+                let Some(ray) = ray else {
                     continue;
                 };
-                let task = row.columns.binary_search(&x).ok();
                 let near = camera.near_distance_along(ray.dir);
                 let mut bound = task.map_or(f64::INFINITY, |i| self.volume_bound(&row.tasks[i]));
                 if let Some(max) = view.options.max_distance_mm {
