@@ -108,7 +108,8 @@ pub enum Structure {
     /// threshold lowered until it stops leaking into the lung.
     Trachea,
     /// The aorta: the longest chain of bright round sections of 7–16 mm radius in the axial
-    /// slices (see [`crate::navigate::find_aorta`]).
+    /// slices, followed by its round core past the branches' origins to its division (see
+    /// [`crate::navigate::find_aorta`]).
     Aorta,
     /// The colon: the largest gas component inside the body, not the lung (see
     /// [`crate::navigate::find_colon`]).

@@ -135,4 +135,42 @@ mod tests {
         let colon = find_colon(&volume, -500.0).unwrap();
         assert!(colon.contains([35, 15, 10]) && colon.voxel_count() == 5 * 10 * 10);
     }
+
+    #[test]
+    fn a_gas_tube_in_the_body_is_chosen_over_a_larger_hollow_in_the_table() {
+        // Air (−1000 HU, stored 24) around a body (an ellipse of tissue, 40 HU) lying on a
+        // table (plastic, 100 HU, walls 4 mm thick) whose hollow holds more gas than the
+        // colon: a tube of 3 voxels' radius along k inside the body; voxels of 2 mm.
+        let dims = [48, 40, 30];
+        let mut voxels = vec![24u16; dims[0] * dims[1] * dims[2]];
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let (x, y) = (i as f64 - 24.0, j as f64 - 14.0);
+                    let body = (x / 20.0).powi(2) + (y / 12.0).powi(2) <= 1.0;
+                    let colon = x.hypot(y) <= 3.0 && (5..25).contains(&k);
+                    let table = (4..44).contains(&i) && (30..38).contains(&j);
+                    let hollow =
+                        (6..42).contains(&i) && (32..36).contains(&j) && (2..28).contains(&k);
+                    let value = match () {
+                        _ if body && !colon => 1064,
+                        _ if table && !hollow => 1124,
+                        _ => continue,
+                    };
+                    voxels[i + dims[0] * (j + dims[1] * k)] = value;
+                }
+            }
+        }
+        let g = crate::Geometry::axis_aligned(dims, glam::DVec3::splat(2.0), glam::DVec3::ZERO)
+            .unwrap();
+        let map = crate::ValueMap::new(1.0, -1024.0).unwrap();
+        let volume = Volume::new(g, voxels, map, crate::Modality::Ct).unwrap();
+        // The largest gas inside the field of view is the table's hollow.
+        let largest = Lumen::largest(&volume, -500.0, LumenSide::Below, true)
+            .unwrap()
+            .unwrap();
+        assert!(largest.contains([24, 34, 15]));
+        let colon = find_colon(&volume, -500.0).unwrap();
+        assert!(colon.contains([24, 14, 15]) && !colon.contains([24, 34, 15]));
+    }
 }

@@ -58,11 +58,12 @@ impl BitGrid {
 }
 
 impl BitGrid {
-    /// Clears every bit whose `i` lies outside `range`.
-    pub(crate) fn keep_i(&mut self, range: std::ops::RangeInclusive<usize>) {
+    /// Clears every bit whose index along `axis` (0 `i`, 1 `j`, 2 `k`) lies outside `range`.
+    pub(crate) fn keep_along(&mut self, axis: usize, range: std::ops::RangeInclusive<usize>) {
         let [nx, ny, nz] = self.dims;
         for n in 0..nx * ny * nz {
-            if !range.contains(&(n % nx)) {
+            let at = [n % nx, n / nx % ny, n / (nx * ny)];
+            if !range.contains(&at[axis]) {
                 self.words[n >> 6] &= !(1 << (n & 63));
             }
         }

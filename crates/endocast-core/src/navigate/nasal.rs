@@ -4,7 +4,10 @@
 //! the slice's border, while the nasal cavity above the nostrils, the sinuses, the pharynx and
 //! the mastoid air cells are holes in the head; the nostrils open downwards, so the slices cut
 //! them off. The nasal cavity is the largest 3D component of those holes that crosses the
-//! head's mid-sagittal plane: the mastoid cells lie to the sides.
+//! head's mid-sagittal plane: the mastoid cells lie to the sides. The axial slices and the
+//! left–right axis are taken from the scan's orientation (the index axes nearest the patient's
+//! superior–inferior and left–right), so a head stored in sagittal or coronal slices, or
+//! flipped, is read the same way.
 
 use super::distance::DistanceField;
 use super::lumen::{BitGrid, Lumen, LumenSide};
@@ -45,13 +48,16 @@ pub fn find_nasal_cavity(volume: &Volume, threshold: f64) -> Option<NasalCavity>
     if !threshold.is_finite() {
         return None;
     }
-    let (mut holes, middle) = slice_holes(volume, threshold);
+    let axes = BodyAxes::of(volume);
+    let (mut holes, middle) = slice_holes(volume, threshold, axes);
     let middle = middle?;
-    let spans = |lo: [usize; 3], hi: [usize; 3]| (lo[0]..=hi[0]).contains(&middle);
+    let lr = axes.left_right;
+    let spans = |lo: [usize; 3], hi: [usize; 3]| (lo[lr]..=hi[lr]).contains(&middle);
     let below = LumenSide::Below;
     let lumen = Lumen::largest_within(volume, threshold, below, &holes, spans).ok()??;
-    let reach = (PASSAGE_HALF_WIDTH_MM / volume.geometry().spacing_mm().x).round() as usize;
-    holes.keep_i(middle.saturating_sub(reach)..=middle + reach);
+    let spacing = volume.geometry().spacing_mm().to_array();
+    let reach = (PASSAGE_HALF_WIDTH_MM / spacing[lr]).round() as usize;
+    holes.keep_along(lr, middle.saturating_sub(reach)..=middle + reach);
     let passages = Lumen::largest_within(volume, threshold, below, &holes, spans).ok()??;
     let start_mm = front_centre(volume, &passages);
     Some(NasalCavity {
@@ -59,6 +65,42 @@ pub fn find_nasal_cavity(volume: &Volume, threshold: f64) -> Option<NasalCavity>
         passages,
         start_mm,
     })
+}
+
+/// The index axes (0 `i`, 1 `j`, 2 `k`) of a volume nearest the patient's axes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct BodyAxes {
+    /// Nearest superior–inferior (world z): the axial slices are across it.
+    superior: usize,
+    /// Nearest left–right (world x) of the other two.
+    left_right: usize,
+}
+
+impl BodyAxes {
+    fn of(volume: &Volume) -> Self {
+        let d = volume.geometry().direction();
+        let along = |a: usize, world: usize| d.col(a)[world].abs();
+        let superior = (0..3)
+            .max_by(|&a, &b| along(a, 2).total_cmp(&along(b, 2)))
+            .unwrap_or(2);
+        let left_right = (0..3)
+            .filter(|&a| a != superior)
+            .max_by(|&a, &b| along(a, 0).total_cmp(&along(b, 0)))
+            .unwrap_or(0);
+        Self {
+            superior,
+            left_right,
+        }
+    }
+
+    /// The two in-slice axes, lower first.
+    fn in_slice(self) -> [usize; 2] {
+        match self.superior {
+            0 => [1, 2],
+            1 => [0, 2],
+            _ => [0, 1],
+        }
+    }
 }
 
 /// The most central voxel (largest distance to the wall) of the front [`FRONT_SHARE`] of
@@ -84,34 +126,49 @@ fn front_centre(volume: &Volume, passages: &Lumen) -> DVec3 {
         .map_or(world[0], |(_, &p)| p)
 }
 
-/// The air holes of every axial slice (one bit per voxel), and the mean `i` of the voxels at or
-/// above `threshold` (`None` when there are none). Slices in parallel.
-fn slice_holes(volume: &Volume, threshold: f64) -> (BitGrid, Option<usize>) {
-    let [nx, ny, nz] = volume.dims();
+/// The air holes of every axial slice (across `axes.superior`; one bit per voxel), and the mean
+/// index along `axes.left_right` of the voxels at or above `threshold` (`None` when there are
+/// none). Slices in parallel.
+fn slice_holes(volume: &Volume, threshold: f64, axes: BodyAxes) -> (BitGrid, Option<usize>) {
+    let dims = volume.dims();
+    let [u, v] = axes.in_slice();
+    let (nu, nv) = (dims[u], dims[v]);
     let map = volume.value_map();
     let air: Vec<bool> = (0..=u16::MAX)
         .map(|s| map.physical(s) < threshold)
         .collect();
-    let per_slice: Vec<(Vec<bool>, f64, usize)> = volume
-        .voxels()
-        .par_chunks(nx * ny)
-        .map(|slice| {
-            let open: Vec<bool> = slice.iter().map(|&s| air[usize::from(s)]).collect();
+    let voxel = |m: usize, n: usize| {
+        let mut at = [0; 3];
+        at[axes.superior] = m;
+        at[u] = n % nu;
+        at[v] = n / nu;
+        at
+    };
+    let voxels = volume.voxels();
+    let linear = |[i, j, k]: [usize; 3]| i + dims[0] * (j + dims[1] * k);
+    let per_slice: Vec<(Vec<bool>, f64, usize)> = (0..dims[axes.superior])
+        .into_par_iter()
+        .map(|m| {
+            let open: Vec<bool> = (0..nu * nv)
+                .map(|n| air[usize::from(voxels[linear(voxel(m, n))])])
+                .collect();
             let (sum, count) = open
                 .iter()
                 .enumerate()
                 .filter(|(_, &a)| !a)
-                .fold((0.0, 0), |(s, c), (n, _)| (s + (n % nx) as f64, c + 1));
-            (holes_of(&open, nx, ny), sum, count)
+                .fold((0.0, 0), |(s, c), (n, _)| {
+                    (s + voxel(m, n)[axes.left_right] as f64, c + 1)
+                });
+            (holes_of(&open, nu, nv), sum, count)
         })
         .collect();
-    let mut holes = BitGrid::new([nx, ny, nz]);
+    let mut holes = BitGrid::new(dims);
     let (mut sum, mut count) = (0.0, 0);
-    for (k, (slice, s, c)) in per_slice.into_iter().enumerate() {
+    for (m, (slice, s, c)) in per_slice.into_iter().enumerate() {
         sum += s;
         count += c;
         for (n, _) in slice.iter().enumerate().filter(|(_, &h)| h) {
-            holes.set([n % nx, n / nx, k]);
+            holes.set(voxel(m, n));
         }
     }
     let middle = (count > 0).then(|| (sum / count as f64).round() as usize);
@@ -150,11 +207,11 @@ fn holes_of(open: &[bool], nx: usize, ny: usize) -> Vec<bool> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn the_midline_cavity_is_cut_off_at_its_nostril_and_the_side_pocket_passed_over() {
-        // Tissue (40 HU, stored 1040) framed by air at the i and j sides; a midline cavity
-        // opening to the front air through a nostril in slices 14–15 only; a larger air pocket
-        // to the side (a mastoid's place), enclosed.
+    /// Tissue (40 HU, stored 1040) framed by air at the i and j sides (40 × 40 × 20 voxels of
+    /// 1 mm, axis-aligned: `i` left, `j` posterior, `k` superior); a midline cavity opening to
+    /// the front air through a nostril in slices 14–15 only; a larger air pocket to the side (a
+    /// mastoid's place), enclosed.
+    fn head_voxels() -> Vec<u16> {
         let dims = [40, 40, 20];
         let mut voxels = vec![1040u16; dims[0] * dims[1] * dims[2]];
         for k in 0..dims[2] {
@@ -172,9 +229,18 @@ mod tests {
                 }
             }
         }
-        let g = crate::Geometry::axis_aligned(dims, DVec3::ONE, DVec3::ZERO).unwrap();
+        voxels
+    }
+
+    fn ct(geometry: crate::Geometry, voxels: Vec<u16>) -> Volume {
         let map = crate::ValueMap::new(1.0, -1000.0).unwrap();
-        let volume = Volume::new(g, voxels, map, crate::Modality::Ct).unwrap();
+        Volume::new(geometry, voxels, map, crate::Modality::Ct).unwrap()
+    }
+
+    #[test]
+    fn the_midline_cavity_is_cut_off_at_its_nostril_and_the_side_pocket_passed_over() {
+        let g = crate::Geometry::axis_aligned([40, 40, 20], DVec3::ONE, DVec3::ZERO).unwrap();
+        let volume = ct(g, head_voxels());
         // Grown on the threshold alone, the largest enclosed air is the pocket.
         let largest = Lumen::largest(&volume, -500.0, LumenSide::Below, true)
             .unwrap()
@@ -192,5 +258,36 @@ mod tests {
             "{s}"
         );
         assert!(find_nasal_cavity(&volume, f64::NAN).is_none());
+    }
+
+    #[test]
+    fn a_head_stored_in_sagittal_slices_front_to_back_is_read_the_same_way() {
+        // The same head stored with `a` superior, `b` left and `c` anterior (world x = b,
+        // y = 39 − c, z = a): its axial slices are the planes of constant `a`.
+        let axial = head_voxels();
+        let dims = [20, 40, 40];
+        let mut voxels = vec![0u16; axial.len()];
+        for c in 0..40 {
+            for b in 0..40 {
+                for a in 0..20 {
+                    let (i, j, k) = (b, 39 - c, a);
+                    voxels[a + 20 * (b + 40 * c)] = axial[i + 40 * (j + 40 * k)];
+                }
+            }
+        }
+        let direction = glam::DMat3::from_cols(DVec3::Z, DVec3::X, DVec3::NEG_Y);
+        let g =
+            crate::Geometry::new(dims, DVec3::ONE, DVec3::new(0.0, 39.0, 0.0), direction).unwrap();
+        let volume = ct(g, voxels);
+        let nose = find_nasal_cavity(&volume, -500.0).unwrap();
+        let at = |[i, j, k]: [usize; 3]| [k, i, 39 - j];
+        assert!(nose.lumen.contains(at([20, 12, 8])) && !nose.lumen.contains(at([8, 10, 10])));
+        assert!(!nose.lumen.contains(at([20, 5, 14])));
+        assert_eq!(nose.lumen.voxel_count(), 6 * 12 * 9);
+        let s = nose.start_mm;
+        assert!(
+            (8.0..12.0).contains(&s.y) && (18.0..=21.0).contains(&s.x),
+            "{s}"
+        );
     }
 }
