@@ -128,6 +128,16 @@ fn assert_walled(name: &str, s: &Start, depths: (f64, f64)) {
     );
 }
 
+/// The index of the voxel of `volume` nearest world point `p` (mm).
+fn nearest_voxel(volume: &Volume, p: DVec3) -> [usize; 3] {
+    let v = volume
+        .geometry()
+        .voxel_from_world()
+        .transform_point3(p)
+        .round();
+    [v.x as usize, v.y as usize, v.z as usize]
+}
+
 fn forward(pose: &Pose) -> DVec3 {
     (pose.look_at_mm - pose.eye_mm).normalize()
 }
@@ -174,14 +184,7 @@ fn angioscopy_on_the_abdomen_follows_the_aorta_from_the_top() {
         "bottom {}: not at the bifurcation",
         aorta.bottom_mm
     );
-    let to_voxel = |p: DVec3| {
-        let v = abdomen
-            .geometry()
-            .voxel_from_world()
-            .transform_point3(p)
-            .round();
-        [v.x as usize, v.y as usize, v.z as usize]
-    };
+    let to_voxel = |p: DVec3| nearest_voxel(abdomen, p);
     let renal = DVec3::new(21.5, 94.8, 280.91);
     let kidney = DVec3::new(74.1, 122.7, 280.91);
     assert!(aorta.lumen.contains(to_voxel(renal)) && !aorta.lumen.contains(to_voxel(kidney)));
@@ -289,14 +292,7 @@ fn colonoscopy_on_the_abdomen_starts_in_colon_gas_not_the_lung_nor_the_table() {
     let s = start(abdomen, "colonoscopy");
     assert!(s.what.starts_with("colon"), "{}", s.what);
     assert_walled("colonoscopy", &s, (2.0, 80.0));
-    let to_voxel = |p: DVec3| {
-        let v = abdomen
-            .geometry()
-            .voxel_from_world()
-            .transform_point3(p)
-            .round();
-        [v.x as usize, v.y as usize, v.z as usize]
-    };
+    let to_voxel = |p: DVec3| nearest_voxel(abdomen, p);
     // Gas (below −900 HU), not aerated lung (−820 to −900).
     let [i, j, k] = to_voxel(s.pose.eye_mm);
     let value = abdomen.physical(i, j, k).unwrap();
