@@ -130,9 +130,10 @@ impl RayPass {
         } else {
             Layers::HIT_POSITION | Layers::NORMAL
         };
+        // The look shades the G-buffer itself: the renderer only finds the surfaces.
         let options = RenderOptions {
             grid_shift: shift,
-            ..RenderOptions::new().layers(layers)
+            ..RenderOptions::new().layers(layers).unlit()
         };
         let mut frame = Frame::default();
         // Nothing cancels it.

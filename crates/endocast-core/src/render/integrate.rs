@@ -131,8 +131,9 @@ impl Integrator<'_> {
     /// Renders a group of rays, each as [`Self::run`] would. Iso and hybrid go phase by phase
     /// (every ray's search, then every refinement, then every shading, then the volume behind):
     /// each ray's phases are a chain of dependent steps, while the rays are independent, so
-    /// taking one phase across the group lets the CPU overlap their chains.
-    pub fn run_group(&self, tasks: &mut [RayTask]) {
+    /// taking one phase across the group lets the CPU overlap their chains. Without `shade`
+    /// (iso only), the surfaces are found but not shaded: the colour stays transparent.
+    pub fn run_group(&self, tasks: &mut [RayTask], shade: bool) {
         let volume_behind = match self.params.mode {
             Mode::Iso => false,
             Mode::Hybrid => true,
@@ -146,6 +147,9 @@ impl Integrator<'_> {
         let surface = self.params.lower;
         self.search_group(tasks, surface.iso);
         self.refine_group(tasks, surface.iso);
+        if !shade && !volume_behind {
+            return;
+        }
         for chunk in tasks.chunks_mut(8) {
             self.lit_surfaces(chunk);
         }

@@ -461,3 +461,31 @@ fn the_preview_planner_starts_an_expensive_view_at_an_eighth() {
     planner.observe(Stage::Full, &frame(0));
     assert_eq!(planner.previews([512, 512], budget)[0], Quality::Quarter);
 }
+
+#[test]
+fn an_unlit_iso_render_finds_the_same_surfaces_and_shades_none() {
+    let (renderer, truth) = shell(32);
+    let camera = camera_in(&renderer, &truth, DVec3::new(2.0, -1.0, 0.5), 20);
+    let prepared = renderer.prepare(&iso()).unwrap();
+    let layers = Layers::HIT_POSITION | Layers::NORMAL;
+    let (mut lit, mut unlit) = (Frame::default(), Frame::default());
+    let options = RenderOptions::new().layers(layers);
+    prepared.render_with(&camera, &options, &mut lit).unwrap();
+    prepared
+        .render_with(&camera, &options.unlit(), &mut unlit)
+        .unwrap();
+    let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    assert!(same(&lit.depth_mm, &unlit.depth_mm));
+    assert!(lit
+        .hit_mm
+        .iter()
+        .flatten()
+        .eq(unlit.hit_mm.iter().flatten()));
+    assert!(lit
+        .normal
+        .iter()
+        .flatten()
+        .eq(unlit.normal.iter().flatten()));
+    assert!(lit.color.iter().all(|c| c.transmittance < 0.5));
+    assert!(unlit.color.iter().all(|c| c.transmittance == 1.0));
+}

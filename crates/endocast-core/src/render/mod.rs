@@ -521,7 +521,7 @@ impl Prepared {
                 adjust(&mut task.march, options, x + width * y);
             }
         }
-        integrator.run_group(tasks);
+        integrator.run_group(tasks, !options.unlit);
     }
 
     /// Writes row `row`'s rendered rays into `tile`: pixels, counters and optional layers.

@@ -90,6 +90,9 @@ pub struct RenderOptions<'a> {
     pub(crate) grid_shift: f32,
     /// Where the isosurface searches may start (the second eye of a stereo pair).
     pub(crate) starts: Option<&'a SearchStarts>,
+    /// Iso mode: find the surfaces (depths and the optional layers) but do not shade them; the
+    /// colour stays transparent. For passes that use only the geometry, like a look's ray pass.
+    pub(crate) unlit: bool,
 }
 
 impl fmt::Debug for RenderOptions<'_> {
@@ -102,6 +105,7 @@ impl fmt::Debug for RenderOptions<'_> {
             .field("progress", &self.progress.is_some())
             .field("grid_shift", &self.grid_shift)
             .field("starts", &self.starts.is_some())
+            .field("unlit", &self.unlit)
             .finish()
     }
 }
@@ -111,6 +115,14 @@ impl<'a> RenderOptions<'a> {
     pub(crate) fn search_starts(self, starts: &'a SearchStarts) -> Self {
         Self {
             starts: Some(starts),
+            ..self
+        }
+    }
+
+    /// Iso mode: surfaces found, not shaded (see the field).
+    pub(crate) fn unlit(self) -> Self {
+        Self {
+            unlit: true,
             ..self
         }
     }
