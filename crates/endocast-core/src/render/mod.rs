@@ -58,6 +58,7 @@ mod settings;
 mod simd;
 mod stereo;
 mod still;
+mod tile_pass;
 mod tiles;
 mod trace;
 mod transfer;
@@ -96,17 +97,15 @@ use glam::{DAffine3, DVec3, Vec3};
 use integrate::{Classified, Integrator, Params, PeelParams, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
-use scene_pass::SceneScratch;
 #[cfg(target_arch = "x86_64")]
 use simd::rays4::RaySetup;
-use std::cell::RefCell;
 use std::sync::Arc;
 use std::time::Instant;
 use stereo::SearchStarts;
-use tiles::{Control, Extra, Pixel, Tile, TileRect, Tiling};
+use tiles::{Control, Pixel, Tiling};
 use traverse::{BrickDda, VoxelRay};
 
-use crate::scene::{PlacedScene, Scene};
+use crate::scene::Scene;
 use crate::Volume;
 
 /// A volume ready for rendering: the volume and its brick grid (built once), and for sessions
@@ -446,136 +445,6 @@ impl Prepared {
         Tiling::new(camera.size()).render_into(tile, frame, options.layers, control)
     }
 
-    /// Renders the pixels of `rect`, each row's rays as one group; with a scene, the whole
-    /// tile's rays then meet it in square packets ([`Prepared::add_scene`]).
-    fn tile(
-        &self,
-        integrator: &Integrator<'_>,
-        camera: &Camera,
-        options: &RenderOptions<'_>,
-        scene: Option<&PlacedScene<'_>>,
-        rect: TileRect,
-    ) -> Tile {
-        let pixels = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
-        let mut tile = Tile {
-            pixels: vec![self.pixel_of(&PixelOut::default()); pixels],
-            extras: Vec::new(),
-            stats: RenderStats::default(),
-        };
-        if !options.layers.is_empty() {
-            tile.extras = vec![Extra::default(); pixels];
-        }
-        let view = TileView {
-            camera,
-            options,
-            rect,
-        };
-        // Without a scene each row is finished at once and its buffers reused.
-        let height = if scene.is_some() {
-            rect.y1 - rect.y0
-        } else {
-            1
-        };
-        let mut rows = ROWS.take();
-        if rows.len() < height {
-            rows.resize_with(height, RowTasks::default);
-        }
-        let rows_used = &mut rows[..height];
-        for y in rect.y0..rect.y1 {
-            let row = &mut rows_used[(y - rect.y0) % height];
-            row.y = y;
-            self.volume_row(integrator, &view, row);
-            if scene.is_none() {
-                self.finish_row(integrator, &view, row, &mut tile);
-            }
-        }
-        if let Some(scene) = scene {
-            SCENE_SCRATCH.with_borrow_mut(|scratch| {
-                self.add_scene(integrator, scene, &view, rows_used, scratch);
-                for (x, y, out) in &mut scratch.others {
-                    vignette(camera, *x, *y, out);
-                    tile.pixels[rect.index(*x, *y)] = self.pixel_of(out);
-                }
-            });
-            for row in rows_used {
-                self.finish_row(integrator, &view, row, &mut tile);
-            }
-        }
-        ROWS.set(rows);
-        tile
-    }
-
-    /// Casts row `row.y`'s rays of the tile through the volume into `row` (cleared first).
-    fn volume_row(&self, integrator: &Integrator<'_>, view: &TileView<'_>, row: &mut RowTasks) {
-        let (options, rect, y) = (view.options, view.rect, row.y);
-        let width = view.camera.size()[0];
-        row.columns.clear();
-        row.tasks.clear();
-        // A still frame's shifted grid is not the one the starts were checked on.
-        let late = options.starts.filter(|_| options.grid_shift == 0.0);
-        let late = late.map(|starts| (integrator, starts));
-        let (columns, tasks) = (&mut row.columns, &mut row.tasks);
-        self.row_tasks(view.camera, y, rect.x0..rect.x1, late, columns, tasks);
-        if options.grid_shift != 0.0 || options.max_distance_mm.is_some() {
-            for (&x, task) in columns.iter().zip(tasks.iter_mut()) {
-                adjust(&mut task.march, options, x + width * y);
-            }
-        }
-        integrator.run_group(tasks, !options.unlit);
-    }
-
-    /// Writes row `row`'s rendered rays into `tile`: pixels, counters and optional layers.
-    fn finish_row(
-        &self,
-        integrator: &Integrator<'_>,
-        view: &TileView<'_>,
-        row: &mut RowTasks,
-        tile: &mut Tile,
-    ) {
-        let (camera, y) = (view.camera, row.y);
-        for (&x, task) in row.columns.iter().zip(&mut row.tasks) {
-            vignette(camera, x, y, &mut task.out);
-            let task = &*task;
-            let i = view.rect.index(x, y);
-            tile.pixels[i] = self.pixel_of(&task.out);
-            count_ray(&mut tile.stats, task);
-            if !view.options.layers.is_empty() {
-                let extra = &mut tile.extras[i];
-                self.extra(integrator, camera, view.options, (x, y), task, extra);
-            }
-        }
-    }
-
-    /// The optional layers of pixel `(x, y)`, whose ray `task` has been rendered.
-    fn extra(
-        &self,
-        integrator: &Integrator<'_>,
-        camera: &Camera,
-        options: &RenderOptions<'_>,
-        (x, y): (usize, usize),
-        task: &RayTask,
-        extra: &mut Extra,
-    ) {
-        let layers = options.layers;
-        let depth = task.out.depth_mm;
-        if !depth.is_nan() {
-            if layers.contains(Layers::HIT_POSITION) {
-                if let Some(hit) = camera.point_at(x, y, f64::from(depth)) {
-                    extra.hit_mm = hit.as_vec3().to_array();
-                }
-            }
-            if layers.contains(Layers::NORMAL) {
-                extra.normal = integrator.normal_at(&task.march, depth).to_array();
-            }
-        }
-        if layers.contains(Layers::DEPTHS) {
-            if let Some(mut fresh) = self.task(camera, x, y) {
-                adjust(&mut fresh.march, options, x + camera.size()[0] * y);
-                integrator.crossings(&mut fresh.march, &mut extra.depths_mm);
-            }
-        }
-    }
-
     /// The ray of pixel `(x, y)`, in the world and in voxel space, and its part inside the
     /// volume; `None` where the camera forms no ray.
     fn ray(&self, camera: &Camera, x: usize, y: usize) -> Option<PixelRay> {
@@ -743,29 +612,6 @@ impl Prepared {
             value: (f64::from(out.value) * map.scale() + map.offset()) as f32,
         }
     }
-}
-
-thread_local! {
-    /// Each worker thread's row buffers, kept from tile to tile.
-    static ROWS: RefCell<Vec<RowTasks>> = RefCell::default();
-    /// Each worker thread's buffers for the scene pass, kept from tile to tile.
-    static SCENE_SCRATCH: RefCell<SceneScratch> = RefCell::new(SceneScratch::default());
-}
-
-/// What every row of one tile shares: the frame's camera and options, and the tile.
-#[derive(Clone, Copy)]
-struct TileView<'r> {
-    camera: &'r Camera,
-    options: &'r RenderOptions<'r>,
-    rect: TileRect,
-}
-
-/// One row of a tile: the columns whose rays meet the volume (ascending) and their tasks.
-#[derive(Default)]
-struct RowTasks {
-    y: usize,
-    columns: Vec<usize>,
-    tasks: Vec<RayTask>,
 }
 
 /// Darkens a ray's colour by the camera lens's vignetting at pixel `(x, y)`.

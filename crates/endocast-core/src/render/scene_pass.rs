@@ -22,12 +22,15 @@ use super::march::{MarchStats, RayMarch};
 use super::ray_task::{PixelOut, RayTask};
 use super::sample::Accum;
 use super::settings::Mode;
+use super::tile_pass::{RowTasks, TileView};
+use super::tiles::Tile;
 use super::traverse::VoxelRay;
-use super::{adjust, Prepared, RowTasks, TileView};
+use super::{adjust, vignette, Prepared};
 use crate::camera::Ray;
 use crate::scene::bvh::PACKET;
 use crate::scene::{Hit, PlacedScene, Scene, Traced};
 use glam::{Vec3, Vec3A};
+use std::cell::RefCell;
 use std::ops::Range;
 use std::sync::Arc;
 
@@ -36,9 +39,14 @@ use std::sync::Arc;
 const BLOCK: usize = 8;
 const _: () = assert!(BLOCK * BLOCK == PACKET, "a block is one packet");
 
+thread_local! {
+    /// Each worker thread's buffers for the scene pass, kept from tile to tile.
+    static SCRATCH: RefCell<SceneScratch> = RefCell::new(SceneScratch::default());
+}
+
 /// A tile's buffers for [`Prepared::add_scene`], kept from block to block.
 #[derive(Default)]
-pub(super) struct SceneScratch {
+struct SceneScratch {
     /// The block's rays and their intervals.
     rays: Vec<Traced>,
     /// Each ray's pixel and the index of its rendered task in the pixel's row (`None`: the
@@ -47,7 +55,7 @@ pub(super) struct SceneScratch {
     /// Each ray's surfaces.
     hits: Vec<Vec<Hit>>,
     /// The surfaces of pixels whose ray misses the volume: `(column, row, result)`.
-    pub others: Vec<(usize, usize, PixelOut)>,
+    others: Vec<(usize, usize, PixelOut)>,
 }
 
 impl Prepared {
@@ -64,27 +72,32 @@ impl Prepared {
     }
 
     /// Adds `scene` to the rays of the tile `view.rect`: the rendered tasks of `rows` (one
-    /// per row of the tile) in place, and for pixels whose ray misses the volume, their
-    /// surfaces into `scratch.others` as `(column, row, result)`. The rays of each square
-    /// block of pixels are traced together.
+    /// per row of the tile) in place, and the pixels of `tile` whose ray misses the volume
+    /// from their surfaces alone. The rays of each square block of pixels are traced together.
     pub(super) fn add_scene(
         &self,
         integrator: &Integrator<'_>,
         scene: &PlacedScene<'_>,
         view: &TileView<'_>,
         rows: &mut [RowTasks],
-        scratch: &mut SceneScratch,
+        tile: &mut Tile,
     ) {
-        scratch.others.clear();
-        let rect = view.rect;
-        for y0 in (rect.y0..rect.y1).step_by(BLOCK) {
-            for x0 in (rect.x0..rect.x1).step_by(BLOCK) {
-                let xs = x0..(x0 + BLOCK).min(rect.x1);
-                let ys = y0..(y0 + BLOCK).min(rect.y1);
-                self.block_rays(view, (xs, ys), rows, scratch);
-                self.add_block_hits(integrator, scene, view, rows, scratch);
+        SCRATCH.with_borrow_mut(|scratch| {
+            scratch.others.clear();
+            let rect = view.rect;
+            for y0 in (rect.y0..rect.y1).step_by(BLOCK) {
+                for x0 in (rect.x0..rect.x1).step_by(BLOCK) {
+                    let xs = x0..(x0 + BLOCK).min(rect.x1);
+                    let ys = y0..(y0 + BLOCK).min(rect.y1);
+                    self.block_rays(view, (xs, ys), rows, scratch);
+                    self.add_block_hits(integrator, scene, view, rows, scratch);
+                }
             }
-        }
+            for (x, y, out) in &mut scratch.others {
+                vignette(view.camera, *x, *y, out);
+                tile.pixels[rect.index(*x, *y)] = self.pixel_of(out);
+            }
+        });
     }
 
     /// The rays of the pixels `xs × ys` into `scratch` (cleared first), each traced from the
