@@ -75,6 +75,8 @@ mod peel_tests;
 mod scene_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod timing_tests;
 
 pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
 
