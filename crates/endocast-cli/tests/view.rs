@@ -2,40 +2,66 @@
 //! the colon phantom, refines the view, grabs its own window and quits.
 
 use crate::common::{endocast, fails_with};
+use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// An X server of our own on a free display number; killed on drop.
+/// An X server of our own, stopped on drop.
 struct Xvfb(Child, String);
 
 impl Xvfb {
+    /// Starts Xvfb on a display it picks itself (`-displayfd`: it skips displays whose lock or
+    /// socket is taken, and writes the number it chose once it accepts connections). `None`
+    /// when Xvfb is not installed; a server that is installed but does not come up is a
+    /// failure that shows its own words.
     fn start() -> Option<Self> {
-        for n in 90..110 {
-            if std::path::Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-                continue;
+        let mut child = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1400x900x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .ok()?;
+        let stdout = child.stdout.take().unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut line = String::new();
+            let _ = BufReader::new(stdout).read_line(&mut line);
+            let _ = tx.send(line);
+        });
+        match rx.recv_timeout(Duration::from_secs(60)) {
+            Ok(line) if !line.trim().is_empty() => Some(Self(child, format!(":{}", line.trim()))),
+            _ => {
+                let _ = child.kill();
+                let out = child.wait_with_output().unwrap();
+                panic!(
+                    "Xvfb did not start: {}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
             }
-            let display = format!(":{n}");
-            let child = Command::new("Xvfb")
-                .args([&display, "-screen", "0", "1400x900x24", "-nolisten", "tcp"])
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .spawn()
-                .ok()?;
-            let start = Instant::now();
-            while start.elapsed() < Duration::from_secs(10) {
-                if std::path::Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-                    return Some(Self(child, display));
-                }
-                std::thread::sleep(Duration::from_millis(50));
-            }
-            return None;
         }
-        None
     }
 }
 
 impl Drop for Xvfb {
+    /// SIGTERM, so that the server removes its lock file and socket (a killed one leaves
+    /// both behind, and the display numbers run out over many runs); SIGKILL if it lingers.
     fn drop(&mut self) {
+        let _ = Command::new("kill").arg(self.0.id().to_string()).status();
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_secs(5) {
+            if let Ok(Some(_)) = self.0.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
         let _ = self.0.kill();
         let _ = self.0.wait();
     }
@@ -76,7 +102,7 @@ fn view_opens_a_window_under_xvfb_and_writes_its_screenshot() {
     let output = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(status.success(), "{stderr}");
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+    let decoder = png::Decoder::new(BufReader::new(std::fs::File::open(&png).unwrap()));
     let mut reader = decoder.read_info().unwrap();
     let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut pixels).unwrap();
