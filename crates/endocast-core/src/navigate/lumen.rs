@@ -393,6 +393,27 @@ impl Lumen {
         self.side
     }
 
+    /// The same lumen on a volume whose axis `n` is this one's axis `axes[n]` (the same voxels
+    /// stored in another order; `axes` a permutation of 0, 1, 2).
+    pub(crate) fn with_axes(&self, axes: [usize; 3]) -> Self {
+        let pick = |v: [usize; 3]| axes.map(|a| v[a]);
+        let lo = pick(self.lo);
+        let mut mask = BitGrid::new(pick(self.mask.dims));
+        for v in self.voxels() {
+            let w = pick(v);
+            mask.set([0, 1, 2].map(|a| w[a] - lo[a]));
+        }
+        Self {
+            lo,
+            mask,
+            count: self.count,
+            volume_dims: pick(self.volume_dims),
+            seed: pick(self.seed),
+            threshold: self.threshold,
+            side: self.side,
+        }
+    }
+
     /// Every lumen voxel, `i` fastest (sorted by linear index).
     pub fn voxels(&self) -> impl Iterator<Item = [usize; 3]> + '_ {
         let [nx, ny, nz] = self.mask.dims;

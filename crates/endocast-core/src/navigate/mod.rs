@@ -19,6 +19,7 @@
 //! `[usize; 3]` of the volume, `i` first.
 
 mod aorta;
+mod axial;
 mod centreline;
 mod collision;
 mod colon;

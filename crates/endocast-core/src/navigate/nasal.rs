@@ -9,6 +9,7 @@
 //! superior–inferior and left–right), so a head stored in sagittal or coronal slices, or
 //! flipped, is read the same way.
 
+use super::axial::BodyAxes;
 use super::distance::DistanceField;
 use super::lumen::{BitGrid, Lumen, LumenSide};
 use super::section::neighbours4;
@@ -65,42 +66,6 @@ pub fn find_nasal_cavity(volume: &Volume, threshold: f64) -> Option<NasalCavity>
         passages,
         start_mm,
     })
-}
-
-/// The index axes (0 `i`, 1 `j`, 2 `k`) of a volume nearest the patient's axes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct BodyAxes {
-    /// Nearest superior–inferior (world z): the axial slices are across it.
-    superior: usize,
-    /// Nearest left–right (world x) of the other two.
-    left_right: usize,
-}
-
-impl BodyAxes {
-    fn of(volume: &Volume) -> Self {
-        let d = volume.geometry().direction();
-        let along = |a: usize, world: usize| d.col(a)[world].abs();
-        let superior = (0..3)
-            .max_by(|&a, &b| along(a, 2).total_cmp(&along(b, 2)))
-            .unwrap_or(2);
-        let left_right = (0..3)
-            .filter(|&a| a != superior)
-            .max_by(|&a, &b| along(a, 0).total_cmp(&along(b, 0)))
-            .unwrap_or(0);
-        Self {
-            superior,
-            left_right,
-        }
-    }
-
-    /// The two in-slice axes, lower first.
-    fn in_slice(self) -> [usize; 2] {
-        match self.superior {
-            0 => [1, 2],
-            1 => [0, 2],
-            _ => [0, 1],
-        }
-    }
 }
 
 /// The most central voxel (largest distance to the wall) of the front [`FRONT_SHARE`] of

@@ -1,6 +1,8 @@
 //! The airway tree with no seed: the trachea found as the round air column in the top axial
-//! slices, then grown below a threshold lowered until the tree stops leaking into the lung.
+//! slices, then grown below a threshold lowered until the tree stops leaking into the lung. A
+//! scan stored in sagittal or coronal slices is read in an axial copy.
 
+use super::axial::AxialCopy;
 use super::lumen::{Lumen, LumenSide};
 use super::section::{sections, top_is_last};
 use crate::Volume;
@@ -21,8 +23,19 @@ const LOWER_TRIES: usize = 5;
 /// The airway tree below `threshold` (HU): seeded in the most central round air section of the
 /// top axial slices (the scan's highest `z`), grown in 3D and, while it holds more than
 /// [`MAX_TREE_MM3`] or leaks out of the volume, grown again [`LOWER_STEP`] lower. `None` when
-/// no slice holds a round air section of the trachea's size, or every try leaks.
+/// no slice holds a round air section of the trachea's size, or every try leaks. A scan stored
+/// in other than axial slices is searched in an axial copy ([`AxialCopy`]).
 pub fn find_trachea(volume: &Volume, threshold: f64) -> Option<(Lumen, f64)> {
+    match AxialCopy::of(volume) {
+        Some(copy) => {
+            trachea_in_axial(copy.volume(), threshold).map(|(tree, t)| (copy.lumen_back(&tree), t))
+        }
+        None => trachea_in_axial(volume, threshold),
+    }
+}
+
+/// [`find_trachea`] in a scan stored as axial slices.
+fn trachea_in_axial(volume: &Volume, threshold: f64) -> Option<(Lumen, f64)> {
     let seed = trachea_seed(volume, threshold)?;
     let spacing = volume.geometry().spacing_mm();
     let voxel_mm3 = spacing.x * spacing.y * spacing.z;
@@ -59,6 +72,7 @@ fn trachea_seed(volume: &Volume, threshold: f64) -> Option<[usize; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::navigate::axial::reordered;
     use crate::phantom::{self, PhantomOptions};
 
     #[test]
@@ -75,5 +89,21 @@ mod tests {
         assert!(tree.contains([24, 24, 0]) && tree.contains([24, 24, 47]));
         // No air below −2000: nothing is found.
         assert!(find_trachea(&volume, -2000.0).is_none());
+    }
+
+    #[test]
+    fn a_trachea_stored_in_sagittal_slices_is_the_same_tree() {
+        let (volume, _) = phantom::straight_tube(&PhantomOptions {
+            size: 48,
+            ..Default::default()
+        });
+        let (axial, _) = find_trachea(&volume, -900.0).unwrap();
+        // Stored with its superior axis as `i`: every section of the tube lies across `i`.
+        let sagittal = reordered(&volume, [2, 0, 1]).unwrap();
+        let (tree, t) = find_trachea(&sagittal, -900.0).unwrap();
+        assert_eq!(t, -900.0);
+        let mut back: Vec<[usize; 3]> = tree.voxels().map(|[a, b, c]| [b, c, a]).collect();
+        back.sort_by_key(|&[i, j, k]| (k, j, i));
+        assert_eq!(back, axial.voxels().collect::<Vec<_>>());
     }
 }

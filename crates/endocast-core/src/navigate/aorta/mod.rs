@@ -5,11 +5,13 @@
 //! next ([`chain`]), followed past both ends of the chain by its round core where a branch
 //! clings to its section ([`follow`]): from the top of the scan (or where it becomes round) to
 //! the bifurcation, where it splits into two smaller sections, or the scan's end. Every limit
-//! is in millimetres, converted with the scan's spacing.
+//! is in millimetres, converted with the scan's spacing. A scan stored in sagittal or
+//! coronal slices is read in an axial copy.
 
 mod chain;
 mod follow;
 
+use super::axial::AxialCopy;
 use super::lumen::{BitGrid, Lumen, LumenSide};
 use crate::Volume;
 use chain::{candidates, longest_chain, Candidate};
@@ -47,11 +49,23 @@ pub struct Aorta {
 /// The aorta on `side` of `threshold` (contrast above 130 HU): the longest chain of round
 /// candidate sections (see the module doc), at least [`MIN_LENGTH_MM`] long, followed past
 /// both ends. `None` when no slice has a round bright section of the aorta's size, or no chain
-/// is long enough.
+/// is long enough. A scan stored in other than axial slices is searched in an axial copy
+/// ([`AxialCopy`]).
 pub fn find_aorta(volume: &Volume, threshold: f64, side: LumenSide) -> Option<Aorta> {
     if !threshold.is_finite() {
         return None;
     }
+    match AxialCopy::of(volume) {
+        Some(copy) => aorta_in_axial(copy.volume(), threshold, side).map(|aorta| Aorta {
+            lumen: copy.lumen_back(&aorta.lumen),
+            ..aorta
+        }),
+        None => aorta_in_axial(volume, threshold, side),
+    }
+}
+
+/// [`find_aorta`] in a scan stored as axial slices.
+fn aorta_in_axial(volume: &Volume, threshold: f64, side: LumenSide) -> Option<Aorta> {
     let spacing = volume.geometry().spacing_mm();
     let max_gap = ((MAX_GAP_MM / spacing.z).floor() as usize).max(1);
     let span_mm = |chain: &[&Candidate]| {
@@ -139,6 +153,7 @@ fn allowed_voxels(volume: &Volume, chain: &[&Candidate]) -> BitGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::navigate::axial::reordered;
     use crate::phantom::{self, PhantomOptions};
 
     #[test]
@@ -243,5 +258,21 @@ mod tests {
             assert!(!aorta.lumen.contains(voxel(50.0 + apart, 30.0, k)));
         }
         assert!((0..50).all(|k| !aorta.lumen.contains(voxel(50.0, 62.0, k))));
+    }
+
+    #[test]
+    fn an_abdomen_stored_in_coronal_slices_gives_the_same_aorta() {
+        let volume = abdomen();
+        let axial = find_aorta(&volume, 130.0, LumenSide::Above).unwrap();
+        // Stored as coronal slices: `j` superior, `k` posterior.
+        let coronal = reordered(&volume, [0, 2, 1]).unwrap();
+        let aorta = find_aorta(&coronal, 130.0, LumenSide::Above).unwrap();
+        assert_eq!(aorta.lumen.volume_dims(), coronal.dims());
+        let mut back: Vec<[usize; 3]> = aorta.lumen.voxels().map(|[a, b, c]| [a, c, b]).collect();
+        back.sort_by_key(|&[i, j, k]| (k, j, i));
+        assert_eq!(back, axial.lumen.voxels().collect::<Vec<_>>());
+        let close = |a: DVec3, b: DVec3| (a - b).length() < 1e-9;
+        assert!(close(aorta.top_mm, axial.top_mm) && close(aorta.bottom_mm, axial.bottom_mm));
+        assert_eq!(aorta.radii_mm, axial.radii_mm);
     }
 }
