@@ -243,6 +243,35 @@ impl Volume {
         (a.min(b), a.max(b))
     }
 
+    /// The same scan stored with its axis `order[n]` as index axis `n` (`order` a permutation
+    /// of 0, 1, 2): the same voxels, each at the same world position (e.g. a scan in sagittal
+    /// slices stored again as axial slices). `None` when `order` is no permutation.
+    pub fn with_axes(&self, order: [usize; 3]) -> Option<Volume> {
+        if !(0..3).all(|a| order.contains(&a)) {
+            return None;
+        }
+        let g = &self.geometry;
+        let dims = g.dims();
+        let (spacing, d) = (g.spacing_mm(), g.direction());
+        let geometry = Geometry::new(
+            order.map(|a| dims[a]),
+            DVec3::from_array(order.map(|a| spacing[a])),
+            g.origin_mm(),
+            glam::DMat3::from_cols(d.col(order[0]), d.col(order[1]), d.col(order[2])),
+        )
+        .ok()?;
+        let stride = [1, dims[0], dims[0] * dims[1]];
+        let [sx, sy, sz] = order.map(|a| stride[a]);
+        let [nx, ny, nz] = geometry.dims();
+        let mut voxels = Vec::with_capacity(self.voxels.len());
+        for k in 0..nz {
+            for j in 0..ny {
+                voxels.extend((0..nx).map(|i| self.voxels[i * sx + j * sy + k * sz]));
+            }
+        }
+        Volume::new(geometry, voxels, self.value_map, self.modality.clone()).ok()
+    }
+
     /// Trilinearly interpolated physical value at a continuous voxel index, or `None` when the
     /// point lies outside the voxel centres' hull (or is not finite).
     pub fn sample_physical(&self, voxel: DVec3) -> Option<f64> {

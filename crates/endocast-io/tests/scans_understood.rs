@@ -146,4 +146,12 @@ fn the_airway_tree_is_found_on_the_chest_ct_without_the_lung() {
     assert!((hi_mm.z - lo_mm.z).abs() > 100.0);
     let across = (hi_mm.x - lo_mm.x).abs();
     assert!((60.0..=160.0).contains(&across), "{across} mm across");
+    // The same chest stored in sagittal slices (superior along `i`): the same tree.
+    let sagittal = chest.with_axes([2, 0, 1]).unwrap();
+    let (tree_s, threshold_s) = find_trachea(&sagittal, -900.0).unwrap();
+    assert_eq!(
+        (tree_s.voxel_count(), threshold_s),
+        (tree.voxel_count(), threshold)
+    );
+    assert!(tree_s.voxels().all(|[a, b, c]| tree.contains([b, c, a])));
 }

@@ -4,8 +4,7 @@
 //! chest stored in sagittal slices, or with its slices along `i`, is searched as the same chest.
 
 use super::lumen::Lumen;
-use crate::{Geometry, Volume};
-use glam::{DMat3, DVec3};
+use crate::Volume;
 
 /// The index axes (0 `i`, 1 `j`, 2 `k`) of a volume nearest the patient's axes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,7 +62,7 @@ impl AxialCopy {
         }
         let other = 3 - axes.superior - axes.left_right;
         let order = [axes.left_right, other, axes.superior];
-        let volume = reordered(volume, order)?;
+        let volume = volume.with_axes(order)?;
         Some(Self { volume, order })
     }
 
@@ -82,40 +81,12 @@ impl AxialCopy {
     }
 }
 
-/// `volume` stored again with its axis `order[n]` as axis `n` (`order` a permutation of 0, 1,
-/// 2): the same voxels, each at the same world position. `None` when `order` is no permutation.
-pub(crate) fn reordered(volume: &Volume, order: [usize; 3]) -> Option<Volume> {
-    if !(0..3).all(|a| order.contains(&a)) {
-        return None;
-    }
-    let g = volume.geometry();
-    let dims = g.dims();
-    let (spacing, d) = (g.spacing_mm(), g.direction());
-    let geometry = Geometry::new(
-        order.map(|a| dims[a]),
-        DVec3::from_array(order.map(|a| spacing[a])),
-        g.origin_mm(),
-        DMat3::from_cols(d.col(order[0]), d.col(order[1]), d.col(order[2])),
-    )
-    .ok()?;
-    let stride = [1, dims[0], dims[0] * dims[1]];
-    let [sx, sy, sz] = order.map(|a| stride[a]);
-    let [nx, ny, nz] = geometry.dims();
-    let from = volume.voxels();
-    let mut voxels = Vec::with_capacity(from.len());
-    for k in 0..nz {
-        for j in 0..ny {
-            voxels.extend((0..nx).map(|i| from[i * sx + j * sy + k * sz]));
-        }
-    }
-    let modality = volume.modality().clone();
-    Volume::new(geometry, voxels, volume.value_map(), modality).ok()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::navigate::LumenSide;
+    use crate::Geometry;
+    use glam::{DMat3, DVec3};
 
     #[test]
     fn a_sagittally_stored_scan_is_copied_as_axial_slices_and_its_lumens_map_back() {
@@ -131,7 +102,7 @@ mod tests {
         let c = copy.volume();
         assert_eq!(c.dims(), [5, 6, 4]);
         assert!(AxialCopy::of(c).is_none());
-        assert!(reordered(&volume, [0, 0, 1]).is_none());
+        assert!(volume.with_axes([0, 0, 1]).is_none());
         // Every voxel of the copy holds the scan's voxel at the same world position.
         for (k, j, i) in [(0, 0, 0), (3, 5, 4), (1, 2, 3), (2, 4, 1)] {
             let at = DVec3::new(i as f64, j as f64, k as f64);

@@ -72,7 +72,6 @@ fn trachea_seed(volume: &Volume, threshold: f64) -> Option<[usize; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::navigate::axial::reordered;
     use crate::phantom::{self, PhantomOptions};
 
     #[test]
@@ -99,7 +98,7 @@ mod tests {
         });
         let (axial, _) = find_trachea(&volume, -900.0).unwrap();
         // Stored with its superior axis as `i`: every section of the tube lies across `i`.
-        let sagittal = reordered(&volume, [2, 0, 1]).unwrap();
+        let sagittal = volume.with_axes([2, 0, 1]).unwrap();
         let (tree, t) = find_trachea(&sagittal, -900.0).unwrap();
         assert_eq!(t, -900.0);
         let mut back: Vec<[usize; 3]> = tree.voxels().map(|[a, b, c]| [b, c, a]).collect();

@@ -153,7 +153,6 @@ fn allowed_voxels(volume: &Volume, chain: &[&Candidate]) -> BitGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::navigate::axial::reordered;
     use crate::phantom::{self, PhantomOptions};
 
     #[test]
@@ -265,7 +264,7 @@ mod tests {
         let volume = abdomen();
         let axial = find_aorta(&volume, 130.0, LumenSide::Above).unwrap();
         // Stored as coronal slices: `j` superior, `k` posterior.
-        let coronal = reordered(&volume, [0, 2, 1]).unwrap();
+        let coronal = volume.with_axes([0, 2, 1]).unwrap();
         let aorta = find_aorta(&coronal, 130.0, LumenSide::Above).unwrap();
         assert_eq!(aorta.lumen.volume_dims(), coronal.dims());
         let mut back: Vec<[usize; 3]> = aorta.lumen.voxels().map(|[a, b, c]| [a, c, b]).collect();
