@@ -6,7 +6,7 @@
 //! finds for its ray.
 
 use super::{Aabb, PacketRay, Tri, EDGE_SLACK, PACKET};
-use glam::{BVec4A, Vec3A, Vec4};
+use glam::{BVec4A, Mat4, Vec3A, Vec4};
 
 /// Rays per group of [`Lanes`].
 pub(super) const LANES: usize = 4;
@@ -30,32 +30,49 @@ pub(super) struct Lanes {
 }
 
 impl Lanes {
-    /// The lanes of `rays` (at least one, at most [`PACKET`]).
-    pub(super) fn of(rays: &[PacketRay]) -> Self {
-        let first = rays[0];
-        let groups = rays.len().div_ceil(LANES);
-        let splat = |v: glam::Vec3| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
-        let mut lanes = Self {
-            origin: [splat(first.origin); GROUPS],
-            dir: [splat(first.dir); GROUPS],
+    /// Lanes of no ray.
+    pub(super) fn new() -> Self {
+        Self {
+            origin: [[Vec4::ZERO; 3]; GROUPS],
+            dir: [[Vec4::ZERO; 3]; GROUPS],
             inv_dir: [[Vec4::ZERO; 3]; GROUPS],
-            t_min: [Vec4::INFINITY; GROUPS],
-            t_max: [Vec4::NEG_INFINITY; GROUPS],
-            groups,
+            t_min: [Vec4::ZERO; GROUPS],
+            t_max: [Vec4::ZERO; GROUPS],
+            groups: 0,
+        }
+    }
+
+    /// Sets the lanes to `rays` (at least one, at most [`PACKET`]); the groups past them keep
+    /// what they held.
+    pub(super) fn fill(&mut self, rays: &[PacketRay]) {
+        let pad = PacketRay {
+            t_min: f32::INFINITY,
+            t_max: f32::NEG_INFINITY,
+            ..rays[0]
         };
-        for (l, ray) in rays.iter().enumerate() {
-            let (g, k) = (l / LANES, l % LANES);
-            for axis in 0..3 {
-                lanes.origin[g][axis][k] = ray.origin[axis];
-                lanes.dir[g][axis][k] = ray.dir[axis];
-            }
-            lanes.t_min[g][k] = ray.t_min;
-            lanes.t_max[g][k] = ray.t_max;
-        }
+        let groups = rays.len().div_ceil(LANES);
+        self.groups = groups;
+        let lanes = self;
         for g in 0..groups {
+            let ray = |k: usize| rays.get(LANES * g + k).unwrap_or(&pad);
+            // Four rays' first and last four numbers as columns, transposed into lanes.
+            let head = |r: &PacketRay| Vec4::new(r.origin.x, r.origin.y, r.origin.z, r.dir.x);
+            let tail = |r: &PacketRay| Vec4::new(r.dir.y, r.dir.z, r.t_min, r.t_max);
+            let [r0, r1, r2, r3] = [ray(0), ray(1), ray(2), ray(3)];
+            let a = Mat4::from_cols(head(r0), head(r1), head(r2), head(r3)).transpose();
+            let b = Mat4::from_cols(tail(r0), tail(r1), tail(r2), tail(r3)).transpose();
+            lanes.origin[g] = [a.x_axis, a.y_axis, a.z_axis];
+            lanes.dir[g] = [a.w_axis, b.x_axis, b.y_axis];
             lanes.inv_dir[g] = lanes.dir[g].map(Vec4::recip);
+            lanes.t_min[g] = b.z_axis;
+            lanes.t_max[g] = b.w_axis;
         }
-        lanes
+    }
+
+    /// The highest `t_max` of the rays.
+    pub(super) fn highest_t_max(&self) -> f32 {
+        let t = self.t_max[..self.groups].iter();
+        t.fold(Vec4::NEG_INFINITY, |m, &t| m.max(t)).max_element()
     }
 
     /// Which rays of group `group`, from ray `from` of the packet on, meet `bounds` within
@@ -86,12 +103,12 @@ impl Lanes {
         })
     }
 
-    /// Which rays of group `group` meet `tri` inside their intervals (bit `k`: lane `k`), and
-    /// at what distance: [`Tri::hit`] four rays at a time.
+    /// Which rays of group `group` among `mask` (bit `k`: lane `k`) meet `tri` inside their
+    /// intervals, and at what distance: [`Tri::hit`] four rays at a time.
     #[inline]
-    pub(super) fn hit(&self, group: usize, tri: &Tri) -> (u32, Vec4) {
+    pub(super) fn hit(&self, group: usize, tri: &Tri, mask: u32) -> (u32, Vec4) {
         let (o, d) = (&self.origin[group], &self.dir[group]);
-        hit4(tri, o, d, (self.t_min[group], self.t_max[group]))
+        hit4(tri, o, d, (self.t_min[group], self.t_max[group]), mask)
     }
 
     /// The ranges over all lanes of the starts and inverse directions, the lowest `t_min` and
@@ -146,14 +163,16 @@ fn dot(a: &Vec3x4, b: &Vec3x4) -> Vec4 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// [`Tri::hit`] for the four rays `origin + t·dir` with `t` inside `(t_min, t_max)` per lane:
-/// which lanes hit (bit `k`: lane `k`) and the distances (meaningful where they hit).
+/// [`Tri::hit`] for the four rays `origin + t·dir` with `t` inside `(t_min, t_max)` per lane,
+/// of which only the `lanes` (bit `k`: lane `k`) count: which lanes hit and the distances
+/// (meaningful where they hit).
 #[inline]
 pub(super) fn hit4(
     tri: &Tri,
     origin: &Vec3x4,
     dir: &Vec3x4,
     (t_min, t_max): (Vec4, Vec4),
+    lanes: u32,
 ) -> (u32, Vec4) {
     let splat = |v: glam::Vec3| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
     let (e1, e2) = (splat(tri.e1), splat(tri.e2));
@@ -165,12 +184,17 @@ pub(super) fn hit4(
     let s = [origin[0] - v0[0], origin[1] - v0[1], origin[2] - v0[2]];
     let u = dot(&s, &p) * inv;
     let in_u = u.cmpge(Vec4::splat(-EDGE_SLACK)) & u.cmple(Vec4::splat(1.0 + EDGE_SLACK));
+    let candidates = (usable & in_u).bitmask() & lanes;
+    if candidates == 0 {
+        // Coherent rays mostly miss a triangle together.
+        return (0, Vec4::ZERO);
+    }
     let q = cross(&s, &e1);
     let v = dot(dir, &q) * inv;
     let out_v = v.cmplt(Vec4::splat(-EDGE_SLACK)) | (u + v).cmpgt(Vec4::splat(1.0 + EDGE_SLACK));
     let t = dot(&e2, &q) * inv;
     let inside = t.cmpgt(t_min) & t.cmplt(t_max);
-    ((usable & in_u & !out_v & inside).bitmask(), t)
+    ((!out_v & inside).bitmask() & candidates, t)
 }
 
 #[cfg(test)]
@@ -254,9 +278,16 @@ mod tests {
                 };
                 let (o, d) = (lane(|r| r.0), lane(|r| r.1));
                 let bounds = (Vec4::from(rays.map(|r| r.2)), Vec4::from(rays.map(|r| r.3)));
-                let (mask, t) = hit4(&tri, &o, &d, bounds);
+                // Now and then only some lanes count.
+                let counted = if s.unit() < 0.3 {
+                    (s.next_u64() % 16) as u32
+                } else {
+                    0b1111
+                };
+                let (mask, t) = hit4(&tri, &o, &d, bounds, counted);
                 for (k, ray) in rays.iter().enumerate() {
                     let scalar = tri.hit(ray.0, ray.1, ray.2, ray.3);
+                    let scalar = scalar.filter(|_| counted >> k & 1 == 1);
                     let four = (mask >> k & 1 == 1).then(|| t[k]);
                     assert_eq!(
                         scalar.map(f32::to_bits),

@@ -20,6 +20,7 @@ use glam::Vec3;
 /// A ray of a packet ([`Bvh::traverse_packet`]): `origin + t·dir` for `t_min < t < t_max`
 /// (world mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub struct PacketRay {
     /// Start, world mm.
     pub origin: Vec3,

@@ -13,10 +13,16 @@
 use super::lanes::{Lanes, LANES};
 use super::{Aabb, Bvh, PacketRay, PACKET};
 use glam::{BVec3A, Vec3A};
+use std::cell::Cell;
 
 /// Relative margin of [`Bounds::misses`]: a box is ruled out only when every ray misses it by
 /// more than this share of the distances involved (far above `f32` rounding).
 const MARGIN: f32 = 1e-4;
+
+thread_local! {
+    /// Each thread's lanes, kept from walk to walk.
+    static SPARE: Cell<Option<Box<Lanes>>> = const { Cell::new(None) };
+}
 
 impl Bvh {
     /// [`Bvh::traverse`] for many rays at once: calls `on_hit(ray, t, triangle)` for every
@@ -54,8 +60,21 @@ impl Bvh {
         if rays.is_empty() {
             return;
         }
-        let mut lanes = Lanes::of(rays);
-        let mut packet = Bounds::of(&lanes);
+        // The thread's lanes from walk to walk (a nested walk makes its own).
+        let mut lanes = SPARE.take().unwrap_or_else(|| Box::new(Lanes::new()));
+        lanes.fill(rays);
+        self.walk_lanes(rays, &mut lanes, on_hit);
+        SPARE.set(Some(lanes));
+    }
+
+    /// [`Self::walk`] with the packet's rays in `lanes` too.
+    fn walk_lanes(
+        &self,
+        rays: &mut [PacketRay],
+        lanes: &mut Lanes,
+        on_hit: &mut dyn FnMut(usize, f32, u32) -> f32,
+    ) {
+        let mut packet = Bounds::of(lanes);
         // The first ray, from `from` on, that meets node `node`'s box, and where it enters it.
         let enters = |node: usize, from: usize, lanes: &Lanes, packet: &Option<Bounds>| {
             let bounds = &self.nodes[node].bounds;
@@ -66,23 +85,23 @@ impl Bvh {
         };
         let mut stack = [(0u32, 0u32); 64];
         let mut top = 0usize;
-        let Some((mut first, _)) = enters(0, 0, &lanes, &packet) else {
+        let Some((mut first, _)) = enters(0, 0, lanes, &packet) else {
             return;
         };
         let mut node = 0usize;
         loop {
             let nd = self.nodes[node];
             if nd.count > 0 {
-                if self.leaf(node, first, rays, &mut lanes, on_hit) {
+                if self.leaf(node, first, rays, lanes, on_hit) {
                     if let Some(p) = &mut packet {
-                        p.t_max = rays.iter().fold(f32::NEG_INFINITY, |m, r| m.max(r.t_max));
+                        p.t_max = lanes.highest_t_max();
                     }
                 }
             } else {
                 let (l, r) = (nd.index as usize, nd.index as usize + 1);
                 match (
-                    enters(l, first, &lanes, &packet),
-                    enters(r, first, &lanes, &packet),
+                    enters(l, first, lanes, &packet),
+                    enters(r, first, lanes, &packet),
                 ) {
                     (Some((fl, tl)), Some((fr, tr))) => {
                         let ((near, fnear), far) = if tl <= tr {
@@ -115,7 +134,7 @@ impl Bvh {
                 }
                 top -= 1;
                 let (next, from) = (stack[top].0 as usize, stack[top].1 as usize);
-                if let Some((f, _)) = enters(next, from, &lanes, &packet) {
+                if let Some((f, _)) = enters(next, from, lanes, &packet) {
                     (node, first) = (next, f);
                     break;
                 }
@@ -144,8 +163,7 @@ impl Bvh {
             // Triangle after triangle, each against the group's rays at once: each ray still
             // meets the triangles in order, with the bound its earlier hits left.
             for k in tris.clone() {
-                let (mut hits, t) = lanes.hit(group, &self.tris[k]);
-                hits &= mask;
+                let (mut hits, t) = lanes.hit(group, &self.tris[k], mask);
                 while hits != 0 {
                     let lane = hits.trailing_zeros() as usize;
                     hits &= hits - 1;
