@@ -13,6 +13,15 @@ pub(super) const LANES: usize = 4;
 /// Groups of a packet.
 const GROUPS: usize = PACKET / LANES;
 
+/// Every lane of a group (bit `k`: lane `k`).
+pub(super) const ALL_LANES: u32 = 0b1111;
+
+/// The lanes of ray `from`'s group from that ray on.
+#[inline]
+pub(super) fn from_lane(from: usize) -> u32 {
+    (ALL_LANES << (from % LANES)) & ALL_LANES
+}
+
 /// Three coordinates of four rays (x, y and z lanes).
 type Vec3x4 = [Vec4; 3];
 
@@ -75,10 +84,10 @@ impl Lanes {
         t.fold(Vec4::NEG_INFINITY, |m, &t| m.max(t)).max_element()
     }
 
-    /// Which rays of group `group`, from ray `from` of the packet on, meet `bounds` within
-    /// their intervals (bit `k`: lane `k`), and where each enters it.
+    /// Which rays of group `group` meet `bounds` within their intervals (bit `k`: lane `k`),
+    /// and where each enters it.
     #[inline]
-    pub(super) fn meet(&self, group: usize, bounds: &Aabb, from: usize) -> (u32, Vec4) {
+    pub(super) fn meet(&self, group: usize, bounds: &Aabb) -> (u32, Vec4) {
         let (o, inv) = (&self.origin[group], &self.inv_dir[group]);
         let (mut near, mut far) = (self.t_min[group], self.t_max[group]);
         for axis in 0..3 {
@@ -89,18 +98,23 @@ impl Lanes {
             near = t0.min(t1).max(near);
             far = t0.max(t1).min(far);
         }
-        let mask = near.cmple(far).bitmask();
-        let skip = from.saturating_sub(LANES * group).min(LANES);
-        (mask & (0xf << skip) & 0xf, near)
+        (near.cmple(far).bitmask(), near)
     }
 
     /// The first ray, from ray `from` on, that meets `bounds`, and where it enters it.
+    #[inline]
     pub(super) fn first_meeting(&self, bounds: &Aabb, from: usize) -> Option<(usize, f32)> {
-        (from / LANES..self.groups).find_map(|group| {
-            let (mask, near) = self.meet(group, bounds, from);
-            let lane = mask.trailing_zeros() as usize;
-            (mask != 0).then(|| (LANES * group + lane, near[lane]))
-        })
+        let mut counted = from_lane(from);
+        for group in from / LANES..self.groups {
+            let (mask, near) = self.meet(group, bounds);
+            let mask = mask & counted;
+            if mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                return Some((LANES * group + lane, near[lane]));
+            }
+            counted = ALL_LANES;
+        }
+        None
     }
 
     /// Which rays of group `group` among `mask` (bit `k`: lane `k`) meet `tri` inside their
@@ -282,7 +296,7 @@ mod tests {
                 let counted = if s.unit() < 0.3 {
                     (s.next_u64() % 16) as u32
                 } else {
-                    0b1111
+                    ALL_LANES
                 };
                 let (mask, t) = hit4(&tri, &o, &d, bounds, counted);
                 for (k, ray) in rays.iter().enumerate() {

@@ -10,7 +10,7 @@
 //! the test on the safe side of rounding. Boxes and triangles are tested against four rays at a
 //! time ([`Lanes`], in SSE registers through `glam::Vec4`).
 
-use super::lanes::{Lanes, LANES};
+use super::lanes::{from_lane, Lanes, ALL_LANES, LANES};
 use super::{Aabb, Bvh, PacketRay, PACKET};
 use glam::{BVec3A, Vec3A};
 use std::cell::Cell;
@@ -155,8 +155,10 @@ impl Bvh {
         let nd = self.nodes[node];
         let mut any = false;
         let tris = nd.index as usize..(nd.index + nd.count) as usize;
+        let mut counted = from_lane(first);
         for group in first / LANES..lanes.groups {
-            let mask = lanes.meet(group, &nd.bounds, first).0;
+            let mask = lanes.meet(group, &nd.bounds).0 & counted;
+            counted = ALL_LANES;
             if mask == 0 {
                 continue;
             }
