@@ -115,8 +115,11 @@ impl Prepared {
         let origin = camera.shared_origin();
         for y in ys {
             let row = &rows[y - view.rect.y0];
+            // The row's rendered columns ascend: the next one to match.
+            let mut next = row.columns.partition_point(|&c| c < xs.start);
             for x in xs.clone() {
-                let task = row.columns.binary_search(&x).ok();
+                let task = (row.columns.get(next) == Some(&x)).then_some(next);
+                next += usize::from(task.is_some());
                 // A rendered ray's direction is the camera's, rounded to `f32` (as a mesh's
                 // hierarchy takes it): no second set-up of the ray.
                 let ray = match (task, origin) {

@@ -35,6 +35,7 @@ pub use mesh::{MeshError, TriangleMesh};
 use crate::camera::{Camera, Ray};
 use bvh::{Bvh, PacketRay, PACKET};
 use glam::{DVec3, Vec3};
+use std::cell::Cell;
 use std::sync::Arc;
 use thiserror::Error;
 
@@ -259,37 +260,47 @@ impl PlacedScene<'_> {
                 }
             }
         }
+        let n = rays.len();
         let objects = &self.scene.objects;
+        let mut packet = [UNUSED_RAY; PACKET];
         for object in objects.iter().filter(|o| o.material.is_opaque()) {
-            let nearest = nearest_each(&object.shape, rays, &bound[..rays.len()]);
-            for (i, found) in nearest.into_iter().enumerate().take(rays.len()) {
-                if let Some((t, normal)) = found {
-                    bound[i] = t;
-                    opaque[i] = Some(hit(t, normal, &object.material));
-                }
-            }
+            let nearest = Nearest {
+                bound: &mut bound[..n],
+                opaque: &mut opaque[..n],
+                packet: &mut packet[..n],
+            };
+            nearest.find(object, rays);
         }
         for object in objects
             .iter()
             .filter(|o| !o.material.is_opaque() && o.material.opacity > 0.0)
         {
-            every_hit(object, rays, &bound[..rays.len()], hits);
+            every_hit(object, rays, &bound[..n], &mut packet[..n], hits);
         }
         for (hits, opaque) in hits.iter_mut().zip(opaque) {
-            hits.sort_by(|a, b| a.t_mm.total_cmp(&b.t_mm));
+            if hits.len() > 1 {
+                hits.sort_by(|a, b| a.t_mm.total_cmp(&b.t_mm));
+            }
             hits.extend(opaque);
         }
     }
 }
 
-/// `rays` as a packet for a mesh's hierarchy, each up to its `bound`.
-fn packet(rays: &[Traced], bound: &[f64]) -> [PacketRay; PACKET] {
-    let mut packet = [PacketRay {
-        origin: Vec3::ZERO,
-        dir: Vec3::X,
-        t_min: 0.0,
-        t_max: 0.0,
-    }; PACKET];
+thread_local! {
+    /// Each thread's list of a translucent mesh's hits in a packet: ray, distance, triangle.
+    static FOUND: Cell<Vec<(usize, f32, u32)>> = const { Cell::new(Vec::new()) };
+}
+
+/// A packet's lane that holds no ray yet.
+const UNUSED_RAY: PacketRay = PacketRay {
+    origin: Vec3::ZERO,
+    dir: Vec3::X,
+    t_min: 0.0,
+    t_max: 0.0,
+};
+
+/// `rays` into `packet` (as long) for a mesh's hierarchy, each up to its `bound`.
+fn fill_packet(rays: &[Traced], bound: &[f64], packet: &mut [PacketRay]) {
     for ((p, traced), &t_max) in packet.iter_mut().zip(rays).zip(bound) {
         *p = PacketRay {
             origin: traced.ray.origin.as_vec3(),
@@ -298,7 +309,6 @@ fn packet(rays: &[Traced], bound: &[f64]) -> [PacketRay; PACKET] {
             t_max: t_max as f32,
         };
     }
-    packet
 }
 
 fn hit(t: f64, normal: DVec3, m: &Material) -> Hit {
@@ -310,24 +320,46 @@ fn hit(t: f64, normal: DVec3, m: &Material) -> Hit {
     }
 }
 
-/// The nearest hit of `shape` along each of `rays` (at most [`PACKET`]) between its `t_min` and
-/// its `bound`: distance and unit normal.
-fn nearest_each(shape: &Shape, rays: &[Traced], bound: &[f64]) -> [Option<(f64, DVec3)>; PACKET] {
-    let mut found = [None; PACKET];
-    if let Shape::Mesh(m) = shape {
-        let mut packet = packet(rays, bound);
-        let mut best = [None; PACKET];
-        let n = rays.len();
-        m.nearest_each(&mut packet[..n], &mut best[..n]);
-        for (f, b) in found.iter_mut().zip(best) {
-            *f = b.map(|(t, tri)| (f64::from(t), m.normal(tri).as_dvec3()));
+/// The nearest opaque hit so far along each ray of a packet: its distance bound (mm) and the
+/// hit; with a packet buffer for a mesh's hierarchy.
+struct Nearest<'a> {
+    bound: &'a mut [f64],
+    opaque: &'a mut [Option<Hit>],
+    packet: &'a mut [PacketRay],
+}
+
+impl Nearest<'_> {
+    /// Lowers each ray's bound to `object`'s nearest hit between the ray's `t_min` and its
+    /// bound, where there is one, and makes that hit the ray's opaque one.
+    fn find(self, object: &Object, rays: &[Traced]) {
+        let material = &object.material;
+        if let Shape::Mesh(m) = &object.shape {
+            fill_packet(rays, self.bound, self.packet);
+            let mut best = [None; PACKET];
+            let best = &mut best[..rays.len()];
+            m.nearest_each(self.packet, best);
+            let found = self.bound.iter_mut().zip(self.opaque.iter_mut()).zip(best);
+            for ((bound, opaque), best) in found {
+                if let Some((t, tri)) = *best {
+                    *bound = f64::from(t);
+                    *opaque = Some(Hit {
+                        t_mm: t,
+                        normal: m.normal(tri),
+                        color: Vec3::from(material.color),
+                        opacity: material.opacity,
+                    });
+                }
+            }
+            return;
         }
-        return found;
+        for (i, traced) in rays.iter().enumerate() {
+            let (ray, t_min) = (&traced.ray, traced.t_min);
+            if let Some((t, normal)) = nearest_aid(&object.shape, ray, t_min, self.bound[i]) {
+                self.bound[i] = t;
+                self.opaque[i] = Some(hit(t, normal, material));
+            }
+        }
     }
-    for ((f, traced), &t_max) in found.iter_mut().zip(rays).zip(bound) {
-        *f = nearest_aid(shape, &traced.ray, traced.t_min, t_max);
-    }
-    found
 }
 
 /// The nearest hit of a procedural aid (not a mesh) in `(t_min, t_max)`: distance and unit
@@ -347,22 +379,33 @@ fn nearest_aid(shape: &Shape, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64,
 
 /// Every hit of `object` along each of `rays` (at most [`PACKET`]) between its `t_min` and its
 /// `bound`, appended to its list in `hits`: a mesh's in the order of distance, then triangle.
-fn every_hit(object: &Object, rays: &[Traced], bound: &[f64], hits: &mut [Vec<Hit>]) {
+fn every_hit(
+    object: &Object,
+    rays: &[Traced],
+    bound: &[f64],
+    packet: &mut [PacketRay],
+    hits: &mut [Vec<Hit>],
+) {
     let material = &object.material;
     match &object.shape {
         Shape::Mesh(m) => {
-            let n = rays.len();
-            let mut packet = packet(rays, bound);
-            let mut found = Vec::new();
-            m.traverse_packet(&mut packet[..n], |ray, t, tri| {
+            fill_packet(rays, bound, packet);
+            // The thread's list from packet to packet (no allocation per packet).
+            let mut found = FOUND.take();
+            found.clear();
+            m.traverse_packet(packet, |ray, t, tri| {
                 found.push((ray, t, tri));
                 bound[ray] as f32
             });
-            found.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
-            for (ray, t, tri) in found {
+            // No two entries are equal: a ray meets a triangle once.
+            found.sort_unstable_by(|a, b| {
+                a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2))
+            });
+            for &(ray, t, tri) in &found {
                 let normal = m.normal(tri).as_dvec3();
                 hits[ray].push(hit(f64::from(t), normal, material));
             }
+            FOUND.set(found);
         }
         Shape::Grid(_) => {
             for (i, traced) in rays.iter().enumerate() {

@@ -8,9 +8,11 @@
 //! the ray meet" (the nearest hit, let alone all hits, is left to the caller) and brings
 //! nalgebra with it; this file is about 250 lines.
 
+mod lanes;
 mod packet;
 
-pub use packet::PACKET;
+/// Rays walked through the tree as one packet at most (longer slices go in parts).
+pub const PACKET: usize = 64;
 
 use super::mesh::TriangleMesh;
 use glam::Vec3;
@@ -18,6 +20,7 @@ use glam::Vec3;
 /// A ray of a packet ([`Bvh::traverse_packet`]): `origin + t·dir` for `t_min < t < t_max`
 /// (world mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub struct PacketRay {
     /// Start, world mm.
     pub origin: Vec3,
@@ -89,8 +92,9 @@ struct Tri {
 }
 
 impl Tri {
-    /// The distance along the ray to the triangle, if it lies in `(t_min, t_max)`.
-    #[inline]
+    /// The distance along the ray to the triangle, if it lies in `(t_min, t_max)`: the
+    /// scalar reference of the four-ray test the walk runs ([`lanes`]), for the tests.
+    #[cfg(test)]
     fn hit(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
         let p = dir.cross(self.e2);
         let det = self.e1.dot(p);

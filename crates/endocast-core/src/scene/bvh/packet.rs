@@ -7,18 +7,22 @@
 //! the parent, and bounds only shrink): in a coherent packet the first try usually answers.
 //! Before that, the packet's bounds (the ranges of its rays' starts, inverse directions and
 //! distances) rule out at once the boxes that no ray of it can meet, with a margin that keeps
-//! the test on the safe side of rounding. Boxes are tested against four rays at a time
-//! (`Lanes`, in SSE registers through `glam::Vec4`).
+//! the test on the safe side of rounding. Boxes and triangles are tested against four rays at a
+//! time ([`Lanes`], in SSE registers through `glam::Vec4`).
 
-use super::{Aabb, Bvh, PacketRay};
-use glam::{BVec3A, Vec3, Vec3A, Vec4};
+use super::lanes::{from_lane, Lanes, ALL_LANES, LANES};
+use super::{Aabb, Bvh, PacketRay, PACKET};
+use glam::{BVec3A, Vec3A};
+use std::cell::Cell;
 
 /// Relative margin of [`Bounds::misses`]: a box is ruled out only when every ray misses it by
 /// more than this share of the distances involved (far above `f32` rounding).
 const MARGIN: f32 = 1e-4;
 
-/// Rays walked through the tree as one packet at most (longer slices go in parts).
-pub const PACKET: usize = 64;
+thread_local! {
+    /// Each thread's lanes, kept from walk to walk.
+    static SPARE: Cell<Option<Box<Lanes>>> = const { Cell::new(None) };
+}
 
 impl Bvh {
     /// [`Bvh::traverse`] for many rays at once: calls `on_hit(ray, t, triangle)` for every
@@ -53,13 +57,24 @@ impl Bvh {
 
     /// Walks one packet of at most [`PACKET`] rays.
     fn walk(&self, rays: &mut [PacketRay], on_hit: &mut dyn FnMut(usize, f32, u32) -> f32) {
-        let n = rays.len();
-        let mut inv_dir = [Vec3::ZERO; PACKET];
-        for (inv, ray) in inv_dir.iter_mut().zip(rays.iter()) {
-            *inv = ray.dir.recip();
+        if rays.is_empty() {
+            return;
         }
-        let mut packet = Bounds::of(rays, &inv_dir[..n]);
-        let mut lanes = Lanes::of(rays, &inv_dir[..n]);
+        // The thread's lanes from walk to walk (a nested walk makes its own).
+        let mut lanes = SPARE.take().unwrap_or_else(|| Box::new(Lanes::new()));
+        lanes.fill(rays);
+        self.walk_lanes(rays, &mut lanes, on_hit);
+        SPARE.set(Some(lanes));
+    }
+
+    /// [`Self::walk`] with the packet's rays in `lanes` too.
+    fn walk_lanes(
+        &self,
+        rays: &mut [PacketRay],
+        lanes: &mut Lanes,
+        on_hit: &mut dyn FnMut(usize, f32, u32) -> f32,
+    ) {
+        let mut packet = Bounds::of(lanes);
         // The first ray, from `from` on, that meets node `node`'s box, and where it enters it.
         let enters = |node: usize, from: usize, lanes: &Lanes, packet: &Option<Bounds>| {
             let bounds = &self.nodes[node].bounds;
@@ -70,23 +85,23 @@ impl Bvh {
         };
         let mut stack = [(0u32, 0u32); 64];
         let mut top = 0usize;
-        let Some((mut first, _)) = enters(0, 0, &lanes, &packet) else {
+        let Some((mut first, _)) = enters(0, 0, lanes, &packet) else {
             return;
         };
         let mut node = 0usize;
         loop {
             let nd = self.nodes[node];
             if nd.count > 0 {
-                if self.leaf(node, first, rays, &mut lanes, on_hit) {
+                if self.leaf(node, first, rays, lanes, on_hit) {
                     if let Some(p) = &mut packet {
-                        p.t_max = rays.iter().fold(f32::NEG_INFINITY, |m, r| m.max(r.t_max));
+                        p.t_max = lanes.highest_t_max();
                     }
                 }
             } else {
                 let (l, r) = (nd.index as usize, nd.index as usize + 1);
                 match (
-                    enters(l, first, &lanes, &packet),
-                    enters(r, first, &lanes, &packet),
+                    enters(l, first, lanes, &packet),
+                    enters(r, first, lanes, &packet),
                 ) {
                     (Some((fl, tl)), Some((fr, tr))) => {
                         let ((near, fnear), far) = if tl <= tr {
@@ -119,7 +134,7 @@ impl Bvh {
                 }
                 top -= 1;
                 let (next, from) = (stack[top].0 as usize, stack[top].1 as usize);
-                if let Some((f, _)) = enters(next, from, &lanes, &packet) {
+                if let Some((f, _)) = enters(next, from, lanes, &packet) {
                     (node, first) = (next, f);
                     break;
                 }
@@ -140,91 +155,29 @@ impl Bvh {
         let nd = self.nodes[node];
         let mut any = false;
         let tris = nd.index as usize..(nd.index + nd.count) as usize;
+        let mut counted = from_lane(first);
         for group in first / LANES..lanes.groups {
-            let mut mask = lanes.meet(group, &nd.bounds, first).0;
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let l = LANES * group + lane;
-                let ray = &mut rays[l];
-                let (o, d) = (ray.origin, ray.dir);
-                for k in tris.clone() {
-                    if let Some(t) = self.tris[k].hit(o, d, ray.t_min, ray.t_max) {
-                        ray.t_max = on_hit(l, t, self.order[k]);
-                        lanes.t_max[group][lane] = ray.t_max;
-                        any = true;
-                    }
+            let mask = lanes.meet(group, &nd.bounds).0 & counted;
+            counted = ALL_LANES;
+            if mask == 0 {
+                continue;
+            }
+            // Triangle after triangle, each against the group's rays at once: each ray still
+            // meets the triangles in order, with the bound its earlier hits left.
+            for k in tris.clone() {
+                let (mut hits, t) = lanes.hit(group, &self.tris[k], mask);
+                while hits != 0 {
+                    let lane = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    let l = LANES * group + lane;
+                    let t_max = on_hit(l, t[lane], self.order[k]);
+                    rays[l].t_max = t_max;
+                    lanes.t_max[group][lane] = t_max;
+                    any = true;
                 }
             }
         }
         any
-    }
-}
-
-/// Rays per group of [`Lanes`].
-const LANES: usize = 4;
-/// Groups of a packet.
-const GROUPS: usize = PACKET / LANES;
-
-/// A packet's rays four at a time (a structure of arrays): one box against four rays at once.
-/// Lanes past the packet's rays meet nothing.
-struct Lanes {
-    origin: [[Vec4; 3]; GROUPS],
-    inv_dir: [[Vec4; 3]; GROUPS],
-    t_min: [Vec4; GROUPS],
-    t_max: [Vec4; GROUPS],
-    /// Groups holding rays.
-    groups: usize,
-}
-
-impl Lanes {
-    /// The lanes of `rays` (with their inverse directions).
-    fn of(rays: &[PacketRay], inv_dir: &[Vec3]) -> Self {
-        let mut lanes = Self {
-            origin: [[Vec4::ZERO; 3]; GROUPS],
-            inv_dir: [[Vec4::ZERO; 3]; GROUPS],
-            t_min: [Vec4::INFINITY; GROUPS],
-            t_max: [Vec4::NEG_INFINITY; GROUPS],
-            groups: rays.len().div_ceil(LANES),
-        };
-        for (l, (ray, inv)) in rays.iter().zip(inv_dir).enumerate() {
-            let (g, k) = (l / LANES, l % LANES);
-            for axis in 0..3 {
-                lanes.origin[g][axis][k] = ray.origin[axis];
-                lanes.inv_dir[g][axis][k] = inv[axis];
-            }
-            lanes.t_min[g][k] = ray.t_min;
-            lanes.t_max[g][k] = ray.t_max;
-        }
-        lanes
-    }
-
-    /// Which rays of group `group`, from ray `from` of the packet on, meet `bounds` within
-    /// their intervals (bit `k`: lane `k`), and where each enters it.
-    #[inline]
-    fn meet(&self, group: usize, bounds: &Aabb, from: usize) -> (u32, Vec4) {
-        let (o, inv) = (&self.origin[group], &self.inv_dir[group]);
-        let (mut near, mut far) = (self.t_min[group], self.t_max[group]);
-        for axis in 0..3 {
-            let t0 = (Vec4::splat(bounds.lo[axis]) - o[axis]) * inv[axis];
-            let t1 = (Vec4::splat(bounds.hi[axis]) - o[axis]) * inv[axis];
-            // A NaN (a ray in the plane of a slab, along it) leaves the interval as it is:
-            // `min`/`max` return their second operand where either is NaN.
-            near = t0.min(t1).max(near);
-            far = t0.max(t1).min(far);
-        }
-        let mask = near.cmple(far).bitmask();
-        let skip = from.saturating_sub(LANES * group).min(LANES);
-        (mask & (0xf << skip) & 0xf, near)
-    }
-
-    /// The first ray, from ray `from` on, that meets `bounds`, and where it enters it.
-    fn first_meeting(&self, bounds: &Aabb, from: usize) -> Option<(usize, f32)> {
-        (from / LANES..self.groups).find_map(|group| {
-            let (mask, near) = self.meet(group, bounds, from);
-            let lane = mask.trailing_zeros() as usize;
-            (mask != 0).then(|| (LANES * group + lane, near[lane]))
-        })
     }
 }
 
@@ -243,33 +196,25 @@ struct Bounds {
 }
 
 impl Bounds {
-    /// The bounds of `rays` (with their inverse directions), or `None` where the rays' inverse
-    /// directions differ in sign or are not finite along an axis.
-    fn of(rays: &[PacketRay], inv_dir: &[Vec3]) -> Option<Self> {
-        let first = Vec3A::from(*inv_dir.first()?);
-        let negative = first.cmplt(Vec3A::ZERO);
-        let mut b = Self {
-            origin_lo: Vec3A::INFINITY,
-            origin_hi: Vec3A::NEG_INFINITY,
-            inv_lo: Vec3A::INFINITY,
-            inv_hi: Vec3A::NEG_INFINITY,
-            negative,
-            t_min: f32::INFINITY,
-            t_max: f32::NEG_INFINITY,
-        };
-        for (ray, &inv) in rays.iter().zip(inv_dir) {
-            let (o, inv) = (Vec3A::from(ray.origin), Vec3A::from(inv));
-            if !inv.is_finite() || !o.is_finite() || inv.cmplt(Vec3A::ZERO) != negative {
-                return None;
-            }
-            b.origin_lo = b.origin_lo.min(o);
-            b.origin_hi = b.origin_hi.max(o);
-            b.inv_lo = b.inv_lo.min(inv);
-            b.inv_hi = b.inv_hi.max(inv);
-            b.t_min = b.t_min.min(ray.t_min);
-            b.t_max = b.t_max.max(ray.t_max);
+    /// The bounds of the rays in `lanes`, or `None` where the rays' inverse directions differ
+    /// in sign or are not finite along an axis.
+    fn of(lanes: &Lanes) -> Option<Self> {
+        let r = lanes.ranges()?;
+        let (inv_lo, inv_hi) = r.inv_dir;
+        let negative = inv_hi.cmplt(Vec3A::ZERO);
+        // One sign per axis: all below zero, or none.
+        if (negative | inv_lo.cmpge(Vec3A::ZERO)) != BVec3A::TRUE {
+            return None;
         }
-        Some(b)
+        Some(Self {
+            origin_lo: r.origin.0,
+            origin_hi: r.origin.1,
+            inv_lo,
+            inv_hi,
+            negative,
+            t_min: r.t_min,
+            t_max: r.t_max,
+        })
     }
 
     /// Whether no ray of the packet can meet `bounds` (safely: a box that a ray only grazes is
