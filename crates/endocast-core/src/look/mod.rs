@@ -62,6 +62,8 @@ mod still;
 mod texture;
 
 #[cfg(test)]
+mod deferred_tests;
+#[cfg(test)]
 mod tests;
 
 pub use deferred::shade;

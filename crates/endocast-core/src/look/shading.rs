@@ -14,7 +14,7 @@ use glam::Vec3;
 use std::sync::Arc;
 
 /// Share of the colour the full wet darkening takes away at grazing view.
-const WET_DARKENING: f32 = 0.55;
+pub(super) const WET_DARKENING: f32 = 0.55;
 
 /// How the G-buffer is shaded; changing any of it marches no ray.
 #[derive(Debug, Clone, PartialEq)]
