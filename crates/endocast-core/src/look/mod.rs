@@ -49,8 +49,10 @@
 //! assert_ne!(wet.color, dry.color);
 //! ```
 
+mod deferred;
 mod gbuffer;
 mod kind;
+mod lanes;
 mod reduced;
 mod secretion;
 mod settings;
@@ -60,13 +62,16 @@ mod still;
 mod texture;
 
 #[cfg(test)]
+mod deferred_tests;
+#[cfg(test)]
 mod tests;
 
+pub use deferred::shade;
 pub use gbuffer::{GBuffer, RayPass};
 pub use kind::{Look, LookKind, PresetLook};
 pub use reduced::shade_reduced;
 pub use settings::{RayPassSettings, SecretionMode};
-pub use shading::{shade, Shading};
+pub use shading::Shading;
 pub use still::still;
 pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES};
 

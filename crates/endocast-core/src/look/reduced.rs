@@ -2,8 +2,9 @@
 //! depth-aware to the camera's, as the renderer's own quality levels do — so the deferred stage
 //! costs a quarter (half quality) or a sixteenth (quarter quality) of its full-size cost.
 
+use super::deferred::shade;
 use super::gbuffer::GBuffer;
-use super::shading::{shade, Shading};
+use super::shading::Shading;
 use super::LookError;
 use crate::camera::Camera;
 use crate::render::quality::{reduced_camera, upsample};

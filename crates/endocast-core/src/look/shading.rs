@@ -7,22 +7,14 @@
 //! secretion; and the secretion as fog, blending the tissue toward the secretion colour with
 //! its thickness.
 
-use super::gbuffer::GBuffer;
-use super::smooth::smooth;
+use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
 use super::texture::Texture;
 use super::{check, LookError};
-use crate::camera::Camera;
-use crate::render::{Frame, Layers, Premultiplied};
 use glam::Vec3;
-use rayon::prelude::*;
-use std::borrow::Cow;
 use std::sync::Arc;
 
-/// Exponent of the wet darkening's view dependence (the paper's "low power values").
-const WET_POWER: f32 = 2.0;
-
 /// Share of the colour the full wet darkening takes away at grazing view.
-const WET_DARKENING: f32 = 0.55;
+pub(super) const WET_DARKENING: f32 = 0.55;
 
 /// How the G-buffer is shaded; changing any of it marches no ray.
 #[derive(Debug, Clone, PartialEq)]
@@ -119,6 +111,7 @@ impl Shading {
     }
 
     /// The tip's light at `depth_mm`, 0–1.
+    #[inline(always)]
     fn falloff(&self, depth_mm: f32) -> f32 {
         self.attenuation_mm.map_or(1.0, |half| {
             let r = depth_mm / half;
@@ -126,84 +119,68 @@ impl Shading {
         })
     }
 
-    /// The colour of a hit at `depth_mm` and world position `p` with unit normal `n` (facing
-    /// the tip), `to_tip` the unit direction to the light, under `secretion_mm` of secretion.
-    fn color(&self, p: Vec3, n: Vec3, to_tip: Vec3, depth_mm: f32, secretion_mm: f32) -> Vec3 {
-        let cos = n.dot(to_tip).clamp(0.0, 1.0);
-        let texel = self
-            .texture
-            .as_ref()
-            .map_or(0.5, |t| t.triplanar(p / self.texture_mm, n));
-        let detail = 1.0 + self.texture_strength * (2.0 * texel - 1.0);
-        let fog = self.fog(secretion_mm);
-        let wet = (self.wetness + (1.0 - self.wetness) * fog * self.wetness.min(0.5) * 2.0)
-            .clamp(0.0, 1.0);
-        let lit = self.ambient + self.diffuse * cos;
-        let darkening = 1.0 - wet * WET_DARKENING * (1.0 - cos.powf(WET_POWER));
-        let tissue = Vec3::from(self.tissue_color) * (detail * lit * darkening);
-        let mucus = Vec3::from(self.secretion_color) * (lit * darkening);
-        // The reflected light's alignment with the view, for a light at the eye: 2 cos² − 1.
-        let mirror = (2.0 * cos * cos - 1.0).max(0.0);
-        let gloss = 1.3 - 0.6 * texel;
-        let strength = wet * self.specular * gloss;
-        let highlight = if strength > 0.0 && mirror > 0.0 {
-            strength * mirror.powf(self.shininess)
-        } else {
-            0.0
+    /// The colours of eight hits (before the vignetting and the clamp to 1), `tip` the light at
+    /// the endoscope's tip; lanes without a hit (NaN) give NaN or anything else.
+    #[inline(always)]
+    pub(super) fn colors8(&self, s: &Surface8, tip: Vec3) -> [Lanes; 3] {
+        let tip = tip.to_array();
+        let to_tip = normalize_or_zero(map3(|a, k| tip[a] - s.hit[a][k]));
+        let [nx, ny, nz] = &s.normal;
+        let facing = map(|k| nx[k] * to_tip[0][k] + ny[k] * to_tip[1][k] + nz[k] * to_tip[2][k]);
+        // The normal turned toward the tip: its cosine with the light is |n · to tip|.
+        let cos = map(|k| facing[k].abs().clamp(0.0, 1.0));
+        let texel = match &self.texture {
+            Some(t) => t.triplanar8(&map3(|a, k| s.hit[a][k] / self.texture_mm), &s.normal),
+            None => [0.5; LANES],
         };
-        (tissue.lerp(mucus, fog) + Vec3::splat(highlight)) * self.falloff(depth_mm)
+        let fog = if s.secretion.iter().any(|&mm| mm > 0.0) {
+            map(|k| self.fog(s.secretion[k]))
+        } else {
+            [0.0; LANES]
+        };
+        let wet = map(|k| {
+            let raised = (1.0 - self.wetness) * fog[k] * self.wetness.min(0.5) * 2.0;
+            (self.wetness + raised).clamp(0.0, 1.0)
+        });
+        let lit = map(|k| self.ambient + self.diffuse * cos[k]);
+        let darkening = map(|k| 1.0 - wet[k] * WET_DARKENING * (1.0 - cos[k] * cos[k]));
+        let tissue = map(|k| (1.0 + self.texture_strength * (2.0 * texel[k] - 1.0)) * lit[k]);
+        let tissue = map(|k| tissue[k] * darkening[k]);
+        let mucus = map(|k| lit[k] * darkening[k]);
+        let highlight = self.highlights8(&wet, &cos, &texel);
+        let falloff = map(|k| self.falloff(s.depth[k]));
+        map3(|c, k| {
+            let (t, m) = (self.tissue_color[c], self.secretion_color[c]);
+            let mixed = t * tissue[k] * (1.0 - fog[k]) + m * mucus[k] * fog[k];
+            (mixed + highlight[k]) * falloff[k]
+        })
+    }
+
+    /// The wet highlights of eight hits: sharp (the Phong exponent [`Self::shininess`]) where the
+    /// light reflects toward the tip (for a light at the eye, `2 cos² − 1` with the normal),
+    /// stronger on the texture's darker `texel`s and with wetness `wet`.
+    #[inline(always)]
+    fn highlights8(&self, wet: &Lanes, cos: &Lanes, texel: &Lanes) -> Lanes {
+        let mirror = map(|k| (2.0 * cos[k] * cos[k] - 1.0).max(0.0));
+        let strength = map(|k| wet[k] * self.specular * (1.3 - 0.6 * texel[k]));
+        let mut highlight = [0.0; LANES];
+        for k in 0..LANES {
+            if strength[k] > 0.0 && mirror[k] > 0.0 {
+                highlight[k] = strength[k] * mirror[k].powf(self.shininess);
+            }
+        }
+        highlight
     }
 }
 
-/// Shades `gbuffer` (traced by `camera`) as `shading` says, into a frame: colour, opaque where
-/// the rays hit and transparent (background) elsewhere, the smoothed depth, the camera's
-/// vignetting. Reads no volume: a new `shading` on the same G-buffer marches no ray. Fails
-/// when a setting is out of range or the G-buffer's size is not the camera's.
-pub fn shade(gbuffer: &GBuffer, camera: &Camera, shading: &Shading) -> Result<Frame, LookError> {
-    shading.validate()?;
-    let size = camera.size();
-    if [gbuffer.width, gbuffer.height] != size {
-        return Err(LookError::SizeMismatch {
-            gbuffer: [gbuffer.width, gbuffer.height],
-            camera: size,
-        });
-    }
-    let g = match shading.smoothing_px {
-        0 => Cow::Borrowed(gbuffer),
-        r => Cow::Owned(smooth(gbuffer, r)),
-    };
-    let tip = camera.eye_mm().as_vec3();
-    let mut frame = Frame::default();
-    frame.resize(size, Layers::NONE);
-    let w = size[0];
-    let vignetting = camera.lens().vignetting > 0.0;
-    frame
-        .color
-        .par_chunks_mut(w)
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, out) in row.iter_mut().enumerate() {
-                let i = x + w * y;
-                let depth = g.depth_mm[i];
-                if depth.is_nan() {
-                    *out = Premultiplied::default();
-                    continue;
-                }
-                let p = Vec3::from(g.hit_mm[i]);
-                let to_tip = (tip - p).normalize_or_zero();
-                let n = Vec3::from(g.normal[i]);
-                let n = if n.dot(to_tip) < 0.0 { -n } else { n };
-                let mut c = shading.color(p, n, to_tip, depth, g.secretion_mm[i]);
-                if vignetting {
-                    c *= camera.vignetting(x as f64 + 0.5, y as f64 + 0.5) as f32;
-                }
-                *out = Premultiplied {
-                    rgb: c.min(Vec3::ONE).to_array(),
-                    transmittance: 0.0,
-                };
-            }
-        });
-    frame.depth_mm.clone_from(&g.depth_mm);
-    frame.stats = gbuffer.stats;
-    Ok(frame)
+/// Eight pixels of a smoothed G-buffer row, channel by channel.
+pub(super) struct Surface8 {
+    /// Depth, mm (NaN: no hit).
+    pub depth: Lanes,
+    /// Hit position, mm.
+    pub hit: [Lanes; 3],
+    /// Unit normal (either side).
+    pub normal: [Lanes; 3],
+    /// Secretion, mm.
+    pub secretion: Lanes,
 }

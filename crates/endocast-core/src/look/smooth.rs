@@ -5,9 +5,15 @@
 //! neighbour's weight is zero.
 //!
 //! Two one-dimensional passes (rows, then columns), each weighting by the centre pixel's depth:
-//! the usual separable form of a cross-bilateral filter.
+//! the usual separable form of a cross-bilateral filter. They run on bands of rows (the rows'
+//! pass over the band and the window's rows above and below it, then the columns' pass), each
+//! band's channels in planes that stay in the cache, eight pixels at a time
+//! ([`super::lanes`]); [`SmoothBands::run`] hands each smoothed row on as it is done, so the
+//! shading reads it from the cache instead of a smoothed G-buffer in memory.
 
 use super::gbuffer::GBuffer;
+use super::lanes::{load, map, normalize_or_zero, padded, Lanes, LANES};
+use crate::render::with_avx2;
 use rayon::prelude::*;
 
 /// Relative depth difference (to the centre's depth) at which a neighbour's weight falls to
@@ -16,9 +22,25 @@ use rayon::prelude::*;
 pub const DEPTH_EDGE: f32 = 0.08;
 
 /// Channels smoothed per pixel: depth, hit position (3), normal (3), secretion.
-const CHANNELS: usize = 8;
+pub(super) const CHANNELS: usize = 8;
+/// The depth's channel.
+pub(super) const DEPTH: usize = 0;
+/// The hit position's first channel (x; y and z follow).
+pub(super) const HIT: usize = 1;
+/// The normal's first channel.
+pub(super) const NORMAL: usize = 4;
+/// The secretion's channel.
+pub(super) const SECRETION: usize = 7;
 
-type Texel = [f32; CHANNELS];
+/// Rows per band: each band also filters the window's rows above and below it.
+pub(super) const BAND_ROWS: usize = 16;
+
+/// The depth of "no hit" in the smoothing's planes: finite, so that its zero weight times it
+/// adds nothing, and so far that no centre gives it weight.
+const NO_HIT: f32 = f32::MAX;
+
+/// A row of channel planes, each [`padded`] to whole lane sets.
+pub(super) type Planes = [Vec<f32>; CHANNELS];
 
 /// The weight of a neighbour at depth `d` for a centre at depth `centre` (both finite).
 #[inline]
@@ -28,120 +50,289 @@ pub fn depth_weight(d: f32, centre: f32) -> f32 {
 
 /// One over the depth difference at which a neighbour of a centre at depth `centre` loses all
 /// weight (computed once per centre).
-#[inline]
+#[inline(always)]
 fn inverse_edge(centre: f32) -> f32 {
     1.0 / (DEPTH_EDGE * centre.abs()).max(1e-3)
 }
 
 /// The weight of a neighbour `difference` deeper than the centre, `inverse` its
 /// [`inverse_edge`].
-#[inline]
+#[inline(always)]
 fn weight_by_distance(difference: f32, inverse: f32) -> f32 {
     (2.0 - 2.0 * difference.abs() * inverse).clamp(0.0, 1.0)
 }
 
 /// `gbuffer` smoothed over a window of `2 · radius + 1` pixels each way (0: unchanged). Pixels
-/// without a hit stay without one and give no weight to those with one.
+/// without a hit stay without one (NaN depth, position and normal, no secretion) and give no
+/// weight to those with one.
 pub fn smooth(gbuffer: &GBuffer, radius: usize) -> GBuffer {
     if radius == 0 || gbuffer.is_empty() {
         return gbuffer.clone();
     }
-    let (w, h) = (gbuffer.width, gbuffer.height);
-    let kernel: Vec<f32> = (0..=radius)
-        .map(|k| {
-            let sigma = 0.5 * radius as f32 + 0.5;
-            (-0.5 * (k as f32 / sigma).powi(2)).exp()
-        })
-        .collect();
-    // Rows, each gathered into texels once (a row's worth stays in the cache).
-    let mut across = vec![[f32::NAN; CHANNELS]; w * h];
-    across.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        let texels: Vec<Texel> = (0..w).map(|x| texel(gbuffer, x + w * y)).collect();
-        for (x, out) in row.iter_mut().enumerate() {
-            *out = filtered(&texels, &kernel, x, |k| {
-                usize::try_from(x as isize + k).ok().filter(|&x| x < w)
-            });
-        }
-    });
-    // Columns, written straight into the smoothed buffer's layers.
-    let n = w * h;
+    let (w, n) = (gbuffer.width, gbuffer.len());
     let mut out = GBuffer {
         width: w,
-        height: h,
+        height: gbuffer.height,
         depth_mm: vec![0.0; n],
         hit_mm: vec![[0.0; 3]; n],
         normal: vec![[0.0; 3]; n],
         secretion_mm: vec![0.0; n],
         stats: gbuffer.stats,
     };
+    let bands = SmoothBands::new(gbuffer, radius);
+    let band = bands.band_pixels();
     out.depth_mm
-        .par_chunks_mut(w)
-        .zip(out.hit_mm.par_chunks_mut(w))
-        .zip(out.normal.par_chunks_mut(w))
-        .zip(out.secretion_mm.par_chunks_mut(w))
+        .par_chunks_mut(band)
+        .zip(out.hit_mm.par_chunks_mut(band))
+        .zip(out.normal.par_chunks_mut(band))
+        .zip(out.secretion_mm.par_chunks_mut(band))
         .enumerate()
-        .for_each(|(y, (((depth, hit), normal), secretion))| {
-            for x in 0..w {
-                let t = filtered(&across, &kernel, x + w * y, |k| {
-                    let y = usize::try_from(y as isize + k).ok().filter(|&y| y < h)?;
-                    Some(x + w * y)
-                });
-                depth[x] = t[0];
-                hit[x] = [t[1], t[2], t[3]];
-                let n = glam::Vec3::new(t[4], t[5], t[6]).normalize_or_zero();
-                normal[x] = n.to_array();
-                secretion[x] = t[7];
-            }
-        });
+        .for_each_init(
+            || bands.scratch(),
+            |scratch, (b, (((depth, hit), normal), secretion))| {
+                bands.run(
+                    b,
+                    scratch,
+                    #[inline(always)]
+                    |row, planes| {
+                        let at = row * w;
+                        for x in 0..w {
+                            let c = |channel: usize| planes[channel][x];
+                            depth[at + x] = c(DEPTH);
+                            hit[at + x] = [c(HIT), c(HIT + 1), c(HIT + 2)];
+                            normal[at + x] = [c(NORMAL), c(NORMAL + 1), c(NORMAL + 2)];
+                            secretion[at + x] = c(SECRETION);
+                        }
+                    },
+                );
+            },
+        );
     out
 }
 
-/// Pixel `i` of `gbuffer` as one texel of channels.
-fn texel(gbuffer: &GBuffer, i: usize) -> Texel {
-    let [px, py, pz] = gbuffer.hit_mm[i];
-    let [nx, ny, nz] = gbuffer.normal[i];
-    [
-        gbuffer.depth_mm[i],
-        px,
-        py,
-        pz,
-        nx,
-        ny,
-        nz,
-        gbuffer.secretion_mm[i],
-    ]
+/// The smoothing of one G-buffer, band by band: `run` smooths band `b` (rows
+/// `b · BAND_ROWS ..`) and hands on each smoothed row. Bands are independent, so they run in
+/// parallel, each with its own [`Scratch`].
+pub(super) struct SmoothBands<'a> {
+    gbuffer: &'a GBuffer,
+    /// Gaussian weights by distance in pixels, 0 ..= radius.
+    kernel: Vec<f32>,
 }
 
-/// The weighted mean of texel `centre`'s neighbours `neighbour(k)` for `k` in
-/// `−radius..=radius` (`None` past the image's edge).
-#[inline]
-fn filtered(
-    texels: &[Texel],
-    kernel: &[f32],
-    centre: usize,
-    neighbour: impl Fn(isize) -> Option<usize>,
-) -> Texel {
-    let c = texels[centre];
-    if c[0].is_nan() {
-        return c;
+/// A band's working rows (reused from band to band).
+pub(super) struct Scratch {
+    /// One G-buffer row, `radius` pixels of padding (no hit) either side.
+    input: Planes,
+    /// The rows' pass over the band and `radius` rows either side, one padded row after the
+    /// other; no hit ([`NO_HIT`], zero channels) beyond the image.
+    across: Planes,
+    /// The smoothed row handed on.
+    out: Planes,
+}
+
+impl<'a> SmoothBands<'a> {
+    /// The smoothing of `gbuffer` over a window of `2 · radius + 1` pixels each way (0: each
+    /// pixel as it is, its normal renormalised).
+    pub fn new(gbuffer: &'a GBuffer, radius: usize) -> Self {
+        let sigma = 0.5 * radius as f32 + 0.5;
+        let kernel = (0..=radius)
+            .map(|k| (-0.5 * (k as f32 / sigma).powi(2)).exp())
+            .collect();
+        Self { gbuffer, kernel }
     }
-    let r = kernel.len() as isize - 1;
-    let inverse = inverse_edge(c[0]);
-    let (mut sum, mut total) = ([0.0; CHANNELS], 0.0);
-    for k in -r..=r {
-        let Some(j) = neighbour(k) else { continue };
-        let t = &texels[j];
-        if t[0].is_nan() {
-            continue;
+
+    /// Pixels a band's rows hold.
+    pub fn band_pixels(&self) -> usize {
+        BAND_ROWS * self.gbuffer.width
+    }
+
+    /// Working rows for [`Self::run`].
+    pub fn scratch(&self) -> Scratch {
+        let (w, r) = (padded(self.gbuffer.width), self.radius());
+        let planes = |n: usize| std::array::from_fn(|_| vec![0.0; n]);
+        Scratch {
+            input: planes(w + 2 * r),
+            across: planes(w * (BAND_ROWS + 2 * r)),
+            out: planes(w),
         }
-        let weight = kernel[k.unsigned_abs()] * weight_by_distance(t[0] - c[0], inverse);
-        if weight > 0.0 {
-            for (s, v) in sum.iter_mut().zip(t) {
-                *s += weight * v;
+    }
+
+    fn radius(&self) -> usize {
+        self.kernel.len() - 1
+    }
+
+    /// Smooths band `b` and calls `emit(row in the band, planes)` on each of its rows in turn:
+    /// the planes hold the smoothed depth (NaN without a hit), hit position, unit normal (NaN
+    /// without a hit) and secretion of its pixels `0 .. width` (those past it are padding).
+    /// Compiled for AVX2 where the CPU has it, with `emit` inlined.
+    #[inline(always)]
+    pub fn run(&self, b: usize, scratch: &mut Scratch, mut emit: impl FnMut(usize, &Planes)) {
+        with_avx2(
+            #[inline(always)]
+            || {
+                let (h, r) = (self.gbuffer.height, self.radius() as isize);
+                let rows = b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h);
+                let first = rows.start as isize - r;
+                for (slot, y) in (first..rows.end as isize + r).enumerate() {
+                    let y = usize::try_from(y).ok().filter(|&y| y < h);
+                    self.across_row(y, slot, scratch);
+                }
+                for row in 0..rows.len() {
+                    self.down_row(row + r as usize, scratch);
+                    emit(row, &scratch.out);
+                }
+            },
+        );
+    }
+
+    /// The rows' pass over G-buffer row `y` (`None`: beyond the image) into slot `slot` of
+    /// `scratch.across`.
+    #[inline(always)]
+    fn across_row(&self, y: Option<usize>, slot: usize, scratch: &mut Scratch) {
+        let w = padded(self.gbuffer.width);
+        let at = slot * w;
+        let Some(y) = y else {
+            for (channel, plane) in scratch.across.iter_mut().enumerate() {
+                plane[at..at + w].fill(if channel == DEPTH { NO_HIT } else { 0.0 });
             }
-            total += weight;
+            return;
+        };
+        self.gather(y, &mut scratch.input);
+        let r = self.radius();
+        for x0 in (0..w).step_by(LANES) {
+            let mut window = Window::new(load(&scratch.input[DEPTH], x0 + r));
+            for k in 0..=2 * r {
+                window.add(self.kernel[k.abs_diff(r)], |c| {
+                    load(&scratch.input[c], x0 + k)
+                });
+            }
+            let mean = window.mean([NO_HIT, 0.0]);
+            for (plane, m) in scratch.across.iter_mut().zip(&mean) {
+                plane[at + x0..at + x0 + LANES].copy_from_slice(m);
+            }
         }
     }
-    // The centre itself always counts fully.
-    sum.map(|s| s / total)
+
+    /// G-buffer row `y` into `input`: no hit ([`NO_HIT`], zero channels) in the padding
+    /// and where the ray missed.
+    #[inline(always)]
+    fn gather(&self, y: usize, input: &mut Planes) {
+        let g = self.gbuffer;
+        let (w, r) = (g.width, self.radius());
+        for (channel, plane) in input.iter_mut().enumerate() {
+            plane.fill(if channel == DEPTH { NO_HIT } else { 0.0 });
+        }
+        for x in 0..w {
+            let i = x + w * y;
+            let depth = g.depth_mm[i];
+            if depth.is_nan() {
+                continue;
+            }
+            let texel = [
+                depth,
+                g.hit_mm[i][0],
+                g.hit_mm[i][1],
+                g.hit_mm[i][2],
+                g.normal[i][0],
+                g.normal[i][1],
+                g.normal[i][2],
+                g.secretion_mm[i],
+            ];
+            for (plane, v) in input.iter_mut().zip(texel) {
+                plane[r + x] = v;
+            }
+        }
+    }
+
+    /// The columns' pass for the band's row in slot `slot` of `scratch.across` into
+    /// `scratch.out`, its normals renormalised.
+    #[inline(always)]
+    fn down_row(&self, slot: usize, scratch: &mut Scratch) {
+        let w = padded(self.gbuffer.width);
+        let r = self.radius();
+        let across = &scratch.across;
+        for x0 in (0..w).step_by(LANES) {
+            let mut window = Window::new(load(&across[DEPTH], slot * w + x0));
+            for k in 0..=2 * r {
+                let at = (slot + k - r) * w + x0;
+                window.add(self.kernel[k.abs_diff(r)], |c| load(&across[c], at));
+            }
+            let mut mean = window.mean([f32::NAN, 0.0]);
+            let normal = [NORMAL, NORMAL + 1, NORMAL + 2];
+            let unit = normalize_or_zero([mean[NORMAL], mean[NORMAL + 1], mean[NORMAL + 2]]);
+            let hit = map(|k| if window.hit(k) { 1.0 } else { f32::NAN });
+            for (c, u) in normal.into_iter().zip(unit) {
+                // NaN without a hit.
+                mean[c] = map(|k| u[k] * hit[k]);
+            }
+            for position in &mut mean[HIT..HIT + 3] {
+                *position = map(|k| position[k] * hit[k]);
+            }
+            for (plane, m) in scratch.out.iter_mut().zip(&mean) {
+                plane[x0..x0 + LANES].copy_from_slice(m);
+            }
+        }
+    }
+}
+
+/// The weighted sums of one pass's window over eight centre pixels.
+struct Window {
+    centre: Lanes,
+    inverse: Lanes,
+    sum: [Lanes; CHANNELS],
+    total: Lanes,
+}
+
+impl Window {
+    /// An empty window around centres at depths `centre` ([`NO_HIT`]: none).
+    #[inline(always)]
+    fn new(centre: Lanes) -> Self {
+        Self {
+            centre,
+            inverse: map(|k| inverse_edge(centre[k])),
+            sum: [[0.0; LANES]; CHANNELS],
+            total: [0.0; LANES],
+        }
+    }
+
+    /// Whether centre `k` has a hit.
+    #[inline(always)]
+    fn hit(&self, k: usize) -> bool {
+        self.centre[k] < NO_HIT
+    }
+
+    /// Adds the neighbours whose channel `c` is `texel(c)`, at a distance of Gaussian weight
+    /// `tap`. A neighbour without a hit ([`NO_HIT`], zero channels) adds zero.
+    #[inline(always)]
+    fn add(&mut self, tap: f32, texel: impl Fn(usize) -> Lanes) {
+        let depth = texel(DEPTH);
+        let weight = map(|k| tap * weight_by_distance(depth[k] - self.centre[k], self.inverse[k]));
+        for (total, weight) in self.total.iter_mut().zip(&weight) {
+            *total += weight;
+        }
+        for (c, sum) in self.sum.iter_mut().enumerate() {
+            let v = if c == DEPTH { depth } else { texel(c) };
+            for k in 0..LANES {
+                sum[k] += weight[k] * v[k];
+            }
+        }
+    }
+
+    /// The weighted means; without a hit, `miss[0]` for the depth and `miss[1]` for the rest.
+    /// The centre always counts fully, so a hit's total weight is at least 1.
+    #[inline(always)]
+    fn mean(&self, miss: [f32; 2]) -> [Lanes; CHANNELS] {
+        let mut mean = [[0.0; LANES]; CHANNELS];
+        for (c, (mean, sum)) in mean.iter_mut().zip(&self.sum).enumerate() {
+            let miss = miss[usize::from(c != DEPTH)];
+            for k in 0..LANES {
+                mean[k] = if self.hit(k) {
+                    sum[k] / self.total[k]
+                } else {
+                    miss
+                };
+            }
+        }
+        mean
+    }
 }

@@ -2,8 +2,9 @@
 //! pixel, the interleaved sample grid shifted along the ray), each shaded and averaged — the
 //! library's still mode ([`crate::render::Still`]) for the two-stage look.
 
+use super::deferred::shade;
 use super::gbuffer::RayPass;
-use super::shading::{shade, Shading};
+use super::shading::Shading;
 use super::LookError;
 use crate::camera::Camera;
 use crate::render::{Frame, Jitter, Quality, Still};

@@ -3,6 +3,7 @@
 //! Built in: `mucosa` (a procedural, tileable pattern of mottled mucosa with fine vessels) and
 //! `grid` (lines, the strongest shape cue); user textures come from any greyscale image.
 
+use super::lanes::{map, map3, Lanes, LANES};
 use glam::Vec3;
 use thiserror::Error;
 
@@ -95,74 +96,123 @@ impl Texture {
     }
 
     /// The bilinearly interpolated value at `(u, v)` in tiles (1 = one repetition), wrapping.
-    #[inline]
     pub fn sample(&self, u: f32, v: f32) -> f32 {
-        let (w, h) = (self.width, self.height);
-        let (x0, x1, fx) = texel_pair(u, w);
-        let (y0, y1, fy) = texel_pair(v, h);
-        let t = |x: usize, y: usize| self.texels[x + w * y];
-        let top = t(x0, y0) + (t(x1, y0) - t(x0, y0)) * fx;
-        let bottom = t(x0, y1) + (t(x1, y1) - t(x0, y1)) * fx;
-        top + (bottom - top) * fy
+        self.sample8(&[u; LANES], &[v; LANES])[0]
+    }
+
+    /// [`Self::sample`] at eight points (their `u` and `v` lanes).
+    #[inline(always)]
+    pub(super) fn sample8(&self, u: &Lanes, v: &Lanes) -> Lanes {
+        let w = self.width;
+        let (x0, x1, fx) = texel_pairs(u, w);
+        let (y0, y1, fy) = texel_pairs(v, self.height);
+        let last = self.texels.len() - 1;
+        // The four texels around each point; every index is inside (x < width, y < height),
+        // and `min` shows it to the compiler.
+        let mut corner = [[0.0; LANES]; 4];
+        for k in 0..LANES {
+            let (row0, row1) = (w * y0[k] as usize, w * y1[k] as usize);
+            let (i0, i1) = (x0[k] as usize, x1[k] as usize);
+            for (c, i) in [i0 + row0, i1 + row0, i0 + row1, i1 + row1]
+                .into_iter()
+                .enumerate()
+            {
+                corner[c][k] = self.texels[i.min(last)];
+            }
+        }
+        let [a, b, c, d] = &corner;
+        map(|k| {
+            let top = a[k] + (b[k] - a[k]) * fx[k];
+            let bottom = c[k] + (d[k] - c[k]) * fx[k];
+            top + (bottom - top) * fy[k]
+        })
     }
 
     /// The tri-planar value at world position `p` (in tiles: mm over the tile's size in mm)
     /// with unit normal `n`: the three axis projections blended by the normal as the paper's
     /// Figure 5 does (weights `max(0, 7 (|n| − 0.2))³`, normalised).
     pub fn triplanar(&self, p: Vec3, n: Vec3) -> f32 {
-        let w = ((n.abs() - Vec3::splat(0.2)) * 7.0).max(Vec3::ZERO);
-        let w = w * w * w;
-        let sum = w.x + w.y + w.z;
-        if sum <= 0.0 {
-            return self.sample(p.x, p.y);
-        }
-        let mut value = 0.0;
-        if w.x > 0.0 {
-            value += w.x * self.sample(p.y, p.z);
-        }
-        if w.y > 0.0 {
-            value += w.y * self.sample(p.x, p.z);
-        }
-        if w.z > 0.0 {
-            value += w.z * self.sample(p.x, p.y);
-        }
-        value / sum
+        let lanes = |v: Vec3| v.to_array().map(|c| [c; LANES]);
+        self.triplanar8(&lanes(p), &lanes(n))[0]
+    }
+
+    /// [`Self::triplanar`] for eight positions (`p`: x, y and z lanes) and unit normals `n`. A
+    /// projection no lane weights is not sampled.
+    #[inline(always)]
+    pub(super) fn triplanar8(&self, p: &[Lanes; 3], n: &[Lanes; 3]) -> Lanes {
+        let w = map3(|a, k| {
+            let w = ((n[a][k].abs() - 0.2) * 7.0).max(0.0);
+            w * w * w
+        });
+        let sum = map(|k| w[0][k] + w[1][k] + w[2][k]);
+        let used = |axis: usize| w[axis].iter().any(|&w| w > 0.0);
+        let x = self.projection8(&p[1], &p[2], used(0));
+        let y = self.projection8(&p[0], &p[2], used(1));
+        // The (x, y) projection is also the fallback where no axis has weight.
+        let z = self.projection8(&p[0], &p[1], used(2) || sum.iter().any(|&s| s <= 0.0));
+        map(|k| {
+            if sum[k] <= 0.0 {
+                z[k]
+            } else {
+                (w[0][k] * x[k] + w[1][k] * y[k] + w[2][k] * z[k]) / sum[k]
+            }
+        })
     }
 }
 
-/// The two texels either side of tile coordinate `u` on an edge of `n` texels (wrapping) and the
-/// weight of the second: the bilinear filter's footprint along one axis.
+impl Texture {
+    /// One projection's values at `(u, v)` where it is `needed`, else zeros.
+    #[inline(always)]
+    fn projection8(&self, u: &Lanes, v: &Lanes, needed: bool) -> Lanes {
+        if needed {
+            self.sample8(u, v)
+        } else {
+            [0.0; LANES]
+        }
+    }
+}
+
+/// The two texels either side of tile coordinates `u` on an edge of `n` texels (wrapping) and
+/// the weights of the second: the bilinear filter's footprint along one axis. `floor` is one
+/// instruction where [`crate::render::with_avx2`] compiles this (SSE4.1), else a library call.
 #[inline(always)]
-fn texel_pair(u: f32, n: usize) -> (usize, usize, f32) {
+fn texel_pairs(u: &Lanes, n: usize) -> ([u32; LANES], [u32; LANES], Lanes) {
+    // At most MAX_TEXELS: exact.
+    let (n, last) = (n as f32, n as f32 - 1.0);
     // Texel centres lie at (i + 0.5) / n: x in [−0.5, n − 0.5).
-    let x = (u - floor(u)) * n as f32 - 0.5;
-    let x0 = floor(x);
-    let fx = x - x0;
+    let x = map(|k| (u[k] - u[k].floor()) * n - 0.5);
+    let x0 = map(|k| x[k].floor());
+    let fx = map(|k| x[k] - x0[k]);
     // x0 is −1 … n − 1 (NaN gives 0); no division wraps it.
-    let i = x0 as isize;
-    let i0 = if i < 0 {
-        n - 1
-    } else {
-        (i as usize).min(n - 1)
-    };
-    let i1 = if i0 + 1 == n { 0 } else { i0 + 1 };
-    (i0, i1, fx)
+    let first = map(|k| {
+        if x0[k] >= 0.0 {
+            x0[k].min(last)
+        } else if x0[k] < 0.0 {
+            last
+        } else {
+            0.0
+        }
+    });
+    let second = map(|k| {
+        if first[k] == last {
+            0.0
+        } else {
+            first[k] + 1.0
+        }
+    });
+    (whole(&first), whole(&second), fx)
 }
 
-/// `x.floor()` without a call into the maths library (the baseline x86-64 target has no
-/// rounding instruction): truncation, one down for negative non-integers; exact for every
-/// `f32` (those of magnitude 2²³ and more are integers already).
+/// Whole numbers 0 … 2²³ as integers: their bits once 2²³ is added (exact, and unlike `as`,
+/// which saturates, one vector operation).
 #[inline(always)]
-fn floor(x: f32) -> f32 {
-    if x.is_nan() || x.abs() >= 8_388_608.0 {
-        return x;
+fn whole(v: &Lanes) -> [u32; LANES] {
+    const TWO_23: f32 = 8_388_608.0;
+    let mut out = [0; LANES];
+    for (o, v) in out.iter_mut().zip(v) {
+        *o = (v + TWO_23).to_bits() - TWO_23.to_bits();
     }
-    let t = x as i32 as f32;
-    if t > x {
-        t - 1.0
-    } else {
-        t
-    }
+    out
 }
 
 /// A lattice value in [0, 1) at integer point `(x, y)` of a lattice repeating every `period`.
@@ -236,22 +286,7 @@ mod tests {
     }
 
     #[test]
-    fn floor_and_wrapping_match_the_library() {
-        for x in [
-            -2.5f32,
-            -1.0,
-            -0.3,
-            -0.0,
-            0.0,
-            0.7,
-            3.0,
-            1e9,
-            -1e9,
-            8_388_607.5,
-        ] {
-            assert_eq!(floor(x), x.floor(), "{x}");
-        }
-        assert!(floor(f32::NAN).is_nan());
+    fn sampling_wraps() {
         let t = Texture::from_luma(3, 1, vec![0.0, 0.5, 1.0]).unwrap();
         // Between the last texel and the first (wrapped), and at a texel's centre.
         for u in [0.0, 3.0, -1.0] {

@@ -99,8 +99,9 @@ use glam::{DAffine3, DVec3, Vec3};
 use integrate::{Classified, Integrator, Params, PeelParams, Probe, Surface};
 use march::RayMarch;
 use ray_task::{PixelOut, RayTask};
-#[cfg(target_arch = "x86_64")]
 use simd::rays4::RaySetup;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use simd::with_avx2;
 use std::sync::Arc;
 use std::time::Instant;
 use stereo::SearchStarts;

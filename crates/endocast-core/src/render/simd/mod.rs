@@ -10,7 +10,9 @@
 //! - [`sample`]: eight trilinear samples by gathers (AVX2);
 //! - [`sse`]: small SSE/SSE2 batches on eight values (crossing sides, transfer-table lookups)
 //!   with their scalar forms on other targets;
-//! - `unchecked`: the scalar sampler's read of a 2×2×2 cell with one bounds check.
+//! - `unchecked`: the scalar sampler's read of a 2×2×2 cell with one bounds check;
+//! - [`with_avx2`]: plain Rust (loops over fixed lanes that LLVM vectorises) compiled for AVX2
+//!   where the CPU has it: the look's deferred stage.
 //!
 //! # Safety argument
 //!
@@ -64,6 +66,29 @@ impl Avx2 {
             None
         }
     }
+}
+
+/// Runs `f` with AVX2 enabled for the code inlined into it (`#[inline(always)]` functions and
+/// closures: loops over fixed lanes then vectorise eight `f32` wide) where the CPU has AVX2,
+/// else as compiled for the baseline. No fused multiply-add is enabled, and LLVM reorders no
+/// floating-point operation, so both give the same bits.
+#[inline(always)]
+pub(crate) fn with_avx2<R>(f: impl FnOnce() -> R) -> R {
+    match Avx2::detect() {
+        #[cfg(target_arch = "x86_64")]
+        Some(_) => {
+            // SAFETY: the token exists, so the CPU has AVX2.
+            unsafe { avx2_context(f) }
+        }
+        _ => f(),
+    }
+}
+
+/// `f()` in a function compiled for AVX2, so that what is inlined into it is too.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn avx2_context<R>(f: impl FnOnce() -> R) -> R {
+    f()
 }
 
 #[cfg(target_arch = "x86_64")]
