@@ -126,6 +126,38 @@ fn accumulated_secretion_skips_the_air_between_a_drop_and_the_wall() {
     );
 }
 
+#[test]
+fn a_thin_sheet_of_tissue_in_the_secretion_is_found_not_stepped_over() {
+    // Along k: air, then secretion from k = 8, a sheet of tissue in slice 16 whose partial
+    // volume (−182 HU) lies just above the tissue threshold (−230 HU), so that the value passes
+    // the threshold over only 0.3 voxel along k (the thin edge of a turbinate in a sinus full of
+    // secretion), and the wall from k = 30. A continuation stepping half a voxel steps over the
+    // sheet on about a third of the rays and shows the wall behind it; every ray must stop at it.
+    let sheet_hu = -182.0;
+    let volume = rasterize([24, 24, 40], &options(40), &|p: DVec3| match p.z as i64 {
+        ..=7 => AIR_HU,
+        16 => sheet_hu,
+        30.. => TISSUE_HU,
+        _ => SECRETION_HU,
+    });
+    let tissue = Layered::tissue_threshold_hu();
+    let sheet = 16.0 - (sheet_hu - tissue) / (sheet_hu - SECRETION_HU);
+    let camera = looking_down_k(&volume, DVec3::new(11.5, 11.5, 2.0), 40.0, 16);
+    for mode in [SecretionMode::On, SecretionMode::Accumulate] {
+        let gbuffer =
+            pass(volume.clone(), mode, &RenderSettings::default()).trace(&camera, Quality::Full);
+        for i in 0..gbuffer.len() {
+            let cos = camera.pixel_ray(i % 16, i / 16).unwrap().dir.z as f32;
+            let depth = gbuffer.depth_mm[i] * cos;
+            assert!(
+                (f64::from(depth) - (sheet - 2.0)).abs() < 0.05,
+                "{mode:?}, pixel {i}: tissue at k {} (the sheet at {sheet:.3})",
+                depth + 2.0
+            );
+        }
+    }
+}
+
 /// Variance of the 4×4 block means of `error` (a `size²` image): the low-frequency energy in
 /// which sampling bands live (fine per-pixel patterns average out in a block).
 fn banding(error: &[f64], size: usize) -> f64 {
