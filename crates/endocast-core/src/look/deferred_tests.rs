@@ -57,12 +57,7 @@ fn smooth_by_pixel(g: &GBuffer, radius: usize) -> Vec<[f32; 8]> {
     let kernel: Vec<f32> = (0..=radius)
         .map(|k| (-0.5 * (k as f32 / sigma).powi(2)).exp())
         .collect();
-    let texels: Vec<[f32; 8]> = (0..w * h)
-        .map(|i| {
-            let ([px, py, pz], [nx, ny, nz]) = (g.hit_mm[i], g.normal[i]);
-            [g.depth_mm[i], px, py, pz, nx, ny, nz, g.secretion_mm[i]]
-        })
-        .collect();
+    let texels: Vec<[f32; 8]> = (0..w * h).map(|i| g.texel(i)).collect();
     let pass = |texels: &[[f32; 8]], step: [isize; 2]| -> Vec<[f32; 8]> {
         (0..w * h)
             .map(|i| {
@@ -172,17 +167,7 @@ fn the_vectorised_deferred_stage_matches_its_scalar_form() {
             let same = |a: f32, b: f32| a == b || (a.is_nan() && b.is_nan());
             assert!(same(frame.depth_mm[i], t[0]), "pixel {i}");
             if radius > 0 && !t[0].is_nan() {
-                let got = [
-                    smoothed.depth_mm[i],
-                    smoothed.hit_mm[i][0],
-                    smoothed.hit_mm[i][1],
-                    smoothed.hit_mm[i][2],
-                    smoothed.normal[i][0],
-                    smoothed.normal[i][1],
-                    smoothed.normal[i][2],
-                    smoothed.secretion_mm[i],
-                ];
-                assert_eq!(got, *t, "pixel {i}");
+                assert_eq!(smoothed.texel(i), *t, "pixel {i}");
             }
         }
     }

@@ -55,6 +55,22 @@ impl GBuffer {
     pub fn hit(&self, i: usize) -> bool {
         !self.depth_mm[i].is_nan()
     }
+
+    /// Pixel `i`'s eight channels as the smoothing filters them: depth, hit position (x, y,
+    /// z), normal (x, y, z), secretion.
+    pub(crate) fn texel(&self, i: usize) -> [f32; 8] {
+        let ([px, py, pz], [nx, ny, nz]) = (self.hit_mm[i], self.normal[i]);
+        [
+            self.depth_mm[i],
+            px,
+            py,
+            pz,
+            nx,
+            ny,
+            nz,
+            self.secretion_mm[i],
+        ]
+    }
 }
 
 /// The ray pass of a look over one renderer: it owns a renderer prepared in [`Mode::Iso`] at

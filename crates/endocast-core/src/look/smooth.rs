@@ -224,21 +224,10 @@ impl<'a> SmoothBands<'a> {
         }
         for x in 0..w {
             let i = x + w * y;
-            let depth = g.depth_mm[i];
-            if depth.is_nan() {
+            if !g.hit(i) {
                 continue;
             }
-            let texel = [
-                depth,
-                g.hit_mm[i][0],
-                g.hit_mm[i][1],
-                g.hit_mm[i][2],
-                g.normal[i][0],
-                g.normal[i][1],
-                g.normal[i][2],
-                g.secretion_mm[i],
-            ];
-            for (plane, v) in input.iter_mut().zip(texel) {
+            for (plane, v) in input.iter_mut().zip(g.texel(i)) {
                 plane[r + x] = v;
             }
         }
