@@ -256,7 +256,7 @@ impl PlacedScene<'_> {
                 if let Some(t) = capsule.hit(o, d, traced.t_min, bound[i]) {
                     bound[i] = t;
                     let normal = capsule.normal(traced.ray.at(t));
-                    opaque[i] = Some(hit(t, normal, &Material::STEEL));
+                    opaque[i] = Some(hit(t as f32, normal.as_vec3(), &Material::STEEL));
                 }
             }
         }
@@ -311,10 +311,11 @@ fn fill_packet(rays: &[Traced], bound: &[f64], packet: &mut [PacketRay]) {
     }
 }
 
-fn hit(t: f64, normal: DVec3, m: &Material) -> Hit {
+/// A hit at `t_mm` with unit `normal` on a surface of material `m`.
+fn hit(t_mm: f32, normal: Vec3, m: &Material) -> Hit {
     Hit {
-        t_mm: t as f32,
-        normal: normal.as_vec3(),
+        t_mm,
+        normal,
         color: Vec3::from(m.color),
         opacity: m.opacity,
     }
@@ -342,12 +343,7 @@ impl Nearest<'_> {
             for ((bound, opaque), best) in found {
                 if let Some((t, tri)) = *best {
                     *bound = f64::from(t);
-                    *opaque = Some(Hit {
-                        t_mm: t,
-                        normal: m.normal(tri),
-                        color: Vec3::from(material.color),
-                        opacity: material.opacity,
-                    });
+                    *opaque = Some(hit(t, m.normal(tri), material));
                 }
             }
             return;
@@ -356,7 +352,7 @@ impl Nearest<'_> {
             let (ray, t_min) = (&traced.ray, traced.t_min);
             if let Some((t, normal)) = nearest_aid(&object.shape, ray, t_min, self.bound[i]) {
                 self.bound[i] = t;
-                self.opaque[i] = Some(hit(t, normal, material));
+                self.opaque[i] = Some(hit(t as f32, normal.as_vec3(), material));
             }
         }
     }
@@ -402,8 +398,7 @@ fn every_hit(
                 a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2))
             });
             for &(ray, t, tri) in &found {
-                let normal = m.normal(tri).as_dvec3();
-                hits[ray].push(hit(f64::from(t), normal, material));
+                hits[ray].push(hit(t, m.normal(tri), material));
             }
             FOUND.set(found);
         }
@@ -411,7 +406,7 @@ fn every_hit(
             for (i, traced) in rays.iter().enumerate() {
                 let (ray, t_min) = (&traced.ray, traced.t_min);
                 if let Some((t, normal)) = nearest_aid(&object.shape, ray, t_min, bound[i]) {
-                    hits[i].push(hit(t, normal, material));
+                    hits[i].push(hit(t as f32, normal.as_vec3(), material));
                 }
             }
         }
@@ -421,7 +416,7 @@ fn every_hit(
                 if let Some((t0, t1)) = s.crossings(ray.origin, ray.dir) {
                     for t in [t0, t1].into_iter().filter(|&t| t > t_min && t < bound[i]) {
                         let normal = (ray.at(t) - s.centre_mm) / s.radius_mm;
-                        hits[i].push(hit(t, normal, material));
+                        hits[i].push(hit(t as f32, normal.as_vec3(), material));
                     }
                 }
             }
