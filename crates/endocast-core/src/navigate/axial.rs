@@ -45,7 +45,8 @@ impl BodyAxes {
 
 /// A scan's voxels stored again as axial slices: the copy's `k` is the scan's axis nearest
 /// superior–inferior, its `i` the one nearest left–right. Its geometry places every voxel where
-/// the scan's did, so world positions found in the copy hold for the scan.
+/// the scan's did, so world positions found in the copy hold for the scan. It holds a second
+/// copy of the voxels while a finder searches it (made only for scans not stored axially).
 pub(crate) struct AxialCopy {
     volume: Volume,
     /// The scan's axis behind each of the copy's axes.

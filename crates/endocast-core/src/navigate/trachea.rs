@@ -26,6 +26,9 @@ const LOWER_TRIES: usize = 5;
 /// no slice holds a round air section of the trachea's size, or every try leaks. A scan stored
 /// in other than axial slices is searched in an axial copy ([`AxialCopy`]).
 pub fn find_trachea(volume: &Volume, threshold: f64) -> Option<(Lumen, f64)> {
+    if !threshold.is_finite() {
+        return None;
+    }
     match AxialCopy::of(volume) {
         Some(copy) => {
             trachea_in_axial(copy.volume(), threshold).map(|(tree, t)| (copy.lumen_back(&tree), t))
@@ -88,6 +91,7 @@ mod tests {
         assert!(tree.contains([24, 24, 0]) && tree.contains([24, 24, 47]));
         // No air below −2000: nothing is found.
         assert!(find_trachea(&volume, -2000.0).is_none());
+        assert!(find_trachea(&volume, f64::NAN).is_none());
     }
 
     #[test]
