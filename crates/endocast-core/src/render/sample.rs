@@ -156,6 +156,13 @@ impl<'a> Sampler<'a> {
         for (k, p) in points.iter().enumerate() {
             (lanes[0][k], lanes[1][k], lanes[2][k]) = (p.x, p.y, p.z);
         }
+        self.gradients8_lanes(&lanes)
+    }
+
+    /// [`Self::gradients8`] at eight points given as their x, y and z lanes.
+    #[inline]
+    pub fn gradients8_lanes(&self, lanes: &[Lanes; 3]) -> [Vec3; 8] {
+        let lanes = *lanes;
         let at = |axis: usize, offset: f32| {
             let mut moved = lanes;
             for v in &mut moved[axis] {
