@@ -4,7 +4,6 @@
 
 use super::lanes::{map, map3, Lanes, LANES};
 use super::settings::{RayPassSettings, SecretionMode};
-use crate::render::traverse::VoxelRay;
 use crate::render::{with_avx2, Lighting, Renderer, Sampler, Shader};
 use glam::{DAffine3, DVec3, Vec3};
 
@@ -74,63 +73,100 @@ impl<'a> Continuation<'a> {
         }
     }
 
-    /// The tissue behind the secretion hits of up to eight rays at once (one per lane, each
-    /// sample batch one AVX2 gather and the lanes' bookkeeping branch-free over fixed lanes,
-    /// compiled for AVX2 where the CPU has it): ray `k` starts at world `origin` along unit
-    /// `dir` and met the secretion `t_secretion_mm` along it. A lane is `None` where its ray is
-    /// missing, has no secretion hit (NaN), or leaves the volume before the tissue. Each lane
-    /// takes the samples a one-ray march would: the same positions, values and bisection, so
-    /// the result does not depend on its neighbours.
+    /// The tissue behind the secretion hits of up to eight rays at once, one per lane: the
+    /// set-up, the march, the bisection and the measures branch-free over fixed lanes, compiled
+    /// for AVX2 where the CPU has it (each sample batch one AVX2 gather). Ray `k` starts at
+    /// world `origin` along unit `dir` and met the secretion `t_secretion_mm` along it. A lane
+    /// is `None` where its ray is missing, has no secretion hit (NaN), or leaves the volume
+    /// before the tissue. Each lane takes the samples a one-ray march would: the same
+    /// positions, values and bisection, so the result does not depend on its neighbours.
     pub fn tissue_after8(&self, rays: &[Option<(DVec3, DVec3, f32)>]) -> [Option<TissueHit>; 8] {
         debug_assert!(rays.len() <= 8);
-        let mut lanes = Lanes8::default();
-        for (k, ray) in rays.iter().enumerate() {
-            lanes.start(k, self.lane(*ray));
-        }
-        let (t_hit, gradients) = with_avx2(
+        let world = WorldRays::new(rays);
+        let (hits, found) = with_avx2(
             #[inline(always)]
             || {
+                let mut lanes = self.start(&world);
                 lanes.v = self.values(&lanes, &lanes.t);
                 self.march(&mut lanes);
                 let t_hit = self.refine(&lanes);
-                let points = map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * t_hit[k]);
-                (t_hit, self.sampler.gradients8_lanes(&points))
+                (lanes.found, self.measure(&lanes, &world, t_hit))
             },
         );
         std::array::from_fn(|k| {
-            let (origin, dir, t_secretion) = lanes.found[k].then_some(rays[k]?)?;
-            let t_hit = t_hit[k];
-            let measured = if self.accumulate {
-                lanes.inside[k]
-                    + self.inside_secretion((lanes.t[k], lanes.v[k]), (t_hit, self.tissue))
-            } else {
-                t_hit - t_secretion
-            };
-            let edge = t_hit - lanes.entered[k];
-            let d = Vec3::new(lanes.d[0][k], lanes.d[1][k], lanes.d[2][k]);
-            let slope = gradients[k].dot(d);
-            let secretion_mm = (measured - self.own_edge(edge, slope)).max(0.0);
-            let hit = origin + dir * f64::from(t_hit);
-            Some(TissueHit {
-                depth_mm: t_hit,
-                hit_mm: hit.as_vec3().to_array(),
-                normal: self.shader.normal(gradients[k]).to_array(),
-                secretion_mm,
+            hits[k].then(|| TissueHit {
+                depth_mm: found.t_hit[k],
+                hit_mm: found.hit[k],
+                normal: self.shader.normal(found.gradient[k]).to_array(),
+                secretion_mm: found.secretion_mm[k],
             })
         })
     }
 
-    /// A lane's voxel ray (origin, direction), its start and the end of its march; `None`
-    /// without a ray, a secretion hit, or a stretch inside the volume.
-    fn lane(&self, ray: Option<(DVec3, DVec3, f32)>) -> Option<(Vec3, Vec3, f32, f64)> {
-        let (origin, dir, t_secretion_mm) = ray?;
-        if t_secretion_mm.is_nan() {
-            return None;
+    /// The lanes' voxel rays and the ends of their marches, operation for operation as
+    /// [`VoxelRay::new`](crate::render::traverse::VoxelRay::new) and `VoxelRay::clip` make them; lanes without a ray or whose ray
+    /// misses the volume stay idle.
+    #[inline(always)]
+    fn start(&self, world: &WorldRays) -> Lanes8 {
+        let m = self.voxel_from_world.matrix3;
+        let columns = [m.x_axis, m.y_axis, m.z_axis];
+        let turn = |v: &[F64s; 3], a: usize, k: usize| {
+            columns[0][a] * v[0][k] + columns[1][a] * v[1][k] + columns[2][a] * v[2][k]
+        };
+        let shift = self.voxel_from_world.translation;
+        let o: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.origin, a, k) + shift[a]));
+        let d: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.dir, a, k)));
+        let (mut t0, mut t1, mut on) = ([0.0f64; LANES], [f64::INFINITY; LANES], world.on);
+        for a in 0..3 {
+            for k in 0..LANES {
+                let (o, d, hi) = (o[a][k], d[a][k], self.extent[a]);
+                let (p, q) = ((0.0 - o) / d, (hi - o) / d);
+                let flat = d == 0.0;
+                on[k] &= !(flat & ((o < 0.0) | (o > hi)));
+                t0[k] = pick(flat, t0[k], t0[k].max(p.min(q)));
+                t1[k] = pick(flat, t1[k], t1[k].min(p.max(q)));
+            }
         }
-        let ray = VoxelRay::new(&self.voxel_from_world, origin, dir);
-        let (_, t_end) = ray.clip(self.extent, 0.0)?;
-        let (o, d) = (ray.origin.as_vec3(), ray.direction.as_vec3());
-        Some((o, d, t_secretion_mm, t_end))
+        let mut lanes = Lanes8 {
+            o: map3(|a, k| o[a][k] as f32),
+            d: map3(|a, k| d[a][k] as f32),
+            t: world.t_secretion,
+            t_end: map(|k| f32_not_past(t1[k])),
+            entered: world.t_secretion,
+            ..Lanes8::default()
+        };
+        for k in 0..LANES {
+            lanes.marching[k] = on[k] & (t0[k] <= t1[k]) & t1[k].is_finite();
+        }
+        lanes
+    }
+
+    /// What the lanes found at `t_hit`: the world hit, the gradient and the secretion.
+    #[inline(always)]
+    fn measure(&self, lanes: &Lanes8, world: &WorldRays, t_hit: Lanes) -> Found {
+        let points = map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * t_hit[k]);
+        let [gx, gy, gz] = self.sampler.gradients8_lanes(&points);
+        let secretion_mm = map(|k| {
+            let measured = if self.accumulate {
+                let last = self.inside_secretion((lanes.t[k], lanes.v[k]), (t_hit[k], self.tissue));
+                lanes.inside[k] + last
+            } else {
+                t_hit[k] - world.t_secretion[k]
+            };
+            let edge = t_hit[k] - lanes.entered[k];
+            let [dx, dy, dz] = [lanes.d[0][k], lanes.d[1][k], lanes.d[2][k]];
+            let slope = gx[k] * dx + gy[k] * dy + gz[k] * dz;
+            (measured - self.own_edge(edge, slope)).max(0.0)
+        });
+        let hit: [F64s; 3] = std::array::from_fn(|a| {
+            map64(|k| world.origin[a][k] + world.dir[a][k] * f64::from(t_hit[k]))
+        });
+        Found {
+            t_hit,
+            hit: std::array::from_fn(|k| [hit[0][k] as f32, hit[1][k] as f32, hit[2][k] as f32]),
+            gradient: std::array::from_fn(|k| Vec3::new(gx[k], gy[k], gz[k])),
+            secretion_mm,
+        }
     }
 
     /// The values at distances `t` along the lanes' rays (idle lanes read the origin).
@@ -198,6 +234,7 @@ impl<'a> Continuation<'a> {
     /// a real layer lingers between them (a plateau) and takes longer. The stretch counts as
     /// secretion once it takes over [`LAYER_MIN`] times a bare edge's crossing, not at all
     /// under [`EDGE_MAX`] times, smoothly between.
+    #[inline(always)]
     fn own_edge(&self, edge_mm: f32, slope: f32) -> f32 {
         let bare = (self.tissue - self.secretion).abs() / slope.abs().max(f32::MIN_POSITIVE);
         let x = ((edge_mm / bare - EDGE_MAX) / (LAYER_MIN - EDGE_MAX)).clamp(0.0, 1.0);
@@ -271,23 +308,63 @@ struct Lanes8 {
 }
 
 impl Lanes8 {
-    /// Starts lane `k` on `lane` (origin, direction, start, end); `None` leaves it idle.
-    fn start(&mut self, k: usize, lane: Option<(Vec3, Vec3, f32, f64)>) {
-        if let Some((o, d, t, t_end)) = lane {
-            for (axis, (o, d)) in o.to_array().into_iter().zip(d.to_array()).enumerate() {
-                (self.o[axis][k], self.d[axis][k]) = (o, d);
-            }
-            (self.t[k], self.t_end[k]) = (t, f32_not_past(t_end));
-            self.entered[k] = t;
-            self.marching[k] = true;
-        }
-    }
-
     /// The start of each lane's found bracket.
     #[inline(always)]
     fn before(&self) -> [(f32, f32); LANES] {
         std::array::from_fn(|k| (self.t[k], self.v[k]))
     }
+}
+
+/// Eight `f64` values, one per lane.
+type F64s = [f64; LANES];
+
+/// `f` lane by lane, in `f64`.
+#[inline(always)]
+fn map64(f: impl Fn(usize) -> f64) -> F64s {
+    let mut out = [0.0; LANES];
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = f(k);
+    }
+    out
+}
+
+/// Eight lanes' world rays (zero in idle lanes) and secretion hits.
+struct WorldRays {
+    origin: [F64s; 3],
+    dir: [F64s; 3],
+    t_secretion: Lanes,
+    /// Whether the lane has a ray with a secretion hit.
+    on: [bool; LANES],
+}
+
+impl WorldRays {
+    /// The lanes of up to eight `(origin, direction, secretion hit)` rays.
+    fn new(rays: &[Option<(DVec3, DVec3, f32)>]) -> Self {
+        let mut world = Self {
+            origin: [[0.0; LANES]; 3],
+            dir: [[0.0; LANES]; 3],
+            t_secretion: [0.0; LANES],
+            on: [false; LANES],
+        };
+        for (k, ray) in rays.iter().enumerate() {
+            let Some((origin, dir, t)) = ray.filter(|r| !r.2.is_nan()) else {
+                continue;
+            };
+            for a in 0..3 {
+                (world.origin[a][k], world.dir[a][k]) = (origin[a], dir[a]);
+            }
+            (world.t_secretion[k], world.on[k]) = (t, true);
+        }
+        world
+    }
+}
+
+/// What each lane found (unspecified where it found nothing).
+struct Found {
+    t_hit: Lanes,
+    hit: [[f32; 3]; LANES],
+    gradient: [Vec3; LANES],
+    secretion_mm: Lanes,
 }
 
 /// The largest `f32` not greater than `x`, so that `f64::from(t) > x` for an `f32` `t` is
