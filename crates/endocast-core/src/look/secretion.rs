@@ -104,8 +104,8 @@ impl<'a> Continuation<'a> {
     }
 
     /// The lanes' voxel rays and the ends of their marches, operation for operation as
-    /// [`VoxelRay::new`](crate::render::traverse::VoxelRay::new) and `VoxelRay::clip` make them; lanes without a ray or whose ray
-    /// misses the volume stay idle.
+    /// `VoxelRay::new` and `VoxelRay::clip` make them (`render::traverse`); lanes without a ray
+    /// or whose ray misses the volume stay idle.
     #[inline(always)]
     fn start(&self, world: &WorldRays) -> Lanes8 {
         let m = self.voxel_from_world.matrix3;
