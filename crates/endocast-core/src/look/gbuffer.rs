@@ -193,7 +193,8 @@ impl RayPass {
                 for x0 in (0..w).step_by(8) {
                     let lanes = x0..(x0 + 8).min(w);
                     let rays: [_; 8] = std::array::from_fn(|k| {
-                        let x = Some(x0 + k).filter(|x| *x < w)?;
+                        // No ray for a pixel without a secretion hit: it has no tissue hit.
+                        let x = Some(x0 + k).filter(|x| *x < w && !depth[*x].is_nan())?;
                         let ray = camera.pixel_ray(x, y)?;
                         Some((ray.origin, ray.dir, depth[x]))
                     });

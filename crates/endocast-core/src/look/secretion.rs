@@ -2,9 +2,9 @@
 //! march at a small step to the tissue threshold, refined by bisection, with the secretion
 //! measured on the way.
 
+use super::lanes::{map, map3, Lanes, LANES};
 use super::settings::{RayPassSettings, SecretionMode};
-use crate::render::traverse::VoxelRay;
-use crate::render::{Lighting, Renderer, Sampler, Shader};
+use crate::render::{with_avx2, Lighting, Renderer, Sampler, Shader};
 use glam::{DAffine3, DVec3, Vec3};
 
 /// Bisection steps refining the tissue hit (then linear interpolation in the last bracket):
@@ -73,115 +73,154 @@ impl<'a> Continuation<'a> {
         }
     }
 
-    /// The tissue behind the secretion hits of up to eight rays at once (one per lane, each
-    /// sample batch one AVX2 gather where the CPU has it): ray `k` starts at world `origin`
-    /// along unit `dir` and met the secretion `t_secretion_mm` along it. A lane is `None`
-    /// where its ray is missing, has no secretion hit (NaN), or leaves the volume before the
-    /// tissue. Each lane takes the samples a one-ray march would: the same positions, values
-    /// and bisection, so the result does not depend on its neighbours.
+    /// The tissue behind the secretion hits of up to eight rays at once, one per lane: the
+    /// set-up, the march, the bisection and the measures branch-free over fixed lanes, compiled
+    /// for AVX2 where the CPU has it (each sample batch one AVX2 gather). Ray `k` starts at
+    /// world `origin` along unit `dir` and met the secretion `t_secretion_mm` along it. A lane
+    /// is `None` where its ray is missing, has no secretion hit (NaN), or leaves the volume
+    /// before the tissue. Each lane takes the samples a one-ray march would: the same
+    /// positions, values and bisection, so the result does not depend on its neighbours.
     pub fn tissue_after8(&self, rays: &[Option<(DVec3, DVec3, f32)>]) -> [Option<TissueHit>; 8] {
         debug_assert!(rays.len() <= 8);
-        let mut lanes = Lanes8::default();
-        for (k, ray) in rays.iter().enumerate() {
-            lanes.start(k, self.lane(*ray));
-        }
-        lanes.v = self.values(&lanes, &lanes.t);
-        self.march(&mut lanes);
-        let t_hit = self.refine(&lanes);
-        let points: [Vec3; 8] = std::array::from_fn(|k| lanes.o[k] + lanes.d[k] * t_hit[k]);
-        let gradients = self.sampler.gradients8(&points);
+        let world = WorldRays::new(rays);
+        let (hits, found) = with_avx2(
+            #[inline(always)]
+            || {
+                let mut lanes = self.start(&world);
+                lanes.v = self.values(&lanes, &lanes.t);
+                self.march(&mut lanes);
+                let t_hit = self.refine(&lanes);
+                (lanes.found, self.measure(&lanes, &world, t_hit))
+            },
+        );
         std::array::from_fn(|k| {
-            let (origin, dir, t_secretion) = lanes.found[k].then_some(rays[k]?)?;
-            let t_hit = t_hit[k];
-            let measured = if self.accumulate {
-                lanes.inside[k] + self.inside_secretion(lanes.before[k], (t_hit, self.tissue))
-            } else {
-                t_hit - t_secretion
-            };
-            let edge = t_hit - lanes.entered[k];
-            let slope = gradients[k].dot(lanes.d[k]);
-            let secretion_mm = (measured - self.own_edge(edge, slope)).max(0.0);
-            let hit = origin + dir * f64::from(t_hit);
-            Some(TissueHit {
-                depth_mm: t_hit,
-                hit_mm: hit.as_vec3().to_array(),
-                normal: self.shader.normal(gradients[k]).to_array(),
-                secretion_mm,
+            hits[k].then(|| TissueHit {
+                depth_mm: found.t_hit[k],
+                hit_mm: found.hit[k],
+                normal: self.shader.normal(found.gradient[k]).to_array(),
+                secretion_mm: found.secretion_mm[k],
             })
         })
     }
 
-    /// A lane's voxel ray (origin, direction), its start and the end of its march; `None`
-    /// without a ray, a secretion hit, or a stretch inside the volume.
-    fn lane(&self, ray: Option<(DVec3, DVec3, f32)>) -> Option<(Vec3, Vec3, f32, f64)> {
-        let (origin, dir, t_secretion_mm) = ray?;
-        if t_secretion_mm.is_nan() {
-            return None;
+    /// The lanes' voxel rays and the ends of their marches, operation for operation as
+    /// `VoxelRay::new` and `VoxelRay::clip` make them (`render::traverse`); lanes without a ray
+    /// or whose ray misses the volume stay idle.
+    #[inline(always)]
+    fn start(&self, world: &WorldRays) -> Lanes8 {
+        let m = self.voxel_from_world.matrix3;
+        let columns = [m.x_axis, m.y_axis, m.z_axis];
+        let turn = |v: &[F64s; 3], a: usize, k: usize| {
+            columns[0][a] * v[0][k] + columns[1][a] * v[1][k] + columns[2][a] * v[2][k]
+        };
+        let shift = self.voxel_from_world.translation;
+        let o: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.origin, a, k) + shift[a]));
+        let d: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.dir, a, k)));
+        let (mut t0, mut t1, mut on) = ([0.0f64; LANES], [f64::INFINITY; LANES], world.on);
+        for a in 0..3 {
+            for k in 0..LANES {
+                let (o, d, hi) = (o[a][k], d[a][k], self.extent[a]);
+                let (p, q) = ((0.0 - o) / d, (hi - o) / d);
+                let flat = d == 0.0;
+                on[k] &= !(flat & ((o < 0.0) | (o > hi)));
+                t0[k] = pick(flat, t0[k], t0[k].max(p.min(q)));
+                t1[k] = pick(flat, t1[k], t1[k].min(p.max(q)));
+            }
         }
-        let ray = VoxelRay::new(&self.voxel_from_world, origin, dir);
-        let (_, t_end) = ray.clip(self.extent, 0.0)?;
-        let (o, d) = (ray.origin.as_vec3(), ray.direction.as_vec3());
-        Some((o, d, t_secretion_mm, t_end))
+        let mut lanes = Lanes8 {
+            o: map3(|a, k| o[a][k] as f32),
+            d: map3(|a, k| d[a][k] as f32),
+            t: world.t_secretion,
+            t_end: map(|k| f32_not_past(t1[k])),
+            entered: world.t_secretion,
+            ..Lanes8::default()
+        };
+        for k in 0..LANES {
+            lanes.marching[k] = on[k] & (t0[k] <= t1[k]) & t1[k].is_finite();
+        }
+        lanes
+    }
+
+    /// What the lanes found at `t_hit`: the world hit, the gradient and the secretion.
+    #[inline(always)]
+    fn measure(&self, lanes: &Lanes8, world: &WorldRays, t_hit: Lanes) -> Found {
+        let points = map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * t_hit[k]);
+        let [gx, gy, gz] = self.sampler.gradients8_lanes(&points);
+        let secretion_mm = map(|k| {
+            let measured = if self.accumulate {
+                let last = self.inside_secretion((lanes.t[k], lanes.v[k]), (t_hit[k], self.tissue));
+                lanes.inside[k] + last
+            } else {
+                t_hit[k] - world.t_secretion[k]
+            };
+            let edge = t_hit[k] - lanes.entered[k];
+            let [dx, dy, dz] = [lanes.d[0][k], lanes.d[1][k], lanes.d[2][k]];
+            let slope = gx[k] * dx + gy[k] * dy + gz[k] * dz;
+            (measured - self.own_edge(edge, slope)).max(0.0)
+        });
+        let hit: [F64s; 3] = std::array::from_fn(|a| {
+            map64(|k| world.origin[a][k] + world.dir[a][k] * f64::from(t_hit[k]))
+        });
+        Found {
+            t_hit,
+            hit: std::array::from_fn(|k| [hit[0][k] as f32, hit[1][k] as f32, hit[2][k] as f32]),
+            gradient: std::array::from_fn(|k| Vec3::new(gx[k], gy[k], gz[k])),
+            secretion_mm,
+        }
     }
 
     /// The values at distances `t` along the lanes' rays (idle lanes read the origin).
-    fn values(&self, lanes: &Lanes8, t: &[f32; 8]) -> [f32; 8] {
-        let mut xyz = [[0.0f32; 8]; 3];
-        for k in 0..8 {
-            let p = lanes.o[k] + lanes.d[k] * t[k];
-            (xyz[0][k], xyz[1][k], xyz[2][k]) = (p.x, p.y, p.z);
-        }
-        self.sampler.points8(&xyz)
+    #[inline(always)]
+    fn values(&self, lanes: &Lanes8, t: &Lanes) -> Lanes {
+        self.sampler
+            .points8(&map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * t[k]))
     }
 
     /// Steps every marching lane on at the small step until it passes the tissue threshold
-    /// (found, bracketed by `before` and `after`) or leaves the volume.
+    /// (found, bracketed by the last step's start, where the lane stays, and `after`) or leaves
+    /// the volume.
+    #[inline(always)]
     fn march(&self, lanes: &mut Lanes8) {
         while lanes.marching.iter().any(|m| *m) {
-            let t_next: [f32; 8] = std::array::from_fn(|k| lanes.t[k] + self.step_mm);
-            for (k, t) in t_next.iter().enumerate() {
-                if lanes.marching[k] && f64::from(*t) > lanes.t_end[k] {
-                    lanes.marching[k] = false;
-                }
-            }
+            let t_next = map(|k| lanes.t[k] + self.step_mm);
             let v_next = self.values(lanes, &t_next);
-            for k in 0..8 {
-                if !lanes.marching[k] {
-                    continue;
-                }
+            for k in 0..LANES {
+                // `t_end` is the largest f32 not past the f64 end: the same test in f32.
+                let on = lanes.marching[k] & (t_next[k] <= lanes.t_end[k]);
                 let (here, next) = ((lanes.t[k], lanes.v[k]), (t_next[k], v_next[k]));
-                if self.past(next.1, self.tissue) {
-                    (lanes.marching[k], lanes.found[k]) = (false, true);
-                    (lanes.before[k], lanes.after[k]) = (here, next);
-                } else {
-                    if self.accumulate {
-                        lanes.inside[k] += self.inside_secretion(here, next);
-                    }
-                    if !self.past(here.1, self.secretion) && self.past(next.1, self.secretion) {
-                        lanes.entered[k] = crossing(here, next, self.secretion);
-                    }
-                    (lanes.t[k], lanes.v[k]) = next;
+                let found = on & self.past(next.1, self.tissue);
+                let go = on & !found;
+                lanes.found[k] |= found;
+                lanes.after[k] = pick(found, next, lanes.after[k]);
+                if self.accumulate {
+                    let inside = lanes.inside[k] + self.inside_secretion(here, next);
+                    lanes.inside[k] = pick(go, inside, lanes.inside[k]);
                 }
+                let enters =
+                    !self.past(here.1, self.secretion) && self.past(next.1, self.secretion);
+                let entered = crossing(here, next, self.secretion);
+                lanes.entered[k] = pick(go && enters, entered, lanes.entered[k]);
+                (lanes.t[k], lanes.v[k]) = pick(go, next, here);
+                lanes.marching[k] = go;
             }
         }
     }
 
     /// The tissue crossing inside each found lane's bracket: bisection, then linear
-    /// interpolation in the last bracket (other lanes: 0).
-    fn refine(&self, lanes: &Lanes8) -> [f32; 8] {
-        let (mut before, mut after) = (lanes.before, lanes.after);
+    /// interpolation in the last bracket (other lanes: unspecified).
+    #[inline(always)]
+    fn refine(&self, lanes: &Lanes8) -> Lanes {
+        let (mut before, mut after) = (lanes.before(), lanes.after);
         for _ in 0..REFINE_STEPS {
-            let t: [f32; 8] = std::array::from_fn(|k| 0.5 * (before[k].0 + after[k].0));
+            let t = map(|k| 0.5 * (before[k].0 + after[k].0));
             let v = self.values(lanes, &t);
-            for k in 0..8 {
-                if self.past(v[k], self.tissue) {
-                    after[k] = (t[k], v[k]);
-                } else {
-                    before[k] = (t[k], v[k]);
-                }
+            for k in 0..LANES {
+                let past = self.past(v[k], self.tissue);
+                after[k] = pick(past, (t[k], v[k]), after[k]);
+                before[k] = pick(past, before[k], (t[k], v[k]));
             }
         }
-        std::array::from_fn(|k| crossing(before[k], after[k], self.tissue))
+        map(|k| crossing(before[k], after[k], self.tissue))
     }
 
     /// How much of the last stretch into the tissue, `edge_mm` long (from where the ray last
@@ -195,6 +234,7 @@ impl<'a> Continuation<'a> {
     /// a real layer lingers between them (a plateau) and takes longer. The stretch counts as
     /// secretion once it takes over [`LAYER_MIN`] times a bare edge's crossing, not at all
     /// under [`EDGE_MAX`] times, smoothly between.
+    #[inline(always)]
     fn own_edge(&self, edge_mm: f32, slope: f32) -> f32 {
         let bare = (self.tissue - self.secretion).abs() / slope.abs().max(f32::MIN_POSITIVE);
         let x = ((edge_mm / bare - EDGE_MAX) / (LAYER_MIN - EDGE_MAX)).clamp(0.0, 1.0);
@@ -209,26 +249,20 @@ impl<'a> Continuation<'a> {
     }
 
     /// The length of the stretch from `(t0, v0)` to `(t1, v1)` past the secretion threshold,
-    /// the value taken as linear between them.
+    /// the value taken as linear between them (without branches, so that lanes vectorise).
+    #[inline(always)]
     fn inside_secretion(&self, (t0, v0): (f32, f32), (t1, v1): (f32, f32)) -> f32 {
         let s = self.secretion;
-        match (self.past(v0, s), self.past(v1, s)) {
-            (true, true) => t1 - t0,
-            (false, false) => 0.0,
-            (in0, _) => {
-                let f = ((s - v0) / (v1 - v0)).clamp(0.0, 1.0);
-                if in0 {
-                    f * (t1 - t0)
-                } else {
-                    (1.0 - f) * (t1 - t0)
-                }
-            }
-        }
+        let (in0, in1) = (self.past(v0, s), self.past(v1, s));
+        let f = ((s - v0) / (v1 - v0)).clamp(0.0, 1.0);
+        let part = pick(in0, f, 1.0 - f) * (t1 - t0);
+        pick(in0 == in1, pick(in0, t1 - t0, 0.0), part)
     }
 }
 
 /// Where the value, taken as linear from `before` to `after` (distance, value), reaches
 /// `iso` (`after`'s distance when it does not change).
+#[inline(always)]
 fn crossing(before: (f32, f32), after: (f32, f32), iso: f32) -> f32 {
     let dv = after.1 - before.1;
     let f = if dv == 0.0 {
@@ -239,37 +273,134 @@ fn crossing(before: (f32, f32), after: (f32, f32), iso: f32) -> f32 {
     before.0 + f * (after.0 - before.0)
 }
 
-/// Eight rays' continuations in lockstep.
+/// `a` where `on`, else `b` (a select, for lanes that vectorise).
+#[inline(always)]
+fn pick<T>(on: bool, a: T, b: T) -> T {
+    if on {
+        a
+    } else {
+        b
+    }
+}
+
+/// Eight rays' continuations in lockstep, each quantity one value per lane.
 #[derive(Default)]
 struct Lanes8 {
-    /// Voxel-space origin and direction (per mm).
-    o: [Vec3; 8],
-    d: [Vec3; 8],
-    /// Where the march stands, and the value there.
-    t: [f32; 8],
-    v: [f32; 8],
-    /// Where the march must end, mm.
-    t_end: [f64; 8],
+    /// Voxel-space origin and direction (per mm), by axis.
+    o: [Lanes; 3],
+    d: [Lanes; 3],
+    /// Where the march stands, and the value there (a found lane: the start of the step that
+    /// crossed the tissue threshold).
+    t: Lanes,
+    v: Lanes,
+    /// Where the march must end, mm: the largest `f32` not past the ray's (`f64`) end.
+    t_end: Lanes,
     /// Still marching; found the tissue.
-    marching: [bool; 8],
-    found: [bool; 8],
-    /// The found crossing's bracket.
-    before: [(f32, f32); 8],
-    after: [(f32, f32); 8],
+    marching: [bool; LANES],
+    found: [bool; LANES],
+    /// The end of the found crossing's bracket.
+    after: [(f32, f32); LANES],
     /// Length inside the secretion so far ([`SecretionMode::Accumulate`]).
-    inside: [f32; 8],
+    inside: Lanes,
     /// Where the ray last crossed into the secretion: its first secretion hit, or later
     /// where it came back into it after a stretch of air.
-    entered: [f32; 8],
+    entered: Lanes,
 }
 
 impl Lanes8 {
-    /// Starts lane `k` on `lane` (origin, direction, start, end); `None` leaves it idle.
-    fn start(&mut self, k: usize, lane: Option<(Vec3, Vec3, f32, f64)>) {
-        if let Some((o, d, t, t_end)) = lane {
-            (self.o[k], self.d[k], self.t[k], self.t_end[k]) = (o, d, t, t_end);
-            self.entered[k] = t;
-            self.marching[k] = true;
+    /// The start of each lane's found bracket.
+    #[inline(always)]
+    fn before(&self) -> [(f32, f32); LANES] {
+        std::array::from_fn(|k| (self.t[k], self.v[k]))
+    }
+}
+
+/// Eight `f64` values, one per lane.
+type F64s = [f64; LANES];
+
+/// `f` lane by lane, in `f64`.
+#[inline(always)]
+fn map64(f: impl Fn(usize) -> f64) -> F64s {
+    let mut out = [0.0; LANES];
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = f(k);
+    }
+    out
+}
+
+/// Eight lanes' world rays (zero in idle lanes) and secretion hits.
+struct WorldRays {
+    origin: [F64s; 3],
+    dir: [F64s; 3],
+    t_secretion: Lanes,
+    /// Whether the lane has a ray with a secretion hit.
+    on: [bool; LANES],
+}
+
+impl WorldRays {
+    /// The lanes of up to eight `(origin, direction, secretion hit)` rays.
+    fn new(rays: &[Option<(DVec3, DVec3, f32)>]) -> Self {
+        let mut world = Self {
+            origin: [[0.0; LANES]; 3],
+            dir: [[0.0; LANES]; 3],
+            t_secretion: [0.0; LANES],
+            on: [false; LANES],
+        };
+        for (k, ray) in rays.iter().enumerate() {
+            let Some((origin, dir, t)) = ray.filter(|r| !r.2.is_nan()) else {
+                continue;
+            };
+            for a in 0..3 {
+                (world.origin[a][k], world.dir[a][k]) = (origin[a], dir[a]);
+            }
+            (world.t_secretion[k], world.on[k]) = (t, true);
+        }
+        world
+    }
+}
+
+/// What each lane found (unspecified where it found nothing).
+struct Found {
+    t_hit: Lanes,
+    hit: [[f32; 3]; LANES],
+    gradient: [Vec3; LANES],
+    secretion_mm: Lanes,
+}
+
+/// The largest `f32` not greater than `x`, so that `f64::from(t) > x` for an `f32` `t` is
+/// `t > f32_not_past(x)` (for finite `x`; `f32::MAX` where `x` lies beyond the `f32` range).
+fn f32_not_past(x: f64) -> f32 {
+    let nearest = x as f32;
+    if f64::from(nearest) > x {
+        nearest.next_down()
+    } else {
+        nearest
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::f32_not_past;
+
+    #[test]
+    fn the_f32_end_test_is_the_f64_one() {
+        const ENDS: [f64; 8] = [
+            0.1,
+            1.0,
+            1.0 / 3.0,
+            217.123_456_789,
+            1e-40,
+            3.5e38,
+            1e300,
+            -2.7,
+        ];
+        for x in ENDS {
+            let (below, near) = (f32_not_past(x), x as f32);
+            assert!(f64::from(below) <= x, "{x}");
+            let around = [near.next_down(), near, near.next_up(), below.next_up()];
+            for t in around {
+                assert_eq!(f64::from(t) > x, t > below, "t {t} against {x}");
+            }
         }
     }
 }

@@ -156,6 +156,15 @@ impl<'a> Sampler<'a> {
         for (k, p) in points.iter().enumerate() {
             (lanes[0][k], lanes[1][k], lanes[2][k]) = (p.x, p.y, p.z);
         }
+        let [x, y, z] = self.gradients8_lanes(&lanes);
+        std::array::from_fn(|k| Vec3::new(x[k], y[k], z[k]))
+    }
+
+    /// [`Self::gradients8`] at eight points given as their x, y and z lanes, as x, y and z
+    /// lanes.
+    #[inline]
+    pub fn gradients8_lanes(&self, lanes: &[Lanes; 3]) -> [Lanes; 3] {
+        let lanes = *lanes;
         let at = |axis: usize, offset: f32| {
             let mut moved = lanes;
             for v in &mut moved[axis] {
@@ -165,10 +174,11 @@ impl<'a> Sampler<'a> {
         };
         let difference = |axis: usize| {
             let (plus, minus) = (at(axis, 1.0), at(axis, -1.0));
-            std::array::from_fn::<f32, 8, _>(|k| plus[k] - minus[k])
+            std::array::from_fn::<f32, 8, _>(|k| (plus[k] - minus[k]) * 0.5)
         };
-        let [dx, dy, dz] = [0, 1, 2].map(difference);
-        std::array::from_fn(|k| Vec3::new(dx[k], dy[k], dz[k]) * 0.5)
+        // Called in place (not through `array::map`), so that a caller compiled for AVX2
+        // inlines the batches too.
+        [difference(0), difference(1), difference(2)]
     }
 }
 

@@ -48,6 +48,7 @@ fn at_distances(sampler: &VoxelGrid<'_>, line: &SampleGrid, t: __m256) -> Lanes 
 
 /// The values at eight positions given as their x, y and z lanes.
 #[target_feature(enable = "avx2")]
+#[inline]
 pub(super) fn points8(sampler: &VoxelGrid<'_>, [x, y, z]: [&Lanes; 3]) -> Lanes {
     // SAFETY: each array holds exactly eight f32; unaligned loads are allowed.
     let load = |lanes: &Lanes| unsafe { _mm256_loadu_ps(lanes.as_ptr()) };
