@@ -576,24 +576,39 @@ impl Prepared {
         let Some((check, start)) = starts.at(x, y) else {
             return;
         };
-        let (grid, end) = (march.grid(), march.parts().2);
+        let grid = march.grid();
         if start <= grid.t_start {
             return;
         }
         let (eye, clear) = starts.clear;
-        let empty = (grid.at(check + grid.step) - eye).length() < clear || {
-            // The samples up to the first one past `check`, one by one.
-            let iso = self.params.lower.iso;
-            let rising = integrator.rising(march, iso);
-            let mut prefix = (0..end).take_while(|&n| n == 0 || grid.t_of(n - 1) <= check);
-            prefix.all(|n| (integrator.sampler.value(grid.at(grid.t_of(n))) < iso) == rising)
-        };
+        let empty = (grid.at(check + grid.step) - eye).length() < clear
+            || self.on_eye_side_until(integrator, march, check);
         if empty {
             let t_start = f64::from(start).min(t1);
             let dda = BrickDda::new(ray, (t_start, t1), self.renderer.grid.bricks());
             let (step, offset) = (self.step_mm as f32, self.offset(x, y));
             *march = RayMarch::with_walk(dda, ray, (t0, t1), step, offset);
         }
+    }
+
+    /// Whether `march`'s samples up to the first one past `check` (mm) all lie on its eye's
+    /// side of the isovalue: the first alone (where the eye is all but on the wall, it fails
+    /// already), the others eight at a time.
+    fn on_eye_side_until(&self, integrator: &Integrator<'_>, march: &RayMarch, check: f32) -> bool {
+        let (grid, end) = (march.grid(), march.parts().2);
+        let iso = self.params.lower.iso;
+        let rising = integrator.rising(march, iso);
+        let on_side = |v: f32| (v < iso) == rising;
+        if end == 0 || !on_side(integrator.sampler.value(grid.at(grid.t_of(0)))) {
+            return end == 0;
+        }
+        let prefix = (1..end).take_while(|&n| grid.t_of(n - 1) <= check);
+        let last = 1 + prefix.count() as i32;
+        (1..last).step_by(8).all(|n| {
+            let taken = (last - n).min(8) as usize;
+            let values = integrator.sampler.grid8(&grid, n, taken);
+            values[..taken].iter().all(|&v| on_side(v))
+        })
     }
 
     /// A composited pixel over the background, as 8-bit colour.

@@ -1,6 +1,6 @@
 //! The isosurface search (and its refinement, [`refine8`]) for eight rays at once, one ray per
 //! AVX2 lane (ray-parallel SIMD, as packet ray tracers run): every lane walks its own bricks
-//! ([`BrickDda`] step for step) and takes its own samples, two per lane and loop, so the per-ray
+//! ([`BrickDda`](crate::render::traverse::BrickDda) step for step) and takes its own samples, two per lane and loop, so the per-ray
 //! bookkeeping of the walk — brick steps, activity tests, sample ranges, crossing tests — is
 //! done for eight rays by each instruction instead of one.
 //!
@@ -15,7 +15,7 @@
 use super::sample::trilinear;
 use crate::render::march::MarchStats;
 use crate::render::ray_task::{Bracket, RayTask};
-use crate::render::traverse::{BrickDda, Segment};
+use crate::render::traverse::Segment;
 use crate::render::voxel_grid::VoxelGrid;
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_andnot_si256,
@@ -99,9 +99,11 @@ pub(super) fn search8(
 pub(super) fn refine8(sampler: &VoxelGrid<'_>, iso: f32, tasks: &mut [RayTask], steps: u32) {
     debug_assert!(tasks.len() <= 8);
     let grid = Grid::load(tasks);
-    let bracket = |f: fn(&Bracket) -> f32| lanes_f32(tasks, |t| t.bracket.as_ref().map_or(0.0, f));
-    let (mut t0, mut v0) = (bracket(|b| b.before.0), bracket(|b| b.before.1));
-    let (mut t1, mut v1) = (bracket(|b| b.after.0), bracket(|b| b.after.1));
+    let ends = columns(tasks, |t| {
+        t.bracket
+            .map_or([0.0; 4], |b| [b.before.0, b.before.1, b.after.0, b.after.1])
+    });
+    let [mut t0, mut v0, mut t1, mut v1] = [0, 1, 2, 3].map(|i| lanes_f32_from(ends[i]));
     let rising = mask(|k| {
         tasks
             .get(k)
@@ -251,27 +253,34 @@ struct Dda {
 }
 
 impl Dda {
-    /// The tasks' walks; missing lanes have ended.
+    /// The tasks' walks, read in one pass over them; missing lanes have ended.
     #[target_feature(enable = "avx2")]
     fn load(tasks: &[RayTask]) -> Self {
-        let f = |field: fn(&BrickDda) -> f32| lanes_f32(tasks, |task| field(task.march.parts().0));
-        let i = |field: fn(&BrickDda) -> i32| lanes_i32(tasks, |task| field(task.march.parts().0));
+        let [c0, c1, c2, s0, s1, s2, b0, b1, b2] = columns(tasks, |task| {
+            let [c, s, b] = {
+                let d = task.march.parts().0;
+                [d.cell, d.step, d.bricks]
+            };
+            [c[0], c[1], c[2], s[0], s[1], s[2], b[0], b[1], b[2]]
+        });
+        let [n0, n1, n2, d0, d1, d2, t, t_end] = columns(tasks, |task| {
+            let d = task.march.parts().0;
+            let [n, delta] = [d.t_next, d.t_delta];
+            [n[0], n[1], n[2], delta[0], delta[1], delta[2], d.t, d.t_end]
+        });
+        let (f, i) = (|v| lanes_f32_from(v), |v| lanes_i32_from(v));
         Self {
-            cell: [i(|d| d.cell[0]), i(|d| d.cell[1]), i(|d| d.cell[2])],
-            step: [i(|d| d.step[0]), i(|d| d.step[1]), i(|d| d.step[2])],
-            t_next: [f(|d| d.t_next[0]), f(|d| d.t_next[1]), f(|d| d.t_next[2])],
-            t_delta: [
-                f(|d| d.t_delta[0]),
-                f(|d| d.t_delta[1]),
-                f(|d| d.t_delta[2]),
-            ],
-            t: f(|d| d.t),
-            t_end: f(|d| d.t_end),
-            bricks: [i(|d| d.bricks[0]), i(|d| d.bricks[1]), i(|d| d.bricks[2])],
+            cell: [i(c0), i(c1), i(c2)],
+            step: [i(s0), i(s1), i(s2)],
+            t_next: [f(n0), f(n1), f(n2)],
+            t_delta: [f(d0), f(d1), f(d2)],
+            t: f(t),
+            t_end: f(t_end),
+            bricks: [i(b0), i(b1), i(b2)],
         }
     }
 
-    /// One [`BrickDda::next`] in the lanes of `on` (which must not have ended): the segments'
+    /// One [`crate::render::traverse::BrickDda::next`] in the lanes of `on` (which must not have ended): the segments'
     /// `t0`, `t1` and brick index.
     #[target_feature(enable = "avx2")]
     #[inline]
@@ -330,24 +339,23 @@ struct Grid {
 }
 
 impl Grid {
+    /// The tasks' sample grids, read in one pass over them; missing lanes are zero.
     #[target_feature(enable = "avx2")]
     fn load(tasks: &[RayTask]) -> Self {
-        let f = |field: fn(&RayTask) -> f32| lanes_f32(tasks, field);
+        let [ox, oy, oz, dx, dy, dz, t_start, offset, step] = columns(tasks, |task| {
+            let (o, d) = (task.march.grid().origin, task.march.grid().direction);
+            let g = task.march.grid();
+            [o.x, o.y, o.z, d.x, d.y, d.z, g.t_start, g.offset, g.step]
+        });
+        let [end] = columns(tasks, |task| [task.march.parts().2]);
+        let f = |v| lanes_f32_from(v);
         Self {
-            origin: [
-                f(|t| t.march.grid().origin.x),
-                f(|t| t.march.grid().origin.y),
-                f(|t| t.march.grid().origin.z),
-            ],
-            direction: [
-                f(|t| t.march.grid().direction.x),
-                f(|t| t.march.grid().direction.y),
-                f(|t| t.march.grid().direction.z),
-            ],
-            t_start: f(|t| t.march.grid().t_start),
-            offset: f(|t| t.march.grid().offset),
-            step: f(|t| t.march.grid().step),
-            end: lanes_i32(tasks, |t| t.march.parts().2),
+            origin: [f(ox), f(oy), f(oz)],
+            direction: [f(dx), f(dy), f(dz)],
+            t_start: f(t_start),
+            offset: f(offset),
+            step: f(step),
+            end: lanes_i32_from(end),
         }
     }
 
@@ -520,25 +528,28 @@ fn bits(m: Mask) -> u32 {
     _mm256_movemask_ps(_mm256_castsi256_ps(m)) as u32
 }
 
-/// `field` of each task, zero past the last.
-#[target_feature(enable = "avx2")]
-fn lanes_f32(tasks: &[RayTask], field: impl Fn(&RayTask) -> f32) -> __m256 {
-    let mut lanes = [0.0f32; 8];
-    for (lane, task) in lanes.iter_mut().zip(tasks) {
-        *lane = field(task);
+/// `N` numbers of each task, `fields`, as `N` rows of eight lanes, read in one pass over the
+/// tasks (one read of each task instead of one per number); zero past the last task.
+#[inline]
+fn columns<T: Copy + Default, const N: usize>(
+    tasks: &[RayTask],
+    fields: impl Fn(&RayTask) -> [T; N],
+) -> [[T; 8]; N] {
+    let mut rows = [[T::default(); 8]; N];
+    for (k, task) in tasks.iter().enumerate().take(8) {
+        for (row, value) in rows.iter_mut().zip(fields(task)) {
+            row[k] = value;
+        }
     }
-    // SAFETY: eight f32 are read from an array of eight.
-    unsafe { _mm256_loadu_ps(lanes.as_ptr()) }
+    rows
 }
 
-/// `field` of each task, zero past the last.
+/// Eight floats as lanes.
 #[target_feature(enable = "avx2")]
-fn lanes_i32(tasks: &[RayTask], field: impl Fn(&RayTask) -> i32) -> __m256i {
-    let mut lanes = [0i32; 8];
-    for (lane, task) in lanes.iter_mut().zip(tasks) {
-        *lane = field(task);
-    }
-    lanes_i32_from(lanes)
+#[inline]
+fn lanes_f32_from(lanes: [f32; 8]) -> __m256 {
+    // SAFETY: eight f32 are read from an array of eight.
+    unsafe { _mm256_loadu_ps(lanes.as_ptr()) }
 }
 
 /// Eight integers as lanes.

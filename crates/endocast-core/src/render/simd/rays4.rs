@@ -12,9 +12,10 @@ use crate::render::BRICK_VOX;
 use glam::{DAffine3, DVec3};
 use std::arch::x86_64::{
     __m256d, _mm256_add_pd, _mm256_and_pd, _mm256_andnot_pd, _mm256_blendv_pd, _mm256_cmp_pd,
-    _mm256_cvttpd_epi32, _mm256_div_pd, _mm256_max_pd, _mm256_min_pd, _mm256_mul_pd, _mm256_or_pd,
-    _mm256_set1_pd, _mm256_setr_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
-    _mm_storeu_si128, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_OQ,
+    _mm256_cvtps_pd, _mm256_cvttpd_epi32, _mm256_div_pd, _mm256_max_pd, _mm256_min_pd,
+    _mm256_movemask_pd, _mm256_mul_pd, _mm256_or_pd, _mm256_set1_pd, _mm256_setr_pd,
+    _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd, _mm_loadu_ps, _mm_storeu_si128, _CMP_EQ_OQ,
+    _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_OQ,
 };
 
 /// What a frame's rays share: the camera, and the volume's frame.
@@ -349,19 +350,22 @@ fn late_walks(
     t0: __m256d,
     t1: __m256d,
 ) -> (__m256d, [bool; 4]) {
-    let (t0, t1, d) = (doubles(t0), doubles(t1), dir_vox.map(|v| doubles(v)));
-    let mut walk = t0;
-    let mut started = [false; 4];
-    for k in 0..4 {
-        let (check, start) = (f64::from(late.check[k]), f64::from(late.start[k]));
-        let voxels_per_mm = (d[0][k] * d[0][k] + d[1][k] * d[1][k] + d[2][k] * d[2][k]).sqrt();
-        let reach = voxels_per_mm * (check + f64::from(late.step));
-        // A hair inside the ball: the samples are taken in f32.
-        if start > t0[k] && reach < 0.999 * f64::from(late.clear) {
-            (walk[k], started[k]) = (start.min(t1[k]), true);
-        }
-    }
-    (_mm256_setr_pd(walk[0], walk[1], walk[2], walk[3]), started)
+    let splat = _mm256_set1_pd;
+    // SAFETY: four f32 are read from an array of four (each widened exactly to f64).
+    let wide = |v: &[f32; 4]| _mm256_cvtps_pd(unsafe { _mm_loadu_ps(v.as_ptr()) });
+    let (check, start) = (wide(&late.check), wide(&late.start));
+    let voxels_per_mm = _mm256_sqrt_pd(dot(dir_vox, dir_vox));
+    let reach = _mm256_mul_pd(
+        voxels_per_mm,
+        _mm256_add_pd(check, splat(f64::from(late.step))),
+    );
+    // A hair inside the ball: the samples are taken in f32. (NaN starts compare false.)
+    let inside = _mm256_cmp_pd::<_CMP_LT_OQ>(reach, splat(0.999 * f64::from(late.clear)));
+    let started = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(start, t0), inside);
+    // `start.min(t1)`: the minimum's second operand where `t1` is NaN, as `f64::min`.
+    let walk = _mm256_blendv_pd(t0, _mm256_min_pd(t1, start), started);
+    let bits = _mm256_movemask_pd(started);
+    (walk, std::array::from_fn(|k| bits >> k & 1 == 1))
 }
 
 /// The per-lane start of the brick walks.

@@ -30,9 +30,20 @@ pub(super) struct Geometry {
 pub(super) struct Buffers {
     /// The left eye's depths along its view axis, `f32` rounded down.
     depths: Vec<f32>,
-    /// Per column of the right eye: `q = x + ½ − K/f` and the depth where its rays enter the
-    /// left image's field.
-    columns: Vec<[f64; 2]>,
+    /// Per column of the right eye (see [`Column`]).
+    columns: Vec<Column>,
+}
+
+/// What the right rays of one column share in every row.
+#[derive(Debug, Clone, Copy)]
+struct Column {
+    /// `q = x + ½ − K/f`.
+    q: f64,
+    /// The depth where the column's rays enter the left image's field (`x_L = w`).
+    z_enter: f64,
+    /// The first left column the rays can leave the known-empty region at: `floor(q)`, or 0
+    /// where `q < 0`, at most `w`.
+    lo: usize,
 }
 
 /// The right eye's per-pixel `[check, start]` (mm along the ray; NaN where the search starts
@@ -50,7 +61,13 @@ pub(super) fn fill(
     buffers.columns.clear();
     buffers.columns.extend((0..w).map(|x| {
         let q = x as f64 + 0.5 - k / geometry.focus_mm;
-        [q, k / (w as f64 - q)]
+        // Truncation is the floor from 0 up.
+        let lo = (q.max(0.0) as usize).min(w);
+        Column {
+            q,
+            z_enter: k / (w as f64 - q),
+            lo,
+        }
     }));
     let secants = PinholeSecants::of(right);
     starts.resize(w * h, [f32::NAN; 2]);
@@ -61,13 +78,12 @@ pub(super) fn fill(
             bounds.fill(depths, [w, h], y, geometry);
             secants.row(y, &mut bounds.secant);
             let mut walker = bounds.walker();
-            for ((start, &[q, z_enter]), &secant) in row.iter_mut().zip(columns).zip(&bounds.secant)
-            {
+            for ((start, column), &secant) in row.iter_mut().zip(columns).zip(&bounds.secant) {
                 *start = [f32::NAN; 2];
-                let Some(z_safe) = walker.empty_until(q, z_enter, k) else {
+                let Some(z_safe) = walker.empty_until(column, k) else {
                     continue;
                 };
-                let (check, skip) = (z_enter * secant, z_safe * secant);
+                let (check, skip) = (column.z_enter * secant, z_safe * secant);
                 if skip > check + geometry.min_gain {
                     *start = [check as f32, skip as f32];
                 }
@@ -173,8 +189,10 @@ impl RowBounds {
         };
         for (j, (depth, g)) in self.depth.iter_mut().zip(&mut self.suffix).enumerate() {
             *depth = f64::from(nearest(j)) - geometry.margin;
+            // Computed either way and then chosen, so that the loop has no branch.
+            let behind = j as f64 - geometry.k / *depth;
             *g = if *depth > 0.0 {
-                j as f64 - geometry.k / *depth
+                behind
             } else {
                 f64::NEG_INFINITY
             };
@@ -204,17 +222,16 @@ struct RowWalker<'a> {
 }
 
 impl RowWalker<'_> {
-    /// For the right ray with `q = x + ½ − K/f` (not smaller than the last call's), which
-    /// enters the left image (`x_L = w`) at depth `z_enter`: the depth where it leaves the
-    /// known-empty region; `None` where it never enters or leaves at once.
-    fn empty_until(&mut self, q: f64, z_enter: f64, k: f64) -> Option<f64> {
+    /// For the right ray of `column` (whose `q` is not smaller than the last call's): the
+    /// depth where it leaves the known-empty region; `None` where it never enters the left
+    /// image or leaves at once.
+    fn empty_until(&mut self, column: &Column, k: f64) -> Option<f64> {
         let (depth, suffix) = (&self.bounds.depth, &self.bounds.suffix);
+        let Column { q, z_enter, lo } = *column;
         let w = depth.len();
         if w as f64 - q <= 0.0 {
             return None;
         }
-        // `floor(q)` or 0 (truncation is the floor from 0 up).
-        let lo = (q.max(0.0) as usize).min(w);
         // The largest column j ≥ lo with g_j ≤ q: the last suffix minimum ≤ q (non-decreasing
         // in j, and the answer non-decreasing in q).
         while self.below < w && suffix[self.below] <= q {
