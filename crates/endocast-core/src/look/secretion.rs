@@ -380,7 +380,65 @@ fn f32_not_past(x: f64) -> f32 {
 
 #[cfg(test)]
 mod tests {
-    use super::f32_not_past;
+    use super::*;
+    use crate::phantom::{layered, PhantomOptions};
+    use crate::render::traverse::VoxelRay;
+    use crate::test_rng::Rng;
+
+    #[test]
+    fn the_lanes_start_as_the_voxel_rays_do() {
+        let options = PhantomOptions {
+            size: 24,
+            ..Default::default()
+        };
+        let volume = layered(&options).0;
+        let (geometry, dims) = (*volume.geometry(), volume.dims());
+        let renderer = Renderer::new(volume);
+        let on = Continuation::new(&renderer, &RayPassSettings::default());
+        let mut s = Rng::new(7);
+        let (mut inside, mut outside) = (0, 0);
+        for round in 0..40 {
+            let rays: Vec<_> = (0..LANES)
+                .map(|k| {
+                    // From around the volume, a third of its size beyond each face.
+                    let span = DVec3::from(dims.map(|n| n as f64));
+                    let origin = geometry.world_of((s.vec() * 5.0 / 6.0 + 0.5) * span);
+                    // Some directions along an axis (a zero component: the flat case).
+                    let dir = match (round + k) % 4 {
+                        0 => DVec3::Z,
+                        1 => DVec3::new(0.0, -1.0, 0.0),
+                        _ => s.vec().normalize(),
+                    };
+                    (k != 5).then_some((origin, dir, 0.5))
+                })
+                .collect();
+            let lanes = on.start(&WorldRays::new(&rays));
+            for (k, ray) in rays.iter().enumerate() {
+                let Some((origin, dir, _)) = *ray else {
+                    assert!(!lanes.marching[k]);
+                    continue;
+                };
+                let voxel = VoxelRay::new(&on.voxel_from_world, origin, dir);
+                let clipped = voxel.clip(on.extent, 0.0);
+                assert_eq!(lanes.marching[k], clipped.is_some(), "lane {k} of {ray:?}");
+                let Some((_, t_end)) = clipped else {
+                    outside += 1;
+                    continue;
+                };
+                inside += 1;
+                let (o, d) = (voxel.origin.as_vec3(), voxel.direction.as_vec3());
+                for a in 0..3 {
+                    assert_eq!(lanes.o[a][k].to_bits(), o[a].to_bits());
+                    assert_eq!(lanes.d[a][k].to_bits(), d[a].to_bits());
+                }
+                assert_eq!(lanes.t_end[k], f32_not_past(t_end));
+            }
+        }
+        assert!(
+            inside > 50 && outside > 20,
+            "{inside} inside, {outside} outside"
+        );
+    }
 
     #[test]
     fn the_f32_end_test_is_the_f64_one() {

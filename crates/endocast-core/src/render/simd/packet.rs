@@ -1,7 +1,7 @@
 //! The isosurface search (and its refinement, [`refine8`]) for eight rays at once, one ray per
 //! AVX2 lane (ray-parallel SIMD, as packet ray tracers run): every lane walks its own bricks
-//! ([`BrickDda`](crate::render::traverse::BrickDda) step for step) and takes its own samples, two per lane and loop, so the per-ray
-//! bookkeeping of the walk — brick steps, activity tests, sample ranges, crossing tests — is
+//! ([`BrickDda`] step for step) and takes its own samples, two per lane and loop, so the
+//! per-ray bookkeeping of the walk — brick steps, activity tests, sample ranges, crossing tests — is
 //! done for eight rays by each instruction instead of one.
 //!
 //! A lane takes exactly the samples the one-ray walk
@@ -15,7 +15,7 @@
 use super::sample::trilinear;
 use crate::render::march::MarchStats;
 use crate::render::ray_task::{Bracket, RayTask};
-use crate::render::traverse::Segment;
+use crate::render::traverse::{BrickDda, Segment};
 use crate::render::voxel_grid::VoxelGrid;
 use std::arch::x86_64::{
     __m256, __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_and_si256, _mm256_andnot_si256,
@@ -253,14 +253,16 @@ struct Dda {
 }
 
 impl Dda {
-    /// The tasks' walks, read in one pass over them; missing lanes have ended.
+    /// The tasks' walks, read in a pass over them per number type; missing lanes have ended.
     #[target_feature(enable = "avx2")]
     fn load(tasks: &[RayTask]) -> Self {
         let [c0, c1, c2, s0, s1, s2, b0, b1, b2] = columns(tasks, |task| {
-            let [c, s, b] = {
-                let d = task.march.parts().0;
-                [d.cell, d.step, d.bricks]
-            };
+            let BrickDda {
+                cell: c,
+                step: s,
+                bricks: b,
+                ..
+            } = *task.march.parts().0;
             [c[0], c[1], c[2], s[0], s[1], s[2], b[0], b[1], b[2]]
         });
         let [n0, n1, n2, d0, d1, d2, t, t_end] = columns(tasks, |task| {
@@ -280,7 +282,7 @@ impl Dda {
         }
     }
 
-    /// One [`crate::render::traverse::BrickDda::next`] in the lanes of `on` (which must not have ended): the segments'
+    /// One [`BrickDda::next`] in the lanes of `on` (which must not have ended): the segments'
     /// `t0`, `t1` and brick index.
     #[target_feature(enable = "avx2")]
     #[inline]
@@ -339,12 +341,13 @@ struct Grid {
 }
 
 impl Grid {
-    /// The tasks' sample grids, read in one pass over them; missing lanes are zero.
+    /// The tasks' sample grids, read in a pass over them per number type; missing lanes are
+    /// zero.
     #[target_feature(enable = "avx2")]
     fn load(tasks: &[RayTask]) -> Self {
         let [ox, oy, oz, dx, dy, dz, t_start, offset, step] = columns(tasks, |task| {
-            let (o, d) = (task.march.grid().origin, task.march.grid().direction);
             let g = task.march.grid();
+            let (o, d) = (g.origin, g.direction);
             [o.x, o.y, o.z, d.x, d.y, d.z, g.t_start, g.offset, g.step]
         });
         let [end] = columns(tasks, |task| [task.march.parts().2]);
