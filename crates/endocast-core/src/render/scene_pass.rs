@@ -16,6 +16,14 @@
 //! walked again; the others cost one trace against the scene, pruned at the volume's end. The
 //! rays of each 8×8 block of pixels are traced as one packet: nearly square, it meets fewer
 //! nodes of a mesh's hierarchy per ray than a row of pixels does.
+//!
+//! Where the volume's result does not stop at a surface (DVR, two isosurfaces, hybrid with a
+//! translucent surface) the tile's rays meet the scene before the volume is walked instead —
+//! the paper's order: each walk ends at its nearest opaque surface (for hybrid one step behind
+//! it, for the search), so no walk goes on behind geometry only to be walked again in front
+//! of it, and the surfaces traced ahead serve the pass after the walk, cut at its bound. The
+//! images are the same as in the volume-first order, but for a sample lying exactly at an
+//! opaque surface's distance, which is now behind it.
 
 use super::integrate::Integrator;
 use super::march::{MarchStats, RayMarch};
@@ -23,7 +31,7 @@ use super::ray_task::{PixelOut, RayTask};
 use super::sample::Accum;
 use super::settings::Mode;
 use super::tile_pass::{RowTasks, TileView};
-use super::tiles::Tile;
+use super::tiles::{Tile, TileRect};
 use super::traverse::VoxelRay;
 use super::{adjust, vignette, Prepared};
 use crate::camera::Ray;
@@ -56,6 +64,26 @@ struct SceneScratch {
     hits: Vec<Vec<Hit>>,
     /// The surfaces of pixels whose ray misses the volume: `(column, row, result)`.
     others: Vec<(usize, usize, PixelOut)>,
+    /// Each pixel's surfaces in the tile, traced before the volume walk without a bound
+    /// ([`Prepared::end_at_geometry`]), while `ahead_traced`.
+    ahead: Vec<Vec<Hit>>,
+    ahead_traced: bool,
+}
+
+impl SceneScratch {
+    /// Each ray's surfaces from those traced ahead without a bound: the ones nearer than its
+    /// bound, which are what a trace up to the bound finds (the nearest opaque surface where
+    /// it lies below the bound, and the translucent ones in front of it).
+    fn hits_from_ahead(&mut self, rect: TileRect) {
+        let rays = self.rays.iter().zip(&self.pixels);
+        for ((traced, &(x, y, _)), hits) in rays.zip(&mut self.hits) {
+            let ahead = &self.ahead[rect.index(x, y)];
+            // In `f32`, as a mesh's hierarchy compares.
+            let below = ahead.partition_point(|h| h.t_mm < traced.t_max as f32);
+            hits.clear();
+            hits.extend_from_slice(&ahead[..below]);
+        }
+    }
 }
 
 impl Prepared {
@@ -93,11 +121,85 @@ impl Prepared {
                     self.add_block_hits(integrator, scene, view, rows, scratch);
                 }
             }
+            scratch.ahead_traced = false;
             for (x, y, out) in &mut scratch.others {
                 vignette(view.camera, *x, *y, out);
                 tile.pixels[rect.index(*x, *y)] = self.pixel_of(out);
             }
         });
+    }
+
+    /// Whether opaque geometry should end the volume rays before they are walked: where the
+    /// volume's result does not stop at a surface (DVR, two isosurfaces, hybrid with a
+    /// translucent surface), a ray walked first would be walked again in front of the
+    /// geometry ([`Self::split_task`]).
+    pub(super) fn geometry_first(&self) -> bool {
+        let params = &self.params;
+        match params.mode {
+            Mode::Dvr | Mode::TwoIso => true,
+            Mode::Hybrid => params.lower.opacity < params.early_termination,
+            _ => false,
+        }
+    }
+
+    /// Ends each not yet walked ray of `rows` (the tile `view.rect`) at the nearest opaque
+    /// surface of `scene` inside its span — for the hybrid mode one sample step behind it, so
+    /// that the search still sees a crossing just in front of it. The scene pass after the
+    /// walk then finds the same surfaces and composites them as it would after a full walk.
+    pub(super) fn end_at_geometry(
+        &self,
+        scene: &PlacedScene<'_>,
+        view: &TileView<'_>,
+        rows: &mut [RowTasks],
+    ) {
+        SCRATCH.with_borrow_mut(|scratch| {
+            let rect = view.rect;
+            let pixels = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
+            if scratch.ahead.len() < pixels {
+                scratch.ahead.resize_with(pixels, Vec::new);
+            }
+            for y0 in (rect.y0..rect.y1).step_by(BLOCK) {
+                for x0 in (rect.x0..rect.x1).step_by(BLOCK) {
+                    let xs = x0..(x0 + BLOCK).min(rect.x1);
+                    let ys = y0..(y0 + BLOCK).min(rect.y1);
+                    self.block_rays(view, (xs, ys), rows, scratch);
+                    self.end_block(scene, view, rows, scratch);
+                }
+            }
+            scratch.ahead_traced = true;
+        });
+    }
+
+    /// [`Self::end_at_geometry`] for the block of rays in `scratch`.
+    fn end_block(
+        &self,
+        scene: &PlacedScene<'_>,
+        view: &TileView<'_>,
+        rows: &mut [RowTasks],
+        scratch: &mut SceneScratch,
+    ) {
+        let n = scratch.rays.len();
+        if scratch.hits.len() < n {
+            scratch.hits.resize_with(n, Vec::new);
+        }
+        scene.trace_many(&scratch.rays, &mut scratch.hits);
+        let behind = match self.params.mode {
+            Mode::Hybrid => 1.0,
+            _ => 0.0,
+        };
+        for (&(x, y, task), hits) in scratch.pixels.iter().zip(&scratch.hits) {
+            let ahead = &mut scratch.ahead[view.rect.index(x, y)];
+            ahead.clear();
+            ahead.extend_from_slice(hits);
+            let (Some(i), Some(hit)) = (task, hits.last().filter(|h| h.opacity >= 1.0)) else {
+                continue;
+            };
+            let march = &mut rows[y - view.rect.y0].tasks[i].march;
+            let (t_start, t_end) = march.span();
+            if hit.t_mm > t_start && hit.t_mm < t_end {
+                march.limit(hit.t_mm + behind * march.grid().step);
+            }
+        }
     }
 
     /// The rays of the pixels `xs × ys` into `scratch` (cleared first), each traced from the
@@ -162,7 +264,11 @@ impl Prepared {
         if scratch.hits.len() < n {
             scratch.hits.resize_with(n, Vec::new);
         }
-        scene.trace_many(&scratch.rays, &mut scratch.hits);
+        if scratch.ahead_traced {
+            scratch.hits_from_ahead(view.rect);
+        } else {
+            scene.trace_many(&scratch.rays, &mut scratch.hits);
+        }
         for ((&(x, y, task), traced), hits) in
             scratch.pixels.iter().zip(&scratch.rays).zip(&scratch.hits)
         {
@@ -232,6 +338,16 @@ impl Prepared {
             {
                 let in_front = hits.partition_point(|h| h.t_mm < out.depth_mm);
                 *out = around(integrator, out, hits, in_front, dir);
+            }
+            // No surface in front of an opaque hit that the walk reached: hybrid draws nothing
+            // there, so the hits alone (what walking the ray again would give).
+            Mode::Hybrid
+                if out.depth_mm.is_nan()
+                    && hits
+                        .last()
+                        .is_some_and(|h| h.opacity >= 1.0 && h.t_mm <= t_end) =>
+            {
+                *out = around(integrator, out, hits, hits.len(), dir);
             }
             _ if hits.iter().all(|h| h.t_mm <= t_start || h.t_mm >= t_end) => {
                 let in_front = hits.partition_point(|h| h.t_mm <= t_start);

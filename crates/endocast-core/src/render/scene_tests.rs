@@ -169,19 +169,57 @@ fn an_opaque_mesh_hides_the_wall_exactly_where_it_covers_it() {
 #[test]
 fn a_translucent_sphere_half_inside_tissue_composites_in_depth_order() {
     let (renderer, shell) = shell();
+    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
+    let on_wall = centre + DVec3::Z * shell.inner_radius_vox;
+    let glass = Material::new([0.1, 0.9, 0.3], 0.4).unwrap();
+    let tf = TransferFunction::ramp(-700.0, 400.0);
+    let inside = spheres_against_reference(&renderer, centre, tf, &[(on_wall, 6.0, glass)]);
+    assert!(inside > 50, "{inside}");
+}
+
+/// An opaque sphere in the tissue behind a translucent one on the wall, over DVR: the rays
+/// end exactly at its surface (the ray-length image is made before the volume is walked), and
+/// each pixel equals the samples in front of it and both spheres' surfaces in depth order.
+#[test]
+fn an_opaque_sphere_in_tissue_ends_the_walk_at_its_surface() {
+    let (renderer, shell) = shell();
+    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
+    let on_wall = centre + DVec3::Z * shell.inner_radius_vox;
+    let glass = Material::new([0.1, 0.9, 0.3], 0.4).unwrap();
+    let bone = Material::new([0.9, 0.8, 0.6], 1.0).unwrap();
+    let spheres = [
+        (on_wall, 6.0, glass),
+        (on_wall + DVec3::new(1.0, -1.0, 3.0), 2.5, bone),
+        // Beside the glass: seen directly, in air and just inside the tissue.
+        (on_wall + DVec3::new(-9.0, 0.0, 0.5), 3.0, bone),
+    ];
+    // Faint tissue: the samples just in front of the opaque surface still show.
+    let tf = TransferFunction::ramp(-700.0, 6000.0);
+    let inside = spheres_against_reference(&renderer, centre, tf, &spheres);
+    assert!(inside > 50, "{inside}");
+}
+
+/// Renders DVR with `tf` (no early termination) from `centre` along +z with marker
+/// spheres `(centre, radius, material)`, and checks every pixel against compositing the
+/// same samples and the spheres' surfaces merged by distance, up to the first opaque one;
+/// returns how many pixels meet a sphere.
+fn spheres_against_reference(
+    renderer: &Arc<Renderer>,
+    centre: DVec3,
+    tf: TransferFunction,
+    spheres: &[(DVec3, f64, Material)],
+) -> usize {
     let g = *renderer.volume().geometry();
-    let centre = g.world_of(shell.centre_vox);
     let px = 40;
     let camera = camera_at_centre(centre, px);
-    let on_wall = centre + DVec3::Z * shell.inner_radius_vox;
-    let marker = Marker::new(on_wall, 6.0).unwrap();
-    let glass = Material::new([0.1, 0.9, 0.3], 0.4).unwrap();
     let mut s = settings(Mode::Dvr);
-    s.tf = TransferFunction::ramp(-700.0, 400.0);
+    s.tf = tf;
     s.early_termination = 1.0;
     let mut prepared = renderer.prepare(&s).unwrap();
     let mut scene = Scene::new();
-    scene.add_marker(marker, glass);
+    for &(c, r, material) in spheres {
+        scene.add_marker(Marker::new(c, r).unwrap(), material);
+    }
     prepared.set_scene(Some(Arc::new(scene)));
     let frame = prepared.render(&camera);
     let sampler = Sampler::new(renderer.volume());
@@ -211,18 +249,26 @@ fn a_translucent_sphere_half_inside_tissue_composites_in_depth_order() {
                 events.push((grid.t_of(n), Vec3A::from_vec4(e), e.w));
                 n += 1;
             }
-            if let Some((a, b)) = marker.crossings(ray.origin, ray.dir) {
-                inside += 1;
+            let mut met = false;
+            for &(c, r, m) in spheres {
+                let Some((a, b)) = Marker::new(c, r).unwrap().crossings(ray.origin, ray.dir) else {
+                    continue;
+                };
+                met = true;
                 for t in [a, b] {
-                    let normal = ((ray.at(t) - on_wall) / 6.0).as_vec3();
-                    let lit = shader.shade(Vec3::from(glass.color), normal, ray.dir.as_vec3());
-                    events.push((t as f32, Vec3A::from(lit) * 0.4, 0.4));
+                    let normal = ((ray.at(t) - c) / r).as_vec3();
+                    let lit = shader.shade(Vec3::from(m.color), normal, ray.dir.as_vec3());
+                    events.push((t as f32, Vec3A::from(lit) * m.opacity, m.opacity));
                 }
             }
+            inside += usize::from(met);
             events.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut acc = Accum::default();
             for (_, rgb, alpha) in events {
                 acc.under(rgb, alpha);
+                if alpha >= 1.0 {
+                    break;
+                }
             }
             let got = frame.color[x + px * y];
             for c in 0..3 {
@@ -231,11 +277,11 @@ fn a_translucent_sphere_half_inside_tissue_composites_in_depth_order() {
             worst = worst.max((got.transmittance - acc.transmittance).abs());
         }
     }
-    assert!(inside > 50, "{inside}");
     assert!(
         worst < 1e-4,
         "largest difference from the reference {worst}"
     );
+    inside
 }
 
 #[test]

@@ -47,12 +47,26 @@ impl Prepared {
             rows.resize_with(height, RowTasks::default);
         }
         let rows_used = &mut rows[..height];
-        for y in rect.y0..rect.y1 {
-            let row = &mut rows_used[(y - rect.y0) % height];
-            row.y = y;
-            self.volume_row(integrator, &view, row);
-            if scene.is_none() {
-                self.finish_row(integrator, &view, row, &mut tile);
+        if let Some(scene) = scene.filter(|_| self.geometry_first()) {
+            // The ray-length image first (Scharsach et al. 2006, §3.4): no volume walk goes on
+            // behind opaque geometry only to be walked again in front of it.
+            for (row, y) in rows_used.iter_mut().zip(rect.y0..rect.y1) {
+                row.y = y;
+                self.row_rays(integrator, &view, row);
+            }
+            self.end_at_geometry(scene, &view, rows_used);
+            for row in rows_used.iter_mut() {
+                integrator.run_group(&mut row.tasks, !options.unlit);
+            }
+        } else {
+            for y in rect.y0..rect.y1 {
+                let row = &mut rows_used[(y - rect.y0) % height];
+                row.y = y;
+                self.row_rays(integrator, &view, row);
+                integrator.run_group(&mut row.tasks, !options.unlit);
+                if scene.is_none() {
+                    self.finish_row(integrator, &view, row, &mut tile);
+                }
             }
         }
         if let Some(scene) = scene {
@@ -65,8 +79,9 @@ impl Prepared {
         tile
     }
 
-    /// Casts row `row.y`'s rays of the tile through the volume into `row` (cleared first).
-    fn volume_row(&self, integrator: &Integrator<'_>, view: &TileView<'_>, row: &mut RowTasks) {
+    /// Sets up row `row.y`'s rays of the tile through the volume in `row` (cleared first),
+    /// not yet walked.
+    fn row_rays(&self, integrator: &Integrator<'_>, view: &TileView<'_>, row: &mut RowTasks) {
         let (options, rect, y) = (view.options, view.rect, row.y);
         let width = view.camera.size()[0];
         row.columns.clear();
@@ -81,7 +96,6 @@ impl Prepared {
                 adjust(&mut task.march, options, x + width * y);
             }
         }
-        integrator.run_group(tasks, !options.unlit);
     }
 
     /// Writes row `row`'s rendered rays into `tile`: pixels, counters and optional layers.
