@@ -155,6 +155,7 @@ impl Integrator<'_> {
         }
         if volume_behind {
             for task in tasks.iter_mut().filter(|task| task.bracket.is_some()) {
+                task.march.limit(task.composite_end_mm);
                 let out = &mut task.out;
                 self.composite(&mut task.march, out, task.dir_world, false, &mut ());
             }

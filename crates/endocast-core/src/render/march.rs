@@ -172,12 +172,12 @@ impl RayMarch {
 
     /// Ends the ray at `t_max_mm` from the eye if it ends later (opaque geometry in front of
     /// the volume's far side): no sample at or past it is taken, and the brick walk stops
-    /// there. NaN leaves the ray as it is. For a march not yet walked.
+    /// there. NaN leaves the ray as it is. For a march not yet walked, or one a search has
+    /// stopped (what is left of the walk then ends there).
     pub fn limit(&mut self, t_max_mm: f32) {
-        debug_assert!(self.next == 0 && !self.has_previous);
         if t_max_mm < self.dda.t_end {
             self.dda.t_end = t_max_mm.max(self.dda.t);
-            self.end = self.end.min(self.index_at(t_max_mm).max(0));
+            self.end = self.end.min(self.index_at(t_max_mm).max(self.next));
         }
     }
 

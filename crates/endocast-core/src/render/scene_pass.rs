@@ -19,11 +19,13 @@
 //!
 //! Where the volume's result does not stop at a surface (DVR, two isosurfaces, hybrid with a
 //! translucent surface) the tile's rays meet the scene before the volume is walked instead —
-//! the paper's order: each walk ends at its nearest opaque surface (for hybrid one step behind
-//! it, for the search), so no walk goes on behind geometry only to be walked again in front
-//! of it, and the surfaces traced ahead serve the pass after the walk, cut at its bound. The
-//! images are the same as in the volume-first order, but for a sample lying exactly at an
-//! opaque surface's distance, which is now behind it.
+//! the paper's order: each walk ends at its nearest opaque surface (a hybrid search one step
+//! behind it, so that it still sees a crossing just in front of it, and the compositing behind
+//! the hybrid surface at it), so no walk goes on behind geometry only to be walked again in
+//! front of it, and the surfaces traced ahead serve the pass after the walk, cut at its bound.
+//! The images are the same as in the volume-first order, but for a sample lying exactly at an
+//! opaque surface's distance, which is now behind it, and a rounding (at most 2 of 255 in a
+//! test of 392 renders) where translucent geometry lies in front of a hybrid surface.
 
 use super::integrate::Integrator;
 use super::march::{MarchStats, RayMarch};
@@ -194,10 +196,11 @@ impl Prepared {
             let (Some(i), Some(hit)) = (task, hits.last().filter(|h| h.opacity >= 1.0)) else {
                 continue;
             };
-            let march = &mut rows[y - view.rect.y0].tasks[i].march;
-            let (t_start, t_end) = march.span();
+            let task = &mut rows[y - view.rect.y0].tasks[i];
+            let (t_start, t_end) = task.march.span();
             if hit.t_mm > t_start && hit.t_mm < t_end {
-                march.limit(hit.t_mm + behind * march.grid().step);
+                task.march.limit(hit.t_mm + behind * task.march.grid().step);
+                task.composite_end_mm = hit.t_mm;
             }
         }
     }
@@ -318,6 +321,7 @@ impl Prepared {
     ) {
         let dir = task.dir_world;
         let (t_start, t_end) = task.march.span();
+        let composite_end = task.composite_end_mm;
         let out = &mut task.out;
         let opaque_surface = self.params.lower.opacity >= self.params.early_termination;
         match self.params.mode {
@@ -335,6 +339,17 @@ impl Prepared {
             Mode::Hybrid
                 if !out.depth_mm.is_nan()
                     && (opaque_surface || hits.iter().all(|h| h.t_mm < out.depth_mm)) =>
+            {
+                let in_front = hits.partition_point(|h| h.t_mm < out.depth_mm);
+                *out = around(integrator, out, hits, in_front, dir);
+            }
+            // The walk composited behind its surface up to the opaque hit, and no other hit
+            // lies between them: hits in front of the surface, then the volume, then that hit.
+            Mode::Hybrid
+                if !out.depth_mm.is_nan()
+                    && hits
+                        .iter()
+                        .all(|h| h.t_mm < out.depth_mm || h.t_mm >= composite_end) =>
             {
                 let in_front = hits.partition_point(|h| h.t_mm < out.depth_mm);
                 *out = around(integrator, out, hits, in_front, dir);

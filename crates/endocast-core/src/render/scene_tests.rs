@@ -199,6 +199,67 @@ fn an_opaque_sphere_in_tissue_ends_the_walk_at_its_surface() {
     assert!(inside > 50, "{inside}");
 }
 
+/// Hybrid with a translucent wall and an opaque sphere in the tissue behind it: where the
+/// sphere is seen, the pixel equals the volume rendered with the sphere's distance as its
+/// ray length (the surface, then the tissue up to the sphere) with the sphere's shaded
+/// surface under it — the compositing behind the surface stops exactly at the sphere.
+#[test]
+fn hybrid_composites_behind_a_translucent_wall_up_to_opaque_geometry() {
+    let (renderer, shell) = shell();
+    let g = *renderer.volume().geometry();
+    let centre = g.world_of(shell.centre_vox);
+    let px = 40;
+    let camera = camera_at_centre(centre, px);
+    // Three steps or more behind the wall: the search finds the wall either way.
+    let ball = Marker::new(
+        centre + DVec3::new(1.0, 0.5, shell.inner_radius_vox + 6.0),
+        4.0,
+    );
+    let ball = ball.unwrap();
+    let bone = Material::new([0.9, 0.8, 0.6], 1.0).unwrap();
+    let mut s = settings(Mode::Hybrid);
+    s.tf = TransferFunction::ramp(-700.0, 6000.0);
+    s.iso_opacity = 0.5;
+    s.early_termination = 1.0;
+    let mut prepared = renderer.prepare(&s).unwrap();
+    let (mut lengths, mut seen) = (vec![f32::INFINITY; px * px], Vec::new());
+    for y in 0..px {
+        for x in 0..px {
+            let ray = camera.pixel_ray(x, y).unwrap();
+            if let Some((t, _)) = ball.crossings(ray.origin, ray.dir) {
+                lengths[x + px * y] = t as f32;
+                seen.push((x, y, ray, t));
+            }
+        }
+    }
+    let mut expected = Frame::default();
+    let options = RenderOptions::new().max_distance_mm(&lengths);
+    prepared
+        .render_with(&camera, &options, &mut expected)
+        .unwrap();
+    let mut scene = Scene::new();
+    scene.add_marker(ball, bone);
+    prepared.set_scene(Some(Arc::new(scene)));
+    let frame = prepared.render(&camera);
+    let shader = Shader::new(g.world_from_voxel().matrix3, s.lighting);
+    assert!(seen.len() > 30, "{}", seen.len());
+    for (x, y, ray, t) in seen {
+        let i = x + px * y;
+        let volume = expected.color[i];
+        assert!(!expected.depth_mm[i].is_nan(), "({x},{y}) sees the wall");
+        let normal = ((ray.at(t) - ball.centre_mm) / ball.radius_mm).as_vec3();
+        let lit = shader.shade(Vec3::from(bone.color), normal, ray.dir.as_vec3());
+        let got = frame.color[i];
+        let worst = (0..3)
+            .map(|c| (got.rgb[c] - (volume.rgb[c] + volume.transmittance * lit[c])).abs())
+            .fold(got.transmittance, f32::max);
+        assert!(
+            worst < 1e-5,
+            "({x},{y}): {got:?} against {volume:?} and {lit:?}"
+        );
+    }
+}
+
 /// Renders DVR with `tf` (no early termination) from `centre` along +z with marker
 /// spheres `(centre, radius, material)`, and checks every pixel against compositing the
 /// same samples and the spheres' surfaces merged by distance, up to the first opaque one;
