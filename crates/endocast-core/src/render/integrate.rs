@@ -133,7 +133,9 @@ impl Integrator<'_> {
     /// each ray's phases are a chain of dependent steps, while the rays are independent, so
     /// taking one phase across the group lets the CPU overlap their chains. Without `shade`
     /// (iso only), the surfaces are found but not shaded: the colour stays transparent.
-    pub fn run_group(&self, tasks: &mut [RayTask], shade: bool) {
+    /// `composite_ends` (empty, or one per ray, mm) ends the hybrid compositing behind the
+    /// surface where opaque geometry lies, while the search may have looked further.
+    pub fn run_group(&self, tasks: &mut [RayTask], shade: bool, composite_ends: &[f32]) {
         let volume_behind = match self.params.mode {
             Mode::Iso => false,
             Mode::Hybrid => true,
@@ -154,8 +156,13 @@ impl Integrator<'_> {
             self.lit_surfaces(chunk);
         }
         if volume_behind {
-            for task in tasks.iter_mut().filter(|task| task.bracket.is_some()) {
-                task.march.limit(task.composite_end_mm);
+            for (k, task) in tasks.iter_mut().enumerate() {
+                if task.bracket.is_none() {
+                    continue;
+                }
+                if let Some(&end) = composite_ends.get(k) {
+                    task.march.limit(end);
+                }
                 let out = &mut task.out;
                 self.composite(&mut task.march, out, task.dir_world, false, &mut ());
             }

@@ -46,9 +46,6 @@ pub(crate) struct RayTask {
     pub dir_world: Vec3,
     pub out: PixelOut,
     pub(crate) bracket: Option<Bracket>,
-    /// Where opaque geometry ends the compositing behind a hybrid surface, mm (the search may
-    /// look one step further); infinity: at the march's end.
-    pub(crate) composite_end_mm: f32,
 }
 
 impl RayTask {
@@ -59,7 +56,6 @@ impl RayTask {
             dir_world,
             out: PixelOut::default(),
             bracket: None,
-            composite_end_mm: f32::INFINITY,
         }
     }
 }

@@ -66,25 +66,22 @@ struct SceneScratch {
     hits: Vec<Vec<Hit>>,
     /// The surfaces of pixels whose ray misses the volume: `(column, row, result)`.
     others: Vec<(usize, usize, PixelOut)>,
-    /// Each pixel's surfaces in the tile, traced before the volume walk without a bound
-    /// ([`Prepared::end_at_geometry`]), while `ahead_traced`.
-    ahead: Vec<Vec<Hit>>,
+    /// Each pixel's nearest opaque surface in the tile, traced before the volume walk
+    /// ([`Prepared::end_at_geometry`]), while `ahead_traced`: its bound and the hit.
+    ahead: Vec<Option<(f64, Hit)>>,
     ahead_traced: bool,
+    /// The block's rays' entries of `ahead`.
+    opaque: Vec<Option<(f64, Hit)>>,
 }
 
 impl SceneScratch {
-    /// Each ray's surfaces from those traced ahead without a bound: the ones nearer than its
-    /// bound, which are what a trace up to the bound finds (the nearest opaque surface where
-    /// it lies below the bound, and the translucent ones in front of it).
-    fn hits_from_ahead(&mut self, rect: TileRect) {
-        let rays = self.rays.iter().zip(&self.pixels);
-        for ((traced, &(x, y, _)), hits) in rays.zip(&mut self.hits) {
-            let ahead = &self.ahead[rect.index(x, y)];
-            // In `f32`, as a mesh's hierarchy compares.
-            let below = ahead.partition_point(|h| h.t_mm < traced.t_max as f32);
-            hits.clear();
-            hits.extend_from_slice(&ahead[..below]);
-        }
+    /// The entries of `ahead` for the block's rays, into `opaque`.
+    fn opaque_ahead(&mut self, rect: TileRect) {
+        self.opaque.clear();
+        let ahead = &self.ahead;
+        let pixels = self.pixels.iter();
+        self.opaque
+            .extend(pixels.map(|&(x, y, _)| ahead[rect.index(x, y)]));
     }
 }
 
@@ -157,9 +154,8 @@ impl Prepared {
         SCRATCH.with_borrow_mut(|scratch| {
             let rect = view.rect;
             let pixels = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
-            if scratch.ahead.len() < pixels {
-                scratch.ahead.resize_with(pixels, Vec::new);
-            }
+            scratch.ahead.clear();
+            scratch.ahead.resize(pixels, None);
             for y0 in (rect.y0..rect.y1).step_by(BLOCK) {
                 for x0 in (rect.x0..rect.x1).step_by(BLOCK) {
                     let xs = x0..(x0 + BLOCK).min(rect.x1);
@@ -180,27 +176,27 @@ impl Prepared {
         rows: &mut [RowTasks],
         scratch: &mut SceneScratch,
     ) {
-        let n = scratch.rays.len();
-        if scratch.hits.len() < n {
-            scratch.hits.resize_with(n, Vec::new);
-        }
-        scene.trace_many(&scratch.rays, &mut scratch.hits);
+        scratch.opaque.clear();
+        scratch.opaque.resize(scratch.rays.len(), None);
+        scene.nearest_opaque_many(&scratch.rays, &mut scratch.opaque);
         let behind = match self.params.mode {
             Mode::Hybrid => 1.0,
             _ => 0.0,
         };
-        for (&(x, y, task), hits) in scratch.pixels.iter().zip(&scratch.hits) {
-            let ahead = &mut scratch.ahead[view.rect.index(x, y)];
-            ahead.clear();
-            ahead.extend_from_slice(hits);
-            let (Some(i), Some(hit)) = (task, hits.last().filter(|h| h.opacity >= 1.0)) else {
+        for (&(x, y, task), &found) in scratch.pixels.iter().zip(&scratch.opaque) {
+            scratch.ahead[view.rect.index(x, y)] = found;
+            let (Some(i), Some((_, hit))) = (task, found) else {
                 continue;
             };
-            let task = &mut rows[y - view.rect.y0].tasks[i];
-            let (t_start, t_end) = task.march.span();
+            let row = &mut rows[y - view.rect.y0];
+            let march = &mut row.tasks[i].march;
+            let (t_start, t_end) = march.span();
             if hit.t_mm > t_start && hit.t_mm < t_end {
-                task.march.limit(hit.t_mm + behind * task.march.grid().step);
-                task.composite_end_mm = hit.t_mm;
+                march.limit(hit.t_mm + behind * march.grid().step);
+                if row.composite_ends.len() < row.tasks.len() {
+                    row.composite_ends.resize(row.tasks.len(), f32::INFINITY);
+                }
+                row.composite_ends[i] = hit.t_mm;
             }
         }
     }
@@ -268,7 +264,8 @@ impl Prepared {
             scratch.hits.resize_with(n, Vec::new);
         }
         if scratch.ahead_traced {
-            scratch.hits_from_ahead(view.rect);
+            scratch.opaque_ahead(view.rect);
+            scene.trace_many_after(&scratch.rays, &scratch.opaque, &mut scratch.hits);
         } else {
             scene.trace_many(&scratch.rays, &mut scratch.hits);
         }
@@ -280,8 +277,11 @@ impl Prepared {
             }
             match task {
                 Some(i) => {
-                    let task = &mut rows[y - view.rect.y0].tasks[i];
-                    self.with_hits(integrator, view, (x, y), hits, task);
+                    let row = &mut rows[y - view.rect.y0];
+                    let end = row.composite_ends.get(i).copied();
+                    let task = &mut row.tasks[i];
+                    let composited = (task, end.unwrap_or(f32::INFINITY));
+                    self.with_hits(integrator, view, (x, y), hits, composited);
                 }
                 None => {
                     let mut out = PixelOut::default();
@@ -310,18 +310,18 @@ impl Prepared {
         bound.map_or(f64::INFINITY, f64::from)
     }
 
-    /// Joins `hits` (in depth order) to the rendered ray `task` of pixel `(x, y)`.
+    /// Joins `hits` (in depth order) to the rendered ray `task` of pixel `(x, y)`, whose
+    /// compositing behind a hybrid surface ended at `composite_end` mm.
     fn with_hits(
         &self,
         integrator: &Integrator<'_>,
         view: &TileView<'_>,
         (x, y): (usize, usize),
         hits: &[Hit],
-        task: &mut RayTask,
+        (task, composite_end): (&mut RayTask, f32),
     ) {
         let dir = task.dir_world;
         let (t_start, t_end) = task.march.span();
-        let composite_end = task.composite_end_mm;
         let out = &mut task.out;
         let opaque_surface = self.params.lower.opacity >= self.params.early_termination;
         match self.params.mode {

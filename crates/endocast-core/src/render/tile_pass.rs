@@ -47,7 +47,7 @@ impl Prepared {
             rows.resize_with(height, RowTasks::default);
         }
         let rows_used = &mut rows[..height];
-        if let Some(scene) = scene.filter(|_| self.geometry_first()) {
+        if let Some(scene) = scene.filter(|s| self.geometry_first() && s.has_opaque_cover()) {
             // The ray-length image first (Scharsach et al. 2006, §3.4): no volume walk goes on
             // behind opaque geometry only to be walked again in front of it.
             for (row, y) in rows_used.iter_mut().zip(rect.y0..rect.y1) {
@@ -56,14 +56,14 @@ impl Prepared {
             }
             self.end_at_geometry(scene, &view, rows_used);
             for row in rows_used.iter_mut() {
-                integrator.run_group(&mut row.tasks, !options.unlit);
+                integrator.run_group(&mut row.tasks, !options.unlit, &row.composite_ends);
             }
         } else {
             for y in rect.y0..rect.y1 {
                 let row = &mut rows_used[(y - rect.y0) % height];
                 row.y = y;
                 self.row_rays(integrator, &view, row);
-                integrator.run_group(&mut row.tasks, !options.unlit);
+                integrator.run_group(&mut row.tasks, !options.unlit, &[]);
                 if scene.is_none() {
                     self.finish_row(integrator, &view, row, &mut tile);
                 }
@@ -86,6 +86,7 @@ impl Prepared {
         let width = view.camera.size()[0];
         row.columns.clear();
         row.tasks.clear();
+        row.composite_ends.clear();
         // A still frame's shifted grid is not the one the starts were checked on.
         let late = options.starts.filter(|_| options.grid_shift == 0.0);
         let late = late.map(|starts| (integrator, starts));
@@ -170,4 +171,7 @@ pub(super) struct RowTasks {
     pub y: usize,
     pub columns: Vec<usize>,
     pub tasks: Vec<RayTask>,
+    /// Empty, or where each task's compositing behind a hybrid surface ends, mm (opaque
+    /// geometry traced before the walk; infinity: the march's end).
+    pub composite_ends: Vec<f32>,
 }

@@ -246,10 +246,64 @@ impl PlacedScene<'_> {
 
     /// [`Self::trace_many`] for at most [`PACKET`] rays.
     fn trace_packet(&self, rays: &[Traced], hits: &mut [Vec<Hit>]) {
-        let mut opaque: [Option<Hit>; PACKET] = [None; PACKET];
-        let mut bound = [0.0; PACKET];
+        let n = rays.len();
+        let (mut bound, mut opaque) = ([0.0; PACKET], [None; PACKET]);
+        self.nearest_opaque_packet(rays, &mut bound[..n], &mut opaque[..n]);
+        self.translucent_packet(rays, &bound[..n], &opaque[..n], hits);
+    }
+
+    /// Whether the scene holds opaque surfaces that may cover much of a view (a mesh or the
+    /// instruments; not the grid's thin lines or markers).
+    pub fn has_opaque_cover(&self) -> bool {
+        let opaque_mesh = |o: &Object| matches!(o.shape, Shape::Mesh(_)) && o.material.is_opaque();
+        !self.instruments.is_empty() || self.scene.objects.iter().any(opaque_mesh)
+    }
+
+    /// The nearest opaque surface along each of `rays` with `t_min < t < t_max`, into `opaque`
+    /// (as long): its distance as the bound it sets (mm) and the hit; `None` where there is none.
+    pub fn nearest_opaque_many(&self, rays: &[Traced], opaque: &mut [Option<(f64, Hit)>]) {
+        for (chunk, opaque) in rays.chunks(PACKET).zip(opaque.chunks_mut(PACKET)) {
+            let n = chunk.len();
+            let (mut bound, mut found) = ([0.0; PACKET], [None; PACKET]);
+            self.nearest_opaque_packet(chunk, &mut bound[..n], &mut found[..n]);
+            for ((slot, found), bound) in opaque.iter_mut().zip(found).zip(bound) {
+                *slot = found.map(|hit| (bound, hit));
+            }
+        }
+    }
+
+    /// [`Self::trace_many`] where each ray's nearest opaque surface below its `t_max` is known
+    /// already: `opaque[i]` from [`Self::nearest_opaque_many`] over a longer interval (kept
+    /// where it lies below the ray's `t_max`). The same hits as tracing anew.
+    pub fn trace_many_after(
+        &self,
+        rays: &[Traced],
+        opaque: &[Option<(f64, Hit)>],
+        hits: &mut [Vec<Hit>],
+    ) {
+        let chunks = rays.chunks(PACKET).zip(opaque.chunks(PACKET));
+        for ((chunk, opaque), hits) in chunks.zip(hits.chunks_mut(PACKET)) {
+            let n = chunk.len();
+            let (mut bound, mut found) = ([0.0; PACKET], [None; PACKET]);
+            for (i, (traced, ahead)) in chunk.iter().zip(opaque).enumerate() {
+                bound[i] = traced.t_max;
+                if let Some((b, hit)) = ahead.filter(|(b, _)| *b < traced.t_max) {
+                    (bound[i], found[i]) = (b, Some(hit));
+                }
+            }
+            self.translucent_packet(chunk, &bound[..n], &found[..n], hits);
+        }
+    }
+
+    /// The nearest opaque surface of each of at most [`PACKET`] rays into `opaque`, and the
+    /// bound it sets (the ray's `t_max` where there is none) into `bound`.
+    fn nearest_opaque_packet(
+        &self,
+        rays: &[Traced],
+        bound: &mut [f64],
+        opaque: &mut [Option<Hit>],
+    ) {
         for (i, traced) in rays.iter().enumerate() {
-            hits[i].clear();
             bound[i] = traced.t_max;
             let (o, d) = (traced.ray.origin, traced.ray.dir);
             for capsule in &self.instruments {
@@ -260,28 +314,44 @@ impl PlacedScene<'_> {
                 }
             }
         }
-        let n = rays.len();
-        let objects = &self.scene.objects;
         let mut packet = [UNUSED_RAY; PACKET];
-        for object in objects.iter().filter(|o| o.material.is_opaque()) {
+        for object in self.scene.objects.iter().filter(|o| o.material.is_opaque()) {
             let nearest = Nearest {
-                bound: &mut bound[..n],
-                opaque: &mut opaque[..n],
-                packet: &mut packet[..n],
+                bound: &mut *bound,
+                opaque: &mut *opaque,
+                packet: &mut packet[..rays.len()],
             };
             nearest.find(object, rays);
         }
-        for object in objects
+    }
+
+    /// Every translucent surface of at most [`PACKET`] rays below its `bound`, then its
+    /// nearest opaque one `opaque` (if any): into `hits` (each cleared first), in depth order.
+    fn translucent_packet(
+        &self,
+        rays: &[Traced],
+        bound: &[f64],
+        opaque: &[Option<Hit>],
+        hits: &mut [Vec<Hit>],
+    ) {
+        let n = rays.len();
+        for hits in hits[..n].iter_mut() {
+            hits.clear();
+        }
+        let mut packet = [UNUSED_RAY; PACKET];
+        for object in self
+            .scene
+            .objects
             .iter()
             .filter(|o| !o.material.is_opaque() && o.material.opacity > 0.0)
         {
-            every_hit(object, rays, &bound[..n], &mut packet[..n], hits);
+            every_hit(object, rays, bound, &mut packet[..n], hits);
         }
         for (hits, opaque) in hits.iter_mut().zip(opaque) {
             if hits.len() > 1 {
                 hits.sort_by(|a, b| a.t_mm.total_cmp(&b.t_mm));
             }
-            hits.extend(opaque);
+            hits.extend(*opaque);
         }
     }
 }

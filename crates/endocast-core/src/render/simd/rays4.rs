@@ -378,6 +378,7 @@ struct WalkStart {
 
 impl WalkStart {
     /// Lane `k`'s walk over `(t_start, t_end)`.
+    #[inline]
     fn lane(&self, k: usize, (t_start, t_end): (f64, f64), bricks: [i32; 3]) -> BrickDda {
         BrickDda {
             cell: self.cell.map(|c| c[k]),
