@@ -493,3 +493,78 @@ fn every_hit(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
+
+    /// Small triangles scattered in a 40 mm cube.
+    fn scattered(s: &mut Rng, count: u32) -> TriangleMesh {
+        let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+        for k in 0..count {
+            let c = s.vec() * 40.0;
+            for _ in 0..3 {
+                vertices.push(c + (s.vec() - 0.5) * 6.0);
+            }
+            triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        TriangleMesh::new(vertices, triangles).unwrap()
+    }
+
+    #[test]
+    fn tracing_after_the_opaque_surfaces_finds_what_tracing_anew_finds() {
+        let mut s = Rng::new(3);
+        let mut scene = Scene::new();
+        scene.add_mesh(&scattered(&mut s, 300), Material::MESH);
+        let glass = Material::new([0.2, 0.6, 1.0], 0.5).unwrap();
+        scene.add_mesh(&scattered(&mut s, 300), glass);
+        let grid = GridPlane::new(DVec3::splat(20.0), DVec3::new(0.2, 0.1, 1.0), 4.0).unwrap();
+        scene.add_grid(grid, Material::GRID);
+        scene.add_marker(Marker::new(DVec3::splat(25.0), 5.0).unwrap(), glass);
+        let eye = DVec3::new(-20.0, 18.0, 22.0);
+        let camera = Camera::look_at(eye, DVec3::splat(20.0), DVec3::Z, 60.0, [8, 8]).unwrap();
+        let placed = scene.placed(&camera);
+        // Rays from one eye, each with a bound somewhere along the cube or none.
+        let rays: Vec<Traced> = (0..200)
+            .map(|_| {
+                let dir = (DVec3::splat(20.0) + (s.vec() - 0.5) * 40.0 - eye).normalize();
+                let t_max = if s.unit() < 0.2 {
+                    f64::INFINITY
+                } else {
+                    20.0 + 60.0 * s.unit()
+                };
+                Traced {
+                    ray: Ray { origin: eye, dir },
+                    t_min: 0.5,
+                    t_max,
+                }
+            })
+            .collect();
+        let unbounded: Vec<Traced> = rays
+            .iter()
+            .map(|r| Traced {
+                t_max: f64::INFINITY,
+                ..*r
+            })
+            .collect();
+        let mut opaque = vec![None; rays.len()];
+        placed.nearest_opaque_many(&unbounded, &mut opaque);
+        let (mut anew, mut after) = (vec![Vec::new(); rays.len()], vec![Vec::new(); rays.len()]);
+        placed.trace_many(&rays, &mut anew);
+        placed.trace_many_after(&rays, &opaque, &mut after);
+        assert_eq!(after, anew);
+        let cut = opaque
+            .iter()
+            .zip(&rays)
+            .filter(|(o, r)| o.is_some_and(|(b, _)| b >= r.t_max));
+        assert!(
+            cut.count() > 10,
+            "some opaque surfaces lie beyond the bound"
+        );
+        assert!(
+            anew.iter().filter(|h| h.len() > 1).count() > 10,
+            "translucent hits"
+        );
+    }
+}
