@@ -338,21 +338,14 @@ impl Prepared {
             }
             Mode::Mip | Mode::Minip => *out = around(integrator, out, hits, hits.len(), dir),
             // Hybrid draws nothing in front of its surface: hits there, and any hit when the
-            // surface is opaque, join around it.
+            // surface is opaque, join around it — so do hits at or behind where the walk's
+            // compositing behind the surface already stopped (opaque geometry traced ahead).
             Mode::Hybrid
                 if !out.depth_mm.is_nan()
-                    && (opaque_surface || hits.iter().all(|h| h.t_mm < out.depth_mm)) =>
-            {
-                let in_front = hits.partition_point(|h| h.t_mm < out.depth_mm);
-                *out = around(integrator, out, hits, in_front, dir);
-            }
-            // The walk composited behind its surface up to the opaque hit, and no other hit
-            // lies between them: hits in front of the surface, then the volume, then that hit.
-            Mode::Hybrid
-                if !out.depth_mm.is_nan()
-                    && hits
-                        .iter()
-                        .all(|h| h.t_mm < out.depth_mm || h.t_mm >= composite_end) =>
+                    && (opaque_surface
+                        || hits
+                            .iter()
+                            .all(|h| h.t_mm < out.depth_mm || h.t_mm >= composite_end)) =>
             {
                 let in_front = hits.partition_point(|h| h.t_mm < out.depth_mm);
                 *out = around(integrator, out, hits, in_front, dir);

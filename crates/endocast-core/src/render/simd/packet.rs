@@ -1,8 +1,8 @@
 //! The isosurface search (and its refinement, [`refine8`]) for eight rays at once, one ray per
 //! AVX2 lane (ray-parallel SIMD, as packet ray tracers run): every lane walks its own bricks
 //! ([`BrickDda`] step for step) and takes its own samples, two per lane and loop, so the
-//! per-ray bookkeeping of the walk — brick steps, activity tests, sample ranges, crossing tests — is
-//! done for eight rays by each instruction instead of one.
+//! per-ray bookkeeping of the walk — brick steps, activity tests, sample ranges, crossing
+//! tests — is done for eight rays by each instruction instead of one.
 //!
 //! A lane takes exactly the samples the one-ray walk
 //! ([`crate::render::march::Walk::SEARCH`]) takes: in each active brick, from the last sample
