@@ -158,6 +158,46 @@ fn bench_takes_size_and_prints_json_lines_on_stdout() {
 }
 
 #[test]
+fn bench_with_geometry_times_each_frame_without_it_too() {
+    let args = [
+        "bench",
+        "--phantom-size",
+        "32",
+        "--frames",
+        "3",
+        "--size",
+        "16x12",
+        "--rows",
+        "iso only",
+        "--grid",
+        "0,0,0:0,0,1:4",
+        "--json",
+    ];
+    let out = endocast(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("every stdout line is JSON"))
+        .collect();
+    let [with, without] = &lines[..] else {
+        panic!("one setting and its frames without the grid: {stdout}");
+    };
+    assert!(with["scene_over_without"].is_null());
+    assert!(without["setting"]
+        .as_str()
+        .unwrap()
+        .ends_with(", without geometry"));
+    let ratios = without["scene_over_without"].as_array().unwrap();
+    assert_eq!(ratios.len(), 3, "one ratio per frame");
+    assert!(ratios.iter().all(|r| r.as_f64().unwrap() > 0.0));
+}
+
+#[test]
 fn peels_of_the_joint_phantom_from_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
     let volume = dir.path().join("joint.nii.gz");

@@ -69,7 +69,8 @@ pub struct BenchArgs {
     /// or "complex TF". Repeatable: a row named by any of them is measured.
     #[arg(long, value_name = "TEXT")]
     rows: Vec<String>,
-    /// Geometry drawn in every frame (the cost of meshes, a grid, the endoscope).
+    /// Geometry drawn in every frame (the cost of meshes, a grid, the endoscope): each camera
+    /// is also rendered without it, and each setting reports the per-frame ratio.
     #[command(flatten)]
     scene: SceneArgs,
     /// Also append one JSON line per measured setting to this file.
@@ -153,19 +154,45 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut prepared = renderer
             .prepare(&cell.settings)
             .context("invalid settings")?;
+        // With geometry, the same frames without it too, for the geometry's cost.
+        let plain = match scene {
+            Some(_) => Some(
+                renderer
+                    .prepare(&cell.settings)
+                    .context("invalid settings")?,
+            ),
+            None => None,
+        };
         prepared.set_scene(scene.clone());
-        let (mono, pair) = in_pool(args.look.threads, || {
-            measure(args, &prepared, &options, &cameras)
+        let timed = in_pool(args.look.threads, || {
+            measure(args, (&prepared, plain.as_ref()), &options, &cameras)
         })?;
-        report(args, optics.field, &cell.name, &mono?, None)?;
-        if let Some((pair, mut ratios)) = pair {
+        report(args, optics.field, &cell.name, &timed.mono?, None)?;
+        let against = [
+            (
+                timed.pair,
+                "stereo pair",
+                "pair ÷ one eye",
+                "pair_over_one_eye",
+            ),
+            (
+                timed.plain,
+                "without geometry",
+                "with geometry ÷ without",
+                "scene_over_without",
+            ),
+        ];
+        for (paired, suffix, label, key) in against {
+            let Some((measured, mut ratios)) = paired else {
+                continue;
+            };
             ratios.sort_by(f64::total_cmp);
-            let name = format!("{}, stereo pair", cell.name);
-            report(args, optics.field, &name, &pair, Some(&ratios))?;
+            let name = format!("{}, {suffix}", cell.name);
+            report(args, optics.field, &name, &measured, Some((key, &ratios)))?;
             say(
                 table,
                 &format!(
-                    "|   pair ÷ one eye, median of the frames (min–max) | {:.2} ({:.2}–{:.2}) | | | | |",
+                    "|   {label}, median of the frames (min–max) | {:.3} ({:.2}–{:.2}) | | | | |",
                     ratios[ratios.len() / 2],
                     ratios[0],
                     ratios[ratios.len() - 1]
@@ -176,40 +203,71 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Renders every camera with `prepared` (one eye), and with `--stereo` also as a stereo pair
-/// right after it; returns the one-eye timings and, for pairs, their timings (the whole
-/// [`Prepared::render_stereo_into`], from the pair's shared start-up to its second eye) and
-/// the per-frame ratio of a pair's time to one eye's.
+/// The timings of one setting along the path: one eye, and where asked for, each camera as a
+/// stereo pair (with the per-frame ratio of a pair's time to one eye's) and without the
+/// geometry (with the per-frame ratio of one eye's time, geometry included, to that).
+struct Timed {
+    mono: Result<Measured>,
+    pair: Option<(Measured, Vec<f64>)>,
+    plain: Option<(Measured, Vec<f64>)>,
+}
+
+/// Renders every camera with `prepared` (one eye); with `plain` (the same settings without
+/// the geometry) also without it, just before or after in turn (so that neither profits from
+/// the caches the other warmed); with `--stereo` also as a stereo pair right after it. The
+/// pairs' timings are the whole [`Prepared::render_stereo_into`], from the pair's shared
+/// start-up to its second eye.
 fn measure(
     args: &BenchArgs,
-    prepared: &Prepared,
+    (prepared, plain): (&Prepared, Option<&Prepared>),
     options: &RenderOptions<'_>,
     cameras: &[Camera],
-) -> (Result<Measured>, Option<(Measured, Vec<f64>)>) {
+) -> Timed {
     let (mut mono, mut frame) = (Measured::default(), Frame::default());
-    let mut pair = args
-        .stereo
-        .stereo
-        .map(|_| (Measured::default(), Vec::new()));
+    let paired = || (Measured::default(), Vec::new());
+    let mut pair = args.stereo.stereo.map(|_| paired());
+    let mut without = plain.map(|_| paired());
     let mut pair_frames = StereoFrames::default();
-    for camera in cameras {
+    let mut render = |prepared: &Prepared, camera, measured: &mut Measured| {
         // Nothing cancels it.
         let _ = prepared.render_with(camera, options, &mut frame);
-        let one_ms = frame.stats.time.as_secs_f64() * 1e3;
-        mono.ms.push(one_ms);
-        mono.samples += frame.stats.samples;
+        let ms = frame.stats.time.as_secs_f64() * 1e3;
+        measured.ms.push(ms);
+        measured.samples += frame.stats.samples;
+        ms
+    };
+    for (k, camera) in cameras.iter().enumerate() {
+        let (mut one_ms, mut plain_ms) = (f64::NAN, f64::NAN);
+        // Every other camera without the geometry first.
+        for with_scene in [k % 2 == 0, k % 2 == 1] {
+            if with_scene {
+                one_ms = render(prepared, camera, &mut mono);
+            } else if let (Some(plain), Some((measured, _))) = (plain, &mut without) {
+                plain_ms = render(plain, camera, measured);
+            }
+        }
+        if let Some((_, ratios)) = &mut without {
+            ratios.push(one_ms / plain_ms);
+        }
         let Some((pair, ratios)) = &mut pair else {
             continue;
         };
         let nearest = || prepared.nearest_surface_mm(camera);
+        let failed = |error: anyhow::Error| Timed {
+            mono: Err(error),
+            pair: None,
+            plain: None,
+        };
         let rig = match StereoRig::for_view(args.stereo.eye_separation, args.stereo.focus, nearest)
         {
             Ok(rig) => rig,
-            Err(error) => return (Err(error).context("invalid --stereo options"), None),
+            Err(error) => {
+                return failed(anyhow::Error::from(error).context("invalid --stereo options"))
+            }
         };
         let start = Instant::now();
         if let Err(error) = prepared.render_stereo_into(camera, &rig, &mut pair_frames) {
-            return (Err(error).context("invalid stereo camera"), None);
+            return failed(anyhow::Error::from(error).context("invalid stereo camera"));
         }
         let pair_ms = start.elapsed().as_secs_f64() * 1e3;
         pair.ms.push(pair_ms);
@@ -217,7 +275,11 @@ fn measure(
         pair.samples += left.stats.samples + right.stats.samples;
         ratios.push(pair_ms / one_ms);
     }
-    (Ok(mono), pair)
+    Timed {
+        mono: Ok(mono),
+        pair,
+        plain: without,
+    }
 }
 
 /// Renders every camera with a look's ray `pass` at `quality` and shades it (below full
@@ -385,7 +447,7 @@ fn report(
     fov_deg: f64,
     name: &str,
     m: &Measured,
-    ratios: Option<&[f64]>,
+    ratios: Option<(&str, &[f64])>,
 ) -> Result<()> {
     let total_s: f64 = m.ms.iter().sum::<f64>() / 1e3;
     let fps: Vec<f64> = m.ms.iter().map(|ms| 1e3 / ms).collect();
@@ -400,7 +462,7 @@ fn report(
         !args.json,
         &format!("| {name} | {min:.1} | {avg:.1} | {max:.1} | {median:.1} | {msamples:.0} |"),
     );
-    let line = json!({
+    let mut line = json!({
         "setting": name,
         "frames": m.ms.len(),
         "size": args.size,
@@ -409,8 +471,10 @@ fn report(
         "ms_median": median,
         "ms": m.ms,
         "samples_per_s": m.samples as f64 / total_s,
-        "pair_over_one_eye": ratios,
     });
+    if let Some((key, ratios)) = ratios {
+        line[key] = json!(ratios);
+    }
     if args.json {
         println!("{line}");
     }
