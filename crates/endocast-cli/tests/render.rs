@@ -104,6 +104,23 @@ fn shade_dvr_changes_a_dvr_image() {
     assert_ne!(flat, shaded, "--shade-dvr made no difference");
 }
 
+/// Runs `endocast bench` with `args` (which ask for `--json`): its standard output, and each of
+/// its lines as JSON.
+fn bench_json(args: &[&str]) -> (String, Vec<serde_json::Value>) {
+    let out = endocast(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("every stdout line is JSON"))
+        .collect();
+    (stdout, lines)
+}
+
 #[test]
 fn bench_takes_size_and_prints_json_lines_on_stdout() {
     let dir = tempfile::tempdir().unwrap();
@@ -122,17 +139,7 @@ fn bench_takes_size_and_prints_json_lines_on_stdout() {
         "--json-file",
         file.to_str().unwrap(),
     ];
-    let out = endocast(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8(out.stdout).unwrap();
-    let lines: Vec<serde_json::Value> = stdout
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("every stdout line is JSON"))
-        .collect();
+    let (stdout, lines) = bench_json(&args);
     assert!(!lines.is_empty());
     assert!(lines
         .iter()
@@ -173,17 +180,7 @@ fn bench_with_geometry_times_each_frame_without_it_too() {
         "0,0,0:0,0,1:4",
         "--json",
     ];
-    let out = endocast(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8(out.stdout).unwrap();
-    let lines: Vec<serde_json::Value> = stdout
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("every stdout line is JSON"))
-        .collect();
+    let (stdout, lines) = bench_json(&args);
     let [with, without] = &lines[..] else {
         panic!("one setting and its frames without the grid: {stdout}");
     };
