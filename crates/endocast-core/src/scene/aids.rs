@@ -165,6 +165,10 @@ fn sphere_crossings(oc: DVec3, dir: DVec3, r: f64) -> Option<(f64, f64)> {
     Some((-b - s, -b + s))
 }
 
+/// Relative margin below zero of a ray's discriminant against a capsule's infinite cylinder
+/// past which the ray surely misses the capsule ([`Capsule::hit`]).
+const MISS_MARGIN: f64 = 1e-9;
+
 /// A rod with rounded ends: the segment from `a` to `b` (world mm) thickened by `radius`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Capsule {
@@ -180,16 +184,64 @@ impl Capsule {
     /// The nearest point where a unit ray from `origin` outside the capsule enters it, within
     /// `(t_min, t_max)`.
     pub fn hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Option<f64> {
+        self.seen_from(origin).hit(dir, t_min, t_max)
+    }
+
+    /// The capsule's terms for rays from `origin` (many rays of a view share it).
+    pub fn seen_from(&self, origin: DVec3) -> CapsuleFrom {
         let (ba, oa) = (self.b - self.a, origin - self.a);
-        let (baba, bard, baoa) = (ba.dot(ba), ba.dot(dir), ba.dot(oa));
-        let (rdoa, oaoa) = (dir.dot(oa), oa.dot(oa));
+        let (baba, baoa, oaoa) = (ba.dot(ba), ba.dot(oa), oa.dot(oa));
         let r2 = self.radius * self.radius;
+        CapsuleFrom {
+            ba,
+            oa,
+            ob: origin - self.b,
+            baba,
+            baoa,
+            qc: baba * oaoa - baoa * baoa - r2 * baba,
+            radius: self.radius,
+        }
+    }
+
+    /// The outward unit normal at surface point `p`.
+    pub fn normal(&self, p: DVec3) -> DVec3 {
+        let ba = self.b - self.a;
+        let h = ((p - self.a).dot(ba) / ba.length_squared()).clamp(0.0, 1.0);
+        (p - self.a - ba * h).normalize_or_zero()
+    }
+}
+
+/// A [`Capsule`] seen from one ray start ([`Capsule::seen_from`]): what its ray test needs
+/// that does not depend on the direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CapsuleFrom {
+    /// The axis from end `a` to end `b`.
+    ba: DVec3,
+    /// The start from either end.
+    oa: DVec3,
+    ob: DVec3,
+    /// `ba·ba`, `ba·oa`, and the constant term of the side's quadratic.
+    baba: f64,
+    baoa: f64,
+    qc: f64,
+    radius: f64,
+}
+
+impl CapsuleFrom {
+    /// [`Capsule::hit`] for the unit direction `dir` from this start.
+    pub fn hit(&self, dir: DVec3, t_min: f64, t_max: f64) -> Option<f64> {
+        let (ba, baba, baoa, qc) = (self.ba, self.baba, self.baoa, self.qc);
+        let (bard, rdoa) = (ba.dot(dir), dir.dot(self.oa));
         let qa = baba - bard * bard;
         let qb = baba * rdoa - baoa * bard;
-        let qc = baba * oaoa - baoa * baoa - r2 * baba;
         let in_range = |t: f64| (t > t_min && t < t_max).then_some(t);
         if qa > 0.0 {
             let h = qb * qb - qa * qc;
+            // Clearly outside the infinite cylinder around the axis, which holds both rounded
+            // ends too (the margin is far above the rounding of `h`): most rays of a view.
+            if h < -MISS_MARGIN * (qb * qb + (qa * qc).abs()) {
+                return None;
+            }
             if h >= 0.0 {
                 let t = (-qb - h.sqrt()) / qa;
                 let y = baoa + t * bard;
@@ -199,18 +251,11 @@ impl Capsule {
             }
         }
         // The rounded ends: the nearer sphere the ray meets.
-        [self.a, self.b]
+        [self.oa, self.ob]
             .iter()
-            .filter_map(|c| sphere_crossings(origin - *c, dir, self.radius).map(|(t, _)| t))
+            .filter_map(|&oc| sphere_crossings(oc, dir, self.radius).map(|(t, _)| t))
             .filter_map(in_range)
             .min_by(f64::total_cmp)
-    }
-
-    /// The outward unit normal at surface point `p`.
-    pub fn normal(&self, p: DVec3) -> DVec3 {
-        let ba = self.b - self.a;
-        let h = ((p - self.a).dot(ba) / ba.length_squared()).clamp(0.0, 1.0);
-        (p - self.a - ba * h).normalize_or_zero()
     }
 }
 
@@ -299,6 +344,56 @@ mod tests {
             .is_none());
         assert!(GridPlane::new(DVec3::ZERO, DVec3::ZERO, 1.0).is_err());
         assert!(grid.with_spacing(5.0, 6.0).is_err());
+    }
+
+    /// The distance from `p` to the segment `a`–`b`.
+    fn to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+        let ba = b - a;
+        let h = ((p - a).dot(ba) / ba.length_squared()).clamp(0.0, 1.0);
+        (p - a - ba * h).length()
+    }
+
+    #[test]
+    fn a_ray_meets_a_capsule_where_it_comes_within_the_radius_of_its_axis() {
+        let mut s = crate::test_rng::Rng::new(23);
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..4000 {
+            let (a, b) = (s.vec() * 10.0, s.vec() * 10.0);
+            let radius = 0.2 + 2.0 * s.unit();
+            let c = Capsule { a, b, radius };
+            // Rays from far away through points near the capsule: beside its side, beyond its
+            // ends, grazing it.
+            let along = a + (b - a) * (1.4 * s.unit() - 0.2);
+            let aim = along + s.vec().normalize() * radius * (0.5 + 1.5 * s.unit());
+            let origin = aim + s.vec().normalize() * 40.0;
+            let dir = (aim - origin).normalize();
+            // The distance to the axis along the ray is convex: its minimum by ternary search.
+            let gap = |t: f64| to_segment(origin + dir * t, a, b);
+            let (mut lo, mut hi) = (0.0, 80.0);
+            for _ in 0..200 {
+                let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+                (lo, hi) = if gap(m1) < gap(m2) {
+                    (lo, m2)
+                } else {
+                    (m1, hi)
+                };
+            }
+            let closest = gap(lo);
+            let found = c.hit(origin, dir, 0.0, 100.0);
+            if closest < radius * (1.0 - 1e-6) {
+                let t = found.expect("a ray that passes within the radius meets the capsule");
+                assert!(
+                    (gap(t) - radius).abs() < 1e-9 * (1.0 + radius),
+                    "on the surface"
+                );
+                assert!(t <= lo + 1e-9, "the entry, not the exit");
+                hits += 1;
+            } else if closest > radius * (1.0 + 1e-6) {
+                assert_eq!(found, None, "a ray that stays outside the radius misses");
+                misses += 1;
+            }
+        }
+        assert!(hits > 1000 && misses > 1000, "{hits} hits, {misses} misses");
     }
 
     #[test]

@@ -29,7 +29,7 @@ mod aids;
 pub mod bvh;
 mod mesh;
 
-pub use aids::{Capsule, Endoscope, GridPlane, Marker, DEFAULT_INSTRUMENT_LENGTH_MM};
+pub use aids::{Capsule, CapsuleFrom, Endoscope, GridPlane, Marker, DEFAULT_INSTRUMENT_LENGTH_MM};
 pub use mesh::{MeshError, TriangleMesh};
 
 use crate::camera::{Camera, Ray};
@@ -303,11 +303,20 @@ impl PlacedScene<'_> {
         bound: &mut [f64],
         opaque: &mut [Option<Hit>],
     ) {
-        for (i, traced) in rays.iter().enumerate() {
-            bound[i] = traced.t_max;
-            let (o, d) = (traced.ray.origin, traced.ray.dir);
-            for capsule in &self.instruments {
-                if let Some(t) = capsule.hit(o, d, traced.t_min, bound[i]) {
+        for (bound, traced) in bound.iter_mut().zip(rays) {
+            *bound = traced.t_max;
+        }
+        for capsule in &self.instruments {
+            // The rays of a packet mostly share their start.
+            let mut seen = None;
+            for (i, traced) in rays.iter().enumerate() {
+                let origin = traced.ray.origin;
+                let from = match seen {
+                    Some((o, from)) if o == origin => from,
+                    _ => capsule.seen_from(origin),
+                };
+                seen = Some((origin, from));
+                if let Some(t) = from.hit(traced.ray.dir, traced.t_min, bound[i]) {
                     bound[i] = t;
                     let normal = capsule.normal(traced.ray.at(t));
                     opaque[i] = Some(hit(t as f32, normal.as_vec3(), &Material::STEEL));
