@@ -229,19 +229,31 @@ pub struct CapsuleFrom {
 
 impl CapsuleFrom {
     /// [`Capsule::hit`] for the unit direction `dir` from this start.
+    #[inline]
     pub fn hit(&self, dir: DVec3, t_min: f64, t_max: f64) -> Option<f64> {
-        let (ba, baba, baoa, qc) = (self.ba, self.baba, self.baoa, self.qc);
-        let (bard, rdoa) = (ba.dot(dir), dir.dot(self.oa));
-        let qa = baba - bard * bard;
-        let qb = baba * rdoa - baoa * bard;
+        let (bard, rdoa) = (self.ba.dot(dir), dir.dot(self.oa));
+        let qa = self.baba - bard * bard;
+        let qb = self.baba * rdoa - self.baoa * bard;
+        let h = qb * qb - qa * self.qc;
+        // Clearly outside the infinite cylinder around the axis, which holds both rounded ends
+        // too (the margin is far above the rounding of `h`): most rays of a view.
+        if qa > 0.0 && h < -MISS_MARGIN * (qb * qb + (qa * self.qc).abs()) {
+            return None;
+        }
+        self.hit_near(dir, [bard, qa, qb, h], (t_min, t_max))
+    }
+
+    /// [`Self::hit`] for a ray near the capsule, given its terms `bard`, `qa`, `qb` and `h`.
+    #[inline(never)]
+    fn hit_near(
+        &self,
+        dir: DVec3,
+        [bard, qa, qb, h]: [f64; 4],
+        (t_min, t_max): (f64, f64),
+    ) -> Option<f64> {
+        let (baba, baoa) = (self.baba, self.baoa);
         let in_range = |t: f64| (t > t_min && t < t_max).then_some(t);
         if qa > 0.0 {
-            let h = qb * qb - qa * qc;
-            // Clearly outside the infinite cylinder around the axis, which holds both rounded
-            // ends too (the margin is far above the rounding of `h`): most rays of a view.
-            if h < -MISS_MARGIN * (qb * qb + (qa * qc).abs()) {
-                return None;
-            }
             if h >= 0.0 {
                 let t = (-qb - h.sqrt()) / qa;
                 let y = baoa + t * bard;

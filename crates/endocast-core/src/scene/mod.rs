@@ -308,14 +308,13 @@ impl PlacedScene<'_> {
         }
         for capsule in &self.instruments {
             // The rays of a packet mostly share their start.
-            let mut seen = None;
+            let mut seen: Option<(DVec3, CapsuleFrom)> = None;
             for (i, traced) in rays.iter().enumerate() {
                 let origin = traced.ray.origin;
-                let from = match seen {
-                    Some((o, from)) if o == origin => from,
-                    _ => capsule.seen_from(origin),
-                };
-                seen = Some((origin, from));
+                if seen.as_ref().is_some_and(|(o, _)| *o != origin) {
+                    seen = None;
+                }
+                let (_, from) = seen.get_or_insert_with(|| (origin, capsule.seen_from(origin)));
                 if let Some(t) = from.hit(traced.ray.dir, traced.t_min, bound[i]) {
                     bound[i] = t;
                     let normal = capsule.normal(traced.ray.at(t));
