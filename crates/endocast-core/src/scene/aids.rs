@@ -251,15 +251,13 @@ impl CapsuleFrom {
         [bard, qa, qb, h]: [f64; 4],
         (t_min, t_max): (f64, f64),
     ) -> Option<f64> {
-        let (baba, baoa) = (self.baba, self.baoa);
         let in_range = |t: f64| (t > t_min && t < t_max).then_some(t);
-        if qa > 0.0 {
-            if h >= 0.0 {
-                let t = (-qb - h.sqrt()) / qa;
-                let y = baoa + t * bard;
-                if y > 0.0 && y < baba {
-                    return in_range(t);
-                }
+        // The side, where the ray meets the infinite cylinder between the ends.
+        if qa > 0.0 && h >= 0.0 {
+            let t = (-qb - h.sqrt()) / qa;
+            let y = self.baoa + t * bard;
+            if y > 0.0 && y < self.baba {
+                return in_range(t);
             }
         }
         // The rounded ends: the nearer sphere the ray meets.
