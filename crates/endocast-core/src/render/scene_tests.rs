@@ -163,15 +163,22 @@ fn an_opaque_mesh_hides_the_wall_exactly_where_it_covers_it() {
     }
 }
 
+/// The sphere-shell phantom's renderer, its centre and the point of its inner wall straight
+/// ahead (+z) of it (world mm), and a translucent green glass.
+fn glass_on_the_wall() -> (Arc<Renderer>, DVec3, DVec3, Material) {
+    let (renderer, shell) = shell();
+    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
+    let on_wall = centre + DVec3::Z * shell.inner_radius_vox;
+    let glass = Material::new([0.1, 0.9, 0.3], 0.4).unwrap();
+    (renderer, centre, on_wall, glass)
+}
+
 /// A translucent sphere centred on the wall (half in air, half in tissue) over DVR with a
 /// transfer function that leaves tissue translucent: each pixel equals compositing the same
 /// samples and the sphere's two surfaces, merged by distance, one at a time.
 #[test]
 fn a_translucent_sphere_half_inside_tissue_composites_in_depth_order() {
-    let (renderer, shell) = shell();
-    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
-    let on_wall = centre + DVec3::Z * shell.inner_radius_vox;
-    let glass = Material::new([0.1, 0.9, 0.3], 0.4).unwrap();
+    let (renderer, centre, on_wall, glass) = glass_on_the_wall();
     let tf = TransferFunction::ramp(-700.0, 400.0);
     let inside = spheres_against_reference(&renderer, centre, tf, &[(on_wall, 6.0, glass)]);
     assert!(inside > 50, "{inside}");
@@ -182,10 +189,7 @@ fn a_translucent_sphere_half_inside_tissue_composites_in_depth_order() {
 /// each pixel equals the samples in front of it and both spheres' surfaces in depth order.
 #[test]
 fn an_opaque_sphere_in_tissue_ends_the_walk_at_its_surface() {
-    let (renderer, shell) = shell();
-    let centre = renderer.volume().geometry().world_of(shell.centre_vox);
-    let on_wall = centre + DVec3::Z * shell.inner_radius_vox;
-    let glass = Material::new([0.1, 0.9, 0.3], 0.4).unwrap();
+    let (renderer, centre, on_wall, glass) = glass_on_the_wall();
     let bone = Material::new([0.9, 0.8, 0.6], 1.0).unwrap();
     let spheres = [
         (on_wall, 6.0, glass),
