@@ -1,13 +1,15 @@
 //! The options that decide how a scan looks (preset, mode, isovalues, transfer function,
 //! sampling) and how many threads render it; shared by `render` and `bench`.
 
+use crate::lumen::LumenArgs;
 use crate::peel::PeelArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::look::{Look, LookKind, PresetLook, SecretionMode, Texture, BUILT_IN_TEXTURES};
+use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, RenderSettings, TransferFunction};
-use endocast_core::tissue::{self, ScanValues};
+use endocast_core::study::{Study, StudyRequest};
 use endocast_core::Volume;
 
 /// How a scan is rendered.
@@ -62,47 +64,34 @@ impl LookArgs {
         self.preset.as_deref().map(find_preset).transpose()
     }
 
-    /// The preset (or defaults), overridden by every option given; values as the table gives
-    /// them (HU), whatever the scan (see [`LookArgs::on_scan`]).
-    pub fn settings(&self) -> Result<RenderSettings> {
-        let base = match self.preset()? {
-            Some(preset) => preset.settings(),
-            None => RenderSettings::default(),
+    /// The study of `volume` these options ask for ([`Study::resolve`]: the preset carried to
+    /// the scan's units, the lumen, the structure and the start, or `pose` when the user placed
+    /// the camera), then every option given on top, which wins (`--iso` is in the scan's
+    /// units and moves the lumen with it).
+    pub fn on_scan(
+        &self,
+        volume: &Volume,
+        lumen: &LumenArgs,
+        pose: Option<Pose>,
+        fov_deg: Option<f64>,
+    ) -> Result<ScanLook> {
+        let request = StudyRequest {
+            preset: self.preset()?,
+            iso: self.iso.map(|iso| finite("--iso", iso)).transpose()?,
+            lumen_threshold: lumen
+                .lumen_threshold
+                .map(|t| finite("--lumen-threshold", t))
+                .transpose()?,
+            bright_lumen: lumen.bright_lumen,
+            fov_deg,
+            pose,
         };
-        self.overridden(base)
-    }
-
-    /// The look on `volume`: the preset (or the default view) carried to the scan's own units
-    /// ([`tissue::resolve`], [`tissue::default_settings`]), then every option given, which
-    /// wins (`--iso` is in the scan's units). Also says in one line what was resolved.
-    pub fn on_scan(&self, volume: &Volume) -> Result<ScanLook> {
-        let scan = ScanValues::measure(volume);
-        let (base, preset, summary) = match self.preset()? {
-            Some(preset) => {
-                let resolved = tissue::resolve(preset, volume, &scan);
-                (resolved.settings(), Some(resolved.preset), resolved.summary)
-            }
-            None => {
-                let s = tissue::default_settings(&scan);
-                let summary = format!("wall at {:.1} ({scan})", s.iso_hu);
-                (s, None, summary)
-            }
-        };
-        let look_base = preset.map_or_else(|| tissue::default_look(&scan), |p| p.look);
+        let study = Study::resolve(volume, &request);
         Ok(ScanLook {
-            settings: self.overridden(base)?,
-            preset,
-            summary,
-            scan,
-            look: self.realism.look(&look_base, self.iso)?,
+            settings: self.overridden(study.settings().clone())?,
+            look: self.realism.look(&study.look(), self.iso)?,
+            study,
         })
-    }
-
-    /// The clinical or realistic look the options ask for, with the preset's values as the
-    /// table gives them (HU; see [`LookArgs::on_scan`] for a scan's units); `None` for plain.
-    pub fn look(&self) -> Result<Option<Look>> {
-        let base = self.preset()?.map_or(PresetLook::CT, |p| p.look);
-        self.realism.look(&base, self.iso)
     }
 
     /// The name of the look asked for with `--look` (`plain` when none).
@@ -275,16 +264,12 @@ fn texture(spec: &str) -> Result<Option<Texture>> {
 }
 
 /// How a scan looks, its values understood.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct ScanLook {
     /// The settings, options applied.
     pub settings: RenderSettings,
-    /// The preset in the scan's units, if one was named.
-    pub preset: Option<Preset>,
-    /// What was resolved, in one line.
-    pub summary: String,
-    /// What the histogram says.
-    pub scan: ScanValues,
+    /// The scan understood for the procedure: its values, lumen, structure and start.
+    pub study: Study,
     /// The clinical or realistic look's stages; `None` for the plain look.
     pub look: Option<Look>,
 }

@@ -12,6 +12,7 @@ mod pose_args;
 mod progress;
 mod scene_args;
 mod structure;
+mod study_report;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

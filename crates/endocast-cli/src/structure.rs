@@ -2,9 +2,8 @@
 //! on the three slices through the camera.
 
 use anyhow::{bail, Context, Result};
-use endocast_core::navigate::DefaultView;
-use endocast_core::presets::Preset;
-use endocast_core::views::slices::{SliceOptions, Window};
+use endocast_core::study::Study;
+use endocast_core::views::slices::SliceOptions;
 use endocast_core::views::structure::structure_slices;
 use endocast_core::Volume;
 use std::path::Path;
@@ -12,24 +11,20 @@ use std::path::Path;
 /// Edge of each of the three slices, pixels.
 const SLICE_PX: usize = 384;
 
-/// Writes the structure of `view` (see [`structure_slices`]) to `path`, in the slice window of
-/// `preset` (air/tissue without one). An error when no structure was found (no default view,
-/// or a view framing the volume from outside).
-pub fn write(
-    path: &Path,
-    volume: &Volume,
-    view: Option<&DefaultView>,
-    preset: Option<&Preset>,
-) -> Result<()> {
-    let Some(DefaultView::InsideLumen { pose, lumen, .. }) = view else {
+/// Writes the structure `study` found (see [`structure_slices`]) to `path`, through its start,
+/// in its slice window. An error when no structure was found (the user placed the camera, or
+/// the study frames the object from outside).
+pub fn write(path: &Path, volume: &Volume, study: &Study) -> Result<()> {
+    let Some(lumen) = study.structure() else {
         bail!(
             "--show-structure shows the structure a --preset finds: give an endoscopic preset \
              and no --eye/--from (no structure was found to show)"
         );
     };
+    let pose = study.start_pose();
     let mut options = SliceOptions::default();
     options.size_px = SLICE_PX;
-    options.window = preset.map_or(Window::AIR_TISSUE, |p| p.window);
+    options.window = study.window();
     let forward = (pose.look_at_mm - pose.eye_mm).normalize_or_zero();
     let sheet = structure_slices(
         volume,

@@ -15,4 +15,5 @@ mod presets;
 mod real_scans;
 mod render;
 mod scene;
+mod study_table;
 mod view;

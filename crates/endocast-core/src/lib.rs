@@ -27,6 +27,7 @@ pub mod pose;
 pub mod presets;
 pub mod render;
 pub mod scene;
+pub mod study;
 #[cfg(test)]
 mod test_rng;
 pub mod tissue;

@@ -3,10 +3,9 @@
 
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
-use crate::look::{optics, Look};
+use crate::look::{optics, LookOptions};
 use crate::volume::Volume;
 use endocast_core::flight::{Flight, FlightOptions, Layout, Route, ShotSettings};
-use endocast_core::views::slices::Window;
 use endocast_io::route_file::read_route;
 use endocast_io::transfer_json::transfer_function;
 use endocast_io::video::{open_sink, VideoOptions};
@@ -33,22 +32,27 @@ pub fn fly<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let kw = Kwargs::new(py, "fly", options)?;
     let volume = volume.get();
-    let look = Look::take(&kw)?;
+    let options = LookOptions::take(&kw)?;
     let fov = kw.take::<f64>("fov")?;
-    let optics = optics(&kw, look.preset, volume.volume(), fov)?;
     let size = kw.take::<[usize; 2]>("size")?.unwrap_or([384, 384]);
     let frame_step = kw.take::<f64>("frame_step")?.unwrap_or(1.0);
     let look_ahead = kw.take::<f64>("look_ahead")?.unwrap_or(10.0);
     let fps = kw.take::<f64>("fps")?.unwrap_or(25.0);
-    kw.finish()?;
     let route = read(py, route)?;
     let shots = route.shots(frame_step, look_ahead).map_err(to_py)?;
+    let first = shots
+        .first()
+        .ok_or_else(|| error("the route has no frames"))?
+        .pose;
+    let look = options.resolve(py, volume.volume(), Some(first), fov)?;
+    let optics = optics(&kw, look.study.preset(), volume.volume(), fov)?;
+    kw.finish()?;
     let options = FlightOptions {
         size,
         optics,
         stereo: None,
         layout: Layout::Endoscope,
-        window: look.preset.map_or(Window::AIR_TISSUE, |p| p.window),
+        window: look.study.window(),
     };
     let mut flight = Flight::new(volume.renderer().clone(), options);
     let mut looks = ShotSettings::new(look.settings.clone(), transfer_function);

@@ -5,66 +5,95 @@
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
 use endocast_core::camera::{default_up, Lens, Optics, Projection};
-use endocast_core::navigate::{default_view, LumenChoice};
 use endocast_core::pose::Pose;
-use endocast_core::presets::{self, Preset, DEFAULT_FOV_DEG};
-use endocast_core::render::{Camera, Mode, RenderSettings};
+use endocast_core::presets::{self, Preset};
+use endocast_core::render::{Camera, Mode, RenderSettings, TransferFunction};
+use endocast_core::study::{Study, StudyRequest};
 use endocast_core::Volume;
 use glam::DVec3;
 use pyo3::prelude::*;
 
-/// A preset and the render settings: the preset's (or the defaults), overridden by the options.
-pub struct Look {
-    /// The preset named, if any.
-    pub preset: Option<&'static Preset>,
-    /// The settings in force.
-    pub settings: RenderSettings,
-    /// The workers of the `threads` option (`None`: rayon's global pool, all cores); made
-    /// once, so that a flight's frames share it.
-    pool: Option<rayon::ThreadPool>,
+/// The look options as given (the keywords `render`, `fly` and `default_view` share), before
+/// a volume resolves them ([`LookOptions::resolve`]).
+pub struct LookOptions {
+    preset: Option<&'static Preset>,
+    mode: Option<Mode>,
+    iso: Option<f64>,
+    iso2: Option<f64>,
+    iso_opacity: Option<f32>,
+    tf: Option<TransferFunction>,
+    step: Option<f64>,
+    jitter: bool,
+    skip_empty: bool,
+    shade_dvr: Option<bool>,
+    background: Option<[f32; 3]>,
+    lumen_threshold: Option<f64>,
+    bright_lumen: bool,
+    threads: Option<usize>,
 }
 
-impl Look {
+impl LookOptions {
     /// Takes `preset`, `mode`, `iso`, `iso2`, `iso_opacity`, `tf`, `step`, `jitter`,
-    /// `skip_empty`, `shade_dvr`, `background` and `threads`.
+    /// `skip_empty`, `shade_dvr`, `background`, `lumen_threshold`, `bright_lumen` and
+    /// `threads`.
     pub fn take(kw: &Kwargs<'_>) -> PyResult<Self> {
-        let preset = kw
-            .take::<String>("preset")?
-            .map(|name| find_preset(&name))
+        let mode = kw
+            .take::<String>("mode")?
+            .map(|mode| {
+                Mode::from_name(&mode).ok_or_else(|| {
+                    error(format!(
+                        "unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip, minip or \
+                         peel"
+                    ))
+                })
+            })
             .transpose()?;
-        let mut s = preset.map_or_else(RenderSettings::default, Preset::settings);
-        if let Some(mode) = kw.take::<String>("mode")? {
-            s.mode = Mode::from_name(&mode).ok_or_else(|| {
-                error(format!(
-                    "unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip or minip"
-                ))
-            })?;
-        }
-        if let Some(iso) = kw.take("iso")? {
-            s.iso_hu = iso;
-        }
-        if let Some(iso2) = kw.take("iso2")? {
-            s.iso2_hu = iso2;
-        }
-        if let Some(alpha) = kw.take("iso_opacity")? {
-            s.iso_opacity = alpha;
-        }
-        if let Some(tf) = kw.take::<String>("tf")? {
-            s.tf = endocast_io::transfer_json::transfer_function(&tf).map_err(to_py)?;
-        }
-        if let Some(step) = kw.take("step")? {
-            s.step_vox = step;
-        }
-        s.jitter = kw.take("jitter")?.unwrap_or(false);
-        s.skip_empty = kw.take("skip_empty")?.unwrap_or(true);
-        if let Some(shade) = kw.take("shade_dvr")? {
-            s.shade_dvr = shade;
-        }
-        if let Some(background) = kw.take("background")? {
-            s.background = background;
-        }
-        s.validate().map_err(to_py)?;
-        let pool = match kw.take::<usize>("threads")? {
+        let tf = kw
+            .take::<String>("tf")?
+            .map(|tf| endocast_io::transfer_json::transfer_function(&tf).map_err(to_py))
+            .transpose()?;
+        Ok(Self {
+            preset: kw
+                .take::<String>("preset")?
+                .map(|name| find_preset(&name))
+                .transpose()?,
+            mode,
+            iso: finite("iso", kw.take("iso")?)?,
+            iso2: kw.take("iso2")?,
+            iso_opacity: kw.take("iso_opacity")?,
+            tf,
+            step: kw.take("step")?,
+            jitter: kw.take("jitter")?.unwrap_or(false),
+            skip_empty: kw.take("skip_empty")?.unwrap_or(true),
+            shade_dvr: kw.take("shade_dvr")?,
+            background: kw.take("background")?,
+            lumen_threshold: finite("lumen_threshold", kw.take("lumen_threshold")?)?,
+            bright_lumen: kw.take("bright_lumen")?.unwrap_or(false),
+            threads: kw.take("threads")?,
+        })
+    }
+
+    /// The study of `volume` these options ask for (the same as `endocast render`'s: the preset
+    /// in the scan's units, the lumen, the structure and the start, or `pose` when the caller
+    /// placed the camera; resolved without the GIL), and the settings with every option on top.
+    pub fn resolve(
+        &self,
+        py: Python<'_>,
+        volume: &Volume,
+        pose: Option<Pose>,
+        fov_deg: Option<f64>,
+    ) -> PyResult<Look> {
+        let request = StudyRequest {
+            preset: self.preset,
+            iso: self.iso,
+            lumen_threshold: self.lumen_threshold,
+            bright_lumen: self.bright_lumen,
+            fov_deg,
+            pose,
+        };
+        let study = py.detach(|| Study::resolve(volume, &request));
+        let settings = self.overridden(study.settings().clone())?;
+        let pool = match self.threads {
             None => None,
             Some(0) => return Err(error("threads must be at least 1")),
             Some(n) => Some(
@@ -74,13 +103,62 @@ impl Look {
                     .map_err(to_py)?,
             ),
         };
-        Ok(Self {
-            preset,
-            settings: s,
+        Ok(Look {
+            study,
+            settings,
             pool,
         })
     }
 
+    fn overridden(&self, mut s: RenderSettings) -> PyResult<RenderSettings> {
+        if let Some(mode) = self.mode {
+            s.mode = mode;
+        }
+        if let Some(iso2) = self.iso2 {
+            s.iso2_hu = iso2;
+        }
+        if let Some(alpha) = self.iso_opacity {
+            s.iso_opacity = alpha;
+        }
+        if let Some(tf) = &self.tf {
+            s.tf.clone_from(tf);
+        }
+        if let Some(step) = self.step {
+            s.step_vox = step;
+        }
+        s.jitter = self.jitter;
+        s.skip_empty = self.skip_empty;
+        if let Some(shade) = self.shade_dvr {
+            s.shade_dvr = shade;
+        }
+        if let Some(background) = self.background {
+            s.background = background;
+        }
+        s.validate().map_err(to_py)?;
+        Ok(s)
+    }
+}
+
+/// `value` when it is finite (or absent), else an error naming the option.
+fn finite(name: &str, value: Option<f64>) -> PyResult<Option<f64>> {
+    match value {
+        Some(v) if !v.is_finite() => Err(error(format!("{name} must be a finite number, not {v}"))),
+        v => Ok(v),
+    }
+}
+
+/// A scan understood for the options, and the render settings in force.
+pub struct Look {
+    /// The scan understood: its values, lumen, structure and start.
+    pub study: Study,
+    /// The settings in force.
+    pub settings: RenderSettings,
+    /// The workers of the `threads` option (`None`: rayon's global pool, all cores); made
+    /// once, so that a flight's frames share it.
+    pool: Option<rayon::ThreadPool>,
+}
+
+impl Look {
     /// Runs `work` on the `threads` workers (all cores without the option).
     pub fn in_pool<T: Send>(&self, work: impl FnOnce() -> T + Send) -> T {
         match &self.pool {
@@ -97,22 +175,6 @@ pub fn find_preset(name: &str) -> PyResult<&'static Preset> {
             "unknown preset {name:?}; choose one of {}",
             presets::all_names()
         ))
-    })
-}
-
-/// The lumen options `lumen_threshold` and `bright_lumen`, with the wall isovalue `iso` (the
-/// preset's when `None`).
-pub fn lumen_choice<'a>(
-    kw: &Kwargs<'_>,
-    preset: Option<&'a Preset>,
-    iso: Option<f64>,
-) -> PyResult<LumenChoice<'a>> {
-    Ok(LumenChoice {
-        preset,
-        iso,
-        threshold: kw.take("lumen_threshold")?,
-        bright_lumen: kw.take("bright_lumen")?.unwrap_or(false),
-        within: None,
     })
 }
 
@@ -148,42 +210,50 @@ pub fn optics(
     })
 }
 
-/// The camera of `render`: `eye`, `look_at` and `up` (LPS mm) when given, else the library's
-/// default view (inside the largest lumen for an endoscopic preset, else framing the volume);
-/// with the optics and the image `size` (width, height; default 512 × 512).
-pub fn camera(kw: &Kwargs<'_>, look: &Look, volume: &Volume) -> PyResult<Camera> {
-    let fov = kw.take::<f64>("fov")?;
-    let eye = kw.take::<[f64; 3]>("eye")?;
-    let look_at = kw.take::<[f64; 3]>("look_at")?;
-    let up = kw.take::<[f64; 3]>("up")?;
-    let size = kw.take::<[usize; 2]>("size")?.unwrap_or([512, 512]);
-    let lumen = lumen_choice(kw, look.preset, Some(look.settings.iso_hu))?;
-    let (eye, look_at, chosen_up) = match (eye, look_at) {
-        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None),
-        (None, None) => {
-            let pose = default_pose(volume, look, &lumen, fov);
-            (pose.eye_mm, pose.look_at_mm, Some(pose.up))
-        }
-        _ => return Err(error("eye and look_at go together")),
-    };
-    let up = up
-        .map(DVec3::from)
-        .or(chosen_up)
-        .unwrap_or_else(|| default_up(look_at - eye));
-    let optics = optics(kw, look.preset, volume, fov)?;
-    optics.camera(eye, look_at, up, size).map_err(to_py)
+/// Where the caller placed the camera, if they did: `eye`, `look_at` and `up` (LPS mm), the
+/// field `fov` and the image `size` (width, height; default 512 × 512).
+pub struct Placed {
+    /// The camera placed, `None` for the study's start.
+    pub pose: Option<Pose>,
+    /// The field of view, degrees (mm for orthographic).
+    pub fov: Option<f64>,
+    /// Width and height, pixels.
+    pub size: [usize; 2],
 }
 
-/// The library's default view ([`default_view`]) for the preset and lumen options.
-pub fn default_pose(
-    volume: &Volume,
-    look: &Look,
-    lumen: &LumenChoice<'_>,
-    fov: Option<f64>,
-) -> Pose {
-    let fov_deg = fov.unwrap_or_else(|| look.preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
-    let choice = look.preset.map(|_| lumen);
-    default_view(volume, choice, fov_deg).pose()
+impl Placed {
+    /// Takes `eye`, `look_at`, `up`, `fov` and `size`.
+    pub fn take(kw: &Kwargs<'_>) -> PyResult<Self> {
+        let fov = kw.take::<f64>("fov")?;
+        let eye = kw.take::<[f64; 3]>("eye")?;
+        let look_at = kw.take::<[f64; 3]>("look_at")?;
+        let up = kw.take::<[f64; 3]>("up")?.map(DVec3::from);
+        let size = kw.take::<[usize; 2]>("size")?.unwrap_or([512, 512]);
+        let pose = match (eye, look_at) {
+            (Some(eye), Some(look_at)) => {
+                let (eye_mm, look_at_mm) = (DVec3::from(eye), DVec3::from(look_at));
+                Some(Pose {
+                    eye_mm,
+                    look_at_mm,
+                    up: up.unwrap_or_else(|| default_up(look_at_mm - eye_mm)),
+                })
+            }
+            (None, None) => None,
+            _ => return Err(error("eye and look_at go together")),
+        };
+        Ok(Self { pose, fov, size })
+    }
+}
+
+/// The camera of `render`: the study's start (the pose placed, else inside the structure the
+/// preset means looking along its path, else the whole object framed), with the lens options
+/// and the placed field and size.
+pub fn camera(kw: &Kwargs<'_>, look: &Look, volume: &Volume, placed: &Placed) -> PyResult<Camera> {
+    let pose = look.study.start_pose();
+    let optics = optics(kw, look.study.preset(), volume, placed.fov)?;
+    optics
+        .camera(pose.eye_mm, pose.look_at_mm, pose.up, placed.size)
+        .map_err(to_py)
 }
 
 /// The names of the presets (`endocast presets` lists what each sets).

@@ -3,10 +3,10 @@
 
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
-use crate::look::{default_pose, find_preset, lumen_choice, Look};
+use crate::look::{find_preset, LookOptions};
 use crate::volume::Volume;
-use endocast_core::navigate::{plan_path, PathEnd};
 use endocast_core::path::SmoothOptions;
+use endocast_core::study::{Study, StudyPathError, StudyRequest};
 use glam::DVec3;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -20,9 +20,14 @@ type Point = (f64, f64, f64);
 type PathArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// The centred path through the lumen from `start` (LPS mm; or `start_voxel`, an index) to
-/// `end` (or `end_voxel`; neither: the farthest lumen point), as `endocast path` plans it and
-/// writes it: points every `step` mm (default 2) and the last, as an (N, 3) array in LPS mm,
-/// and each point's distance to the lumen wall (N,), mm.
+/// `end` (or `end_voxel`), as `endocast path` plans it and writes it. Without a start, the
+/// `preset`'s structure is found and the path starts where `default_view` puts the camera;
+/// without an end it runs to the structure's known end (the aorta's lowest section), else to
+/// the farthest lumen point. Returns points every `step` mm (default 2) and the last, as an
+/// (N, 3) array in LPS mm, and each point's distance to the lumen wall (N,), mm. Options:
+/// `preset`, `iso` (the wall, in the scan's units: the lumen threshold follows it),
+/// `lumen_threshold`, `bright_lumen`, `smoothing` (control point spacing, mm, default 5) and
+/// `step`.
 #[pyfunction]
 #[pyo3(signature = (volume, start = None, end = None, **options))]
 pub fn path<'py>(
@@ -36,35 +41,48 @@ pub fn path<'py>(
     let volume = volume.get().volume();
     let start_voxel = kw.take::<[f64; 3]>("start_voxel")?;
     let end_voxel = kw.take::<[f64; 3]>("end_voxel")?;
-    let preset = kw
-        .take::<String>("preset")?
-        .map(|n| find_preset(&n))
-        .transpose()?;
-    let iso = kw.take::<f64>("iso")?;
-    let choice = lumen_choice(&kw, preset, iso)?;
+    let request = StudyRequest {
+        preset: kw
+            .take::<String>("preset")?
+            .map(|n| find_preset(&n))
+            .transpose()?,
+        iso: kw.take::<f64>("iso")?,
+        lumen_threshold: kw.take("lumen_threshold")?,
+        bright_lumen: kw.take("bright_lumen")?.unwrap_or(false),
+        ..StudyRequest::default()
+    };
     let smoothing = kw.take::<f64>("smoothing")?.unwrap_or(5.0);
     let step = kw.take::<f64>("step")?.unwrap_or(2.0);
     kw.finish()?;
-    let (threshold, side) = choice.resolve().map_err(to_py)?;
     let world = |p: Option<[f64; 3]>, v: Option<[f64; 3]>, name: &str| match (p, v) {
         (Some(_), Some(_)) => Err(error(format!("give {name} or {name}_voxel, not both"))),
         (Some(p), None) => Ok(Some(DVec3::from(p))),
         (None, Some(v)) => Ok(Some(volume.geometry().world_of(DVec3::from(v)))),
         (None, None) => Ok(None),
     };
-    let start = world(start, start_voxel, "start")?
-        .ok_or_else(|| error("give the start (LPS mm) or start_voxel (an index)"))?;
-    let end = world(end, end_voxel, "end")?.map_or(PathEnd::Farthest, PathEnd::Point);
+    let start = world(start, start_voxel, "start")?;
+    let end = world(end, end_voxel, "end")?;
     let options = SmoothOptions {
         control_spacing_mm: smoothing,
         step_mm: 0.5,
         ..SmoothOptions::default()
     };
     let (points, radii) = py.detach(|| -> PyResult<_> {
-        let (_, field, planned) = plan_path(volume, threshold, side, start, end, &options)
-            .map_err(|e| error(format!("no path in the lumen {side} {threshold}: {e}")))?;
-        let points = planned.path.points_every(step).map_err(to_py)?;
-        let radii: Vec<f64> = points.iter().map(|&p| field.distance_mm(p)).collect();
+        let study = Study::resolve(volume, &request);
+        let planned = study
+            .plan(volume, start, end, &options)
+            .map_err(|e| match e {
+                StudyPathError::NoStart(why) => error(format!(
+                    "{why}: start=(x, y, z) in LPS mm or start_voxel=(i, j, k), or a preset \
+                     whose structure is found"
+                )),
+                e => error(e.to_string()),
+            })?;
+        let points = planned.planned.path.points_every(step).map_err(to_py)?;
+        let radii: Vec<f64> = points
+            .iter()
+            .map(|&p| planned.field.distance_mm(p))
+            .collect();
         Ok((points, radii))
     })?;
     let flat: Vec<f64> = points.iter().flat_map(|p| p.to_array()).collect();
@@ -72,9 +90,11 @@ pub fn path<'py>(
     Ok((points.into_pyarray(py), PyArray1::from_vec(py, radii)))
 }
 
-/// The camera `render` takes when given no `eye`: for an endoscopic preset inside the largest
-/// lumen, looking along it, else framing the whole volume from the front. Returns
-/// `(eye, look_at, up)`, LPS mm.
+/// The camera `render` takes when given no `eye`, the same as `endocast render`'s: for an
+/// endoscopic preset inside the structure it means (the airways from the trachea, the aorta,
+/// the colon, the nasal cavity, the ventricles), looking along the automatic path; else the
+/// whole object framed from the front. Returns `(eye, look_at, up)`, LPS mm. Takes the look
+/// options of `render` (`preset`, `iso`, `lumen_threshold`, `bright_lumen`, `fov`, ...).
 #[pyfunction]
 #[pyo3(signature = (volume, **options))]
 pub fn default_view<'py>(
@@ -84,11 +104,10 @@ pub fn default_view<'py>(
 ) -> PyResult<(Point, Point, Point)> {
     let kw = Kwargs::new(py, "default_view", options)?;
     let volume = volume.get().volume();
-    let look = Look::take(&kw)?;
+    let look = LookOptions::take(&kw)?;
     let fov = kw.take::<f64>("fov")?;
-    let lumen = lumen_choice(&kw, look.preset, Some(look.settings.iso_hu))?;
     kw.finish()?;
-    let pose = py.detach(|| default_pose(volume, &look, &lumen, fov));
+    let pose = look.resolve(py, volume, None, fov)?.study.start_pose();
     let triple = |v: DVec3| (v.x, v.y, v.z);
     Ok((
         triple(pose.eye_mm),

@@ -2,7 +2,7 @@
 
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
-use crate::look::{camera, Look};
+use crate::look::{camera, LookOptions, Placed};
 use crate::volume::Volume;
 use endocast_core::camera::StereoRig;
 use endocast_core::render::{Camera, Frame, Prepared};
@@ -35,6 +35,24 @@ struct View {
 /// isosurface hit, float32 mm from the eye (height, width; NaN where none). A stereo pair
 /// (`stereo="pair"`) gives (2, height, width, 4) and (2, height, width); a combined stereo
 /// image gives the left eye's depth.
+///
+/// The scan is understood as the command understands it: the `preset` (colonoscopy,
+/// bronchoscopy, angioscopy, sinus, ventricles, arthroscopy; `presets()` lists them) is carried
+/// into the scan's own units (HU, HU + 1024, MR intensities), and without `eye`/`look_at` the
+/// camera starts inside the structure the preset names, looking along the automatic path
+/// (`default_view`); without a preset the whole object is framed.
+///
+/// Options (keywords, as the command's flags with `_` for `-`):
+/// - look: `preset`, `mode` (iso, dvr, hybrid, two-iso, mip, minip, peel), `iso` (the wall,
+///   in the scan's units; the lumen threshold follows it), `iso2`, `iso_opacity`, `tf` (a
+///   JSON file or a preset name), `step` (voxels), `jitter`, `skip_empty`, `shade_dvr`,
+///   `background` (r, g, b), `threads`;
+/// - camera: `eye`, `look_at`, `up` (LPS mm), `fov` (degrees), `near` (mm), `size`
+///   (width, height; default 512 × 512), `lens` (pinhole, equidistant, equisolid,
+///   orthographic), `distortion` (k1, k2), `vignetting`;
+/// - stereo: `stereo` (anaglyph, red-cyan, dubois, side-by-side, top-bottom, pair),
+///   `eye_separation`, `focus` (mm);
+/// - lumen: `lumen_threshold`, `bright_lumen`.
 #[pyfunction]
 #[pyo3(signature = (volume, **options))]
 pub fn render<'py>(
@@ -44,8 +62,10 @@ pub fn render<'py>(
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let kw = Kwargs::new(py, "render", options)?;
     let volume = volume.get();
-    let look = Look::take(&kw)?;
-    let camera = camera(&kw, &look, volume.volume())?;
+    let options = LookOptions::take(&kw)?;
+    let placed = Placed::take(&kw)?;
+    let look = options.resolve(py, volume.volume(), placed.pose, placed.fov)?;
+    let camera = camera(&kw, &look, volume.volume(), &placed)?;
     let stereo = stereo_options(&kw)?;
     kw.finish()?;
     let renderer = volume.renderer().clone();

@@ -34,7 +34,7 @@ fn main() {
         size,
     };
     let scene = Arc::new(Scene::new(source, volume));
-    let preset = Preset::find("colonoscopy").expect("a preset");
+    let preset = Preset::find("colonoscopy");
     let at = |s: f64| geometry.world_of(line.point_at(s));
     let pose = |s: f64| {
         let (eye_mm, look_at_mm) = (at(s), at(s + 10.0));

@@ -32,13 +32,25 @@ pub struct ViewerOptions {
     /// The scan.
     pub source: ScanSource,
     /// The procedure's defaults.
-    pub preset: &'static Preset,
+    pub preset: Option<&'static Preset>,
     /// The starting camera; `None`: inside the preset's largest lumen.
     pub pose: Option<Pose>,
     /// A case file to reopen (its scan replaces `source`) and to save to.
     pub case: Option<PathBuf>,
     /// Write a screenshot of the window here once the view has refined, then quit.
     pub screenshot: Option<PathBuf>,
+    /// Called with the session when the screenshot is taken (e.g. to print what it resolved).
+    pub on_screenshot: Option<ScreenshotHook>,
+}
+
+/// What to do with the session when `--screenshot` grabs the window.
+#[derive(Clone)]
+pub struct ScreenshotHook(pub Arc<dyn Fn(&Session) + Send + Sync>);
+
+impl std::fmt::Debug for ScreenshotHook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ScreenshotHook")
+    }
 }
 
 /// The application.
@@ -287,6 +299,9 @@ impl ViewerApp {
             let rgba: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
             if let Err(e) = endocast_io::write_png_rgba8(&path, w as u32, h as u32, &rgba) {
                 eprintln!("error: {e}");
+            }
+            if let (Some(hook), Some(ready)) = (&self.options.on_screenshot, &self.ready) {
+                (hook.0)(&ready.session);
             }
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         } else if self.screenshot_requested || self.loading.is_some() || self.ready.is_some() {

@@ -5,7 +5,7 @@
 
 use crate::controller::FlyCamera;
 use crate::geometry::{with_mesh, Toggles};
-use crate::session::{Controls, Session};
+use crate::session::{Controls, Session, NO_PRESET};
 use endocast_core::animation::KeyFrame;
 use endocast_core::camera::Projection;
 use endocast_core::presets::Preset;
@@ -23,8 +23,9 @@ use std::time::{Duration, Instant};
 pub trait SessionCase: Sized {
     /// The case of `session` now.
     fn of(session: &Session, revision: u64) -> Self;
-    /// The controls this case sets; `path` names the file in errors.
-    fn controls(&self, path: &Path) -> Result<Option<Controls>, CaseError>;
+    /// The controls this case sets, resolved on `session`'s scan; `path` names the file in
+    /// errors.
+    fn controls(&self, path: &Path, session: &Session) -> Result<Option<Controls>, CaseError>;
     /// Puts `session` (open on this case's scan; refused for another scan) in this case's
     /// state.
     fn apply(&self, session: &mut Session, path: &Path) -> Result<(), CaseError>;
@@ -45,7 +46,7 @@ fn fly_camera(c: &CaseCamera) -> Option<FlyCamera> {
 
 fn controls_of(c: &Controls, mesh_files: &[PathBuf]) -> CaseControls {
     CaseControls {
-        preset: c.preset.name.into(),
+        preset: c.preset_name().into(),
         mode: c.mode.name().into(),
         iso_hu: c.iso_hu,
         iso_opacity: c.iso_opacity,
@@ -94,27 +95,31 @@ impl SessionCase for Case {
         case
     }
 
-    fn controls(&self, path: &Path) -> Result<Option<Controls>, CaseError> {
+    fn controls(&self, path: &Path, session: &Session) -> Result<Option<Controls>, CaseError> {
         let Some(c) = &self.controls else {
             return Ok(None);
         };
         let bad = |what: &str, name: &str| CaseError::new(path, format!("unknown {what} {name:?}"));
-        let preset = Preset::find(&c.preset).ok_or_else(|| bad("preset", &c.preset))?;
+        let preset = match c.preset.as_str() {
+            NO_PRESET => None,
+            name => Some(Preset::find(name).ok_or_else(|| bad("preset", name))?),
+        };
         let window = Window::new(c.window_level_hu, c.window_width_hu)
             .map_err(|e| CaseError::new(path, e))?;
         // Cases before version 3 keep none of these: the preset's apply.
-        let defaults = preset.settings();
+        let defaults = session.study_here(preset).settings().clone();
         let tf = match &c.tf {
             Some(tf) => tf.transfer_function(),
-            None => Ok(defaults.tf),
+            None => Ok(defaults.tf.clone()),
         };
         let peel = match &c.peel {
             Some(peel) => peel.apply(&defaults.peel),
-            None => Ok(defaults.peel),
+            None => Ok(defaults.peel.clone()),
         };
         let to_case_error = |e| CaseError::new(path, e);
         Ok(Some(Controls {
             preset,
+            base: defaults.clone(),
             mode: Mode::from_name(&c.mode).ok_or_else(|| bad("mode", &c.mode))?,
             iso_hu: c.iso_hu,
             iso_opacity: c.iso_opacity,
@@ -132,7 +137,7 @@ impl SessionCase for Case {
 
     fn apply(&self, session: &mut Session, path: &Path) -> Result<(), CaseError> {
         self.check_scan(&session.scene().identity, path)?;
-        let controls = SessionCase::controls(self, path)?;
+        let controls = SessionCase::controls(self, path, session)?;
         let camera = match &self.camera {
             Some(c) => Some(
                 fly_camera(c)

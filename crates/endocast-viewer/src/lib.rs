@@ -26,10 +26,11 @@
 //!
 //! run(ViewerOptions {
 //!     source: ScanSource::Phantom { name: "colon".into(), size: 128 },
-//!     preset: Preset::find("colonoscopy").unwrap(),
+//!     preset: Preset::find("colonoscopy"),
 //!     pose: None,
 //!     case: None,
 //!     screenshot: None,
+//!     on_screenshot: None,
 //! })
 //! .unwrap();
 //! # }

@@ -22,7 +22,7 @@ pub(crate) type Opened = (Session, Option<PathBuf>, Vec<String>);
 pub(crate) struct Request {
     pub source: ScanSource,
     pub case: Option<PathBuf>,
-    pub preset: &'static Preset,
+    pub preset: Option<&'static Preset>,
     pub pose: Option<Pose>,
 }
 

@@ -4,7 +4,7 @@
 use crate::jobs::Job;
 use crate::keys::HELP;
 use crate::scene::ScanSource;
-use crate::session::Session;
+use crate::session::{Session, NO_PRESET};
 use crate::state::{Action, Ready};
 use crate::tf_editor::histogram_ui;
 use endocast_core::camera::Projection;
@@ -140,14 +140,20 @@ fn series_ui(ui: &mut egui::Ui, session: &Session) -> Option<String> {
 fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     let mut preset = session.controls.preset;
     egui::ComboBox::from_label("preset")
-        .selected_text(preset.name)
+        .selected_text(session.controls.preset_name())
         .show_ui(ui, |ui| {
+            ui.selectable_value(&mut preset, None, NO_PRESET)
+                .on_hover_text("no procedure: the whole object, the wall between air and tissue");
             for p in presets::iter() {
-                ui.selectable_value(&mut preset, p, p.name)
+                ui.selectable_value(&mut preset, Some(p), p.name)
                     .on_hover_text(p.description);
             }
         });
-    if !std::ptr::eq(preset, session.controls.preset) {
+    let same = match (preset, session.controls.preset) {
+        (Some(a), Some(b)) => std::ptr::eq(a, b),
+        (a, b) => a.is_none() && b.is_none(),
+    };
+    if !same {
         session.apply_preset(preset);
     }
     let scene = Arc::clone(session.scene());

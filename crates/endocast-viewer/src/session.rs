@@ -11,10 +11,11 @@ use crate::worker::{RenderWorker, View};
 use endocast_core::animation::{Animation, KeyFrame};
 use endocast_core::annotate::{self, Annotation, Annotations, DrawOptions, Shape, SurfaceView};
 use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
-use endocast_core::navigate::{default_view, LumenChoice, LumenSide};
+use endocast_core::navigate::LumenSide;
 use endocast_core::pose::Pose;
-use endocast_core::presets::Preset;
+use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, PeelSettings, RenderSettings, TransferFunction};
+use endocast_core::study::{Study, StudyRequest};
 use endocast_core::views::slices::Window;
 use endocast_core::views::Image;
 use glam::DVec3;
@@ -30,8 +31,12 @@ const MAX_WAIT_FOR_FRAME: Duration = Duration::from_millis(150);
 /// Everything the control panel sets.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Controls {
-    /// The procedure preset whose defaults the rest started from.
-    pub preset: &'static Preset,
+    /// The procedure preset whose defaults the rest started from; `None`: no procedure (the
+    /// whole object framed, the wall between background and object).
+    pub preset: Option<&'static Preset>,
+    /// The settings the rest were resolved with: the preset's in the scan's units (its second
+    /// surface, colours, peel); the controls below override them.
+    pub base: RenderSettings,
     /// Render mode.
     pub mode: Mode,
     /// Wall isovalue, physical units.
@@ -59,29 +64,33 @@ pub struct Controls {
 }
 
 impl Controls {
-    /// The clinical defaults of `preset`, collision on, 20 mm/s.
-    pub fn of_preset(preset: &'static Preset) -> Self {
-        let defaults = preset.settings();
+    /// The defaults `study` resolved (its preset in the scan's units, or the view without one),
+    /// collision on, 20 mm/s.
+    pub fn of_study(study: &Study) -> Self {
+        let base = study.settings().clone();
+        let preset = study.request().preset;
+        let (projection, fov_deg) = presets::lens_defaults(study.preset(), None, None, 0.0);
         Self {
             preset,
-            mode: preset.mode,
-            iso_hu: preset.iso,
-            iso_opacity: preset.iso_opacity,
-            projection: preset.projection,
-            fov_deg: preset.fov_deg,
+            mode: base.mode,
+            iso_hu: base.iso_hu,
+            iso_opacity: base.iso_opacity,
+            projection,
+            fov_deg,
             stereo: false,
             collision: true,
             speed_mm_s: 20.0,
-            window: preset.window,
-            tf: defaults.tf,
-            peel: defaults.peel,
+            window: study.window(),
+            tf: base.tf.clone(),
+            peel: base.peel.clone(),
             geometry: Toggles::default(),
+            base,
         }
     }
 
-    /// The render settings: the preset's with the mode and the wall as set here.
+    /// The render settings: the resolved ones with the mode and the wall as set here.
     pub fn settings(&self) -> RenderSettings {
-        let mut settings = self.preset.settings();
+        let mut settings = self.base.clone();
         settings.mode = self.mode;
         settings.iso_hu = self.iso_hu;
         settings.iso_opacity = self.iso_opacity;
@@ -98,7 +107,15 @@ impl Controls {
             ..Optics::default()
         }
     }
+
+    /// The preset's name, `none` without one (as cases store it).
+    pub fn preset_name(&self) -> &'static str {
+        self.preset.map_or(NO_PRESET, |p| p.name)
+    }
 }
+
+/// The name cases and the panel give the absence of a preset.
+pub const NO_PRESET: &str = "none";
 
 /// A flight along the recorded key frames.
 #[derive(Debug, Clone)]
@@ -126,6 +143,8 @@ impl Playback {
 #[derive(Debug)]
 pub struct Session {
     scene: Arc<Scene>,
+    /// The scan understood for the preset: what the controls started from.
+    study: Study,
     navigation: Option<Navigation>,
     /// The lumen being found around a new eye position.
     finding: Option<Job<Option<Navigation>>>,
@@ -148,23 +167,25 @@ pub struct Session {
 }
 
 impl Session {
-    /// A session on `scene` with `preset`'s defaults, starting at `pose` or, without one,
-    /// inside the preset's largest lumen (else framing the volume); `on_frame` is called from
-    /// the render thread after each delivered frame.
+    /// A session on `scene` for `preset` (none: the whole object framed), as the study of the
+    /// scan resolves it ([`Study::resolve`], as every command does): its values in the scan's
+    /// units, starting at `pose` or, without one, inside the structure the preset means
+    /// looking along its path; `on_frame` is called from the render thread after each
+    /// delivered frame.
     pub fn new(
         scene: Arc<Scene>,
-        preset: &'static Preset,
+        preset: Option<&'static Preset>,
         pose: Option<Pose>,
         on_frame: impl Fn() + Send + Sync + 'static,
     ) -> Self {
-        let controls = Controls::of_preset(preset);
-        let pose = pose.unwrap_or_else(|| {
-            let choice = LumenChoice {
-                preset: Some(preset),
-                ..LumenChoice::default()
-            };
-            default_view(scene.volume(), Some(&choice), controls.fov_deg).pose()
-        });
+        let request = StudyRequest {
+            preset,
+            pose,
+            ..StudyRequest::default()
+        };
+        let study = Study::resolve(scene.volume(), &request);
+        let controls = Controls::of_study(&study);
+        let pose = study.start_pose();
         let camera = FlyCamera::from_pose(&pose)
             .or_else(|| FlyCamera::new(pose.eye_mm, DVec3::Z, DVec3::NEG_Y))
             .unwrap_or_else(|| {
@@ -173,6 +194,7 @@ impl Session {
         let worker = RenderWorker::start(Arc::clone(&scene.renderer), on_frame);
         let mut session = Self {
             scene,
+            study,
             navigation: None,
             finding: None,
             camera,
@@ -409,11 +431,27 @@ impl Session {
     }
 
     /// Applies `preset`'s clinical defaults (mode, wall, lens, window), keeping the pose.
-    pub fn apply_preset(&mut self, preset: &'static Preset) {
+    pub fn apply_preset(&mut self, preset: Option<&'static Preset>) {
         let kept = (self.controls.collision, self.controls.speed_mm_s);
-        self.controls = Controls::of_preset(preset);
+        self.study = self.study_here(preset);
+        self.controls = Controls::of_study(&self.study);
         (self.controls.collision, self.controls.speed_mm_s) = kept;
         self.find_lumen();
+    }
+
+    /// The study of the scan for `preset` from the camera where it is (no structure searched).
+    pub fn study_here(&self, preset: Option<&'static Preset>) -> Study {
+        let request = StudyRequest {
+            preset,
+            pose: Some(self.camera.pose()),
+            ..StudyRequest::default()
+        };
+        Study::resolve(self.scene.volume(), &request)
+    }
+
+    /// The scan understood for the preset (its values, structure and start).
+    pub fn study(&self) -> &Study {
+        &self.study
     }
 
     /// Finds the lumen around the eye for the preset's lumen threshold (the wall isovalue for a
@@ -463,15 +501,12 @@ impl Session {
         }
     }
 
-    /// The threshold and side the lumen is grown at: the preset's lumen threshold, else the
-    /// wall isovalue (lumen darker than the wall).
+    /// The threshold and side the lumen is grown at for the wall as set now, by the study's
+    /// rule ([`Study::lumen_at`]): the preset's lumen threshold moved with the wall but never
+    /// past halfway to the lumen's own value, else the wall isovalue (lumen darker than the
+    /// wall).
     pub fn lumen_threshold(&self) -> Option<(f64, LumenSide)> {
-        let choice = LumenChoice {
-            preset: Some(self.controls.preset).filter(|p| p.lumen.is_some()),
-            iso: Some(self.controls.iso_hu),
-            ..LumenChoice::default()
-        };
-        choice.resolve().ok()
+        self.study.lumen_at(self.controls.iso_hu).ok()
     }
 
     /// Records the current view as a key frame (after the last).

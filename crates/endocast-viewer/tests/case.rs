@@ -18,7 +18,7 @@ fn reopen(path: &std::path::Path) -> Session {
     let case = Case::read(path).unwrap();
     let volume = case.scan.load().unwrap();
     let scene = Arc::new(Scene::new(case.scan.clone(), volume));
-    let preset = Preset::find(&case.controls.as_ref().unwrap().preset).unwrap();
+    let preset = Preset::find(&case.controls.as_ref().unwrap().preset);
     let mut session = Session::new(scene, preset, None, || {});
     session.set_view_size([64, 64]);
     case.apply(&mut session, path).unwrap();
@@ -121,7 +121,7 @@ fn a_stroke_drawn_on_the_tissue_is_in_the_saved_case_and_only_fits_its_scan() {
         size: 36,
     };
     let scene = Arc::new(Scene::new(other.clone(), other.load().unwrap()));
-    let mut elsewhere = Session::new(scene, Preset::find("colonoscopy").unwrap(), None, || {});
+    let mut elsewhere = Session::new(scene, Preset::find("colonoscopy"), None, || {});
     let error = case.apply(&mut elsewhere, &path).unwrap_err().to_string();
     assert!(
         error.contains("drawn.endocast-case.json") && error.contains("dimensions"),
@@ -186,7 +186,7 @@ fn bad_case_files_are_refused_with_the_file_and_the_problem() {
         let path = dir.path().join(name);
         std::fs::write(&path, content).unwrap();
         let error = Case::read(&path)
-            .and_then(|case| SessionCase::controls(&case, &path).map(|_| ()))
+            .and_then(|case| SessionCase::controls(&case, &path, &session).map(|_| ()))
             .unwrap_err()
             .to_string();
         assert!(error.contains(name) && error.contains(expect), "{error}");

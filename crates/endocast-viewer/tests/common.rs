@@ -58,7 +58,7 @@ pub fn tube_session() -> (Session, TubeTruth) {
         size: SIZE,
     };
     let scene = Arc::new(Scene::new(source, volume));
-    let preset = Preset::find("colonoscopy").unwrap();
+    let preset = Preset::find("colonoscopy");
     let mut session = Session::new(scene, preset, Some(pose), || {});
     session.set_view_size([64, 64]);
     (session, truth)

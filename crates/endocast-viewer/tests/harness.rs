@@ -19,10 +19,11 @@ pub const SCREEN: Vec2 = Vec2::new(1100.0, 700.0);
 pub fn options(source: ScanSource) -> ViewerOptions {
     ViewerOptions {
         source,
-        preset: Preset::find("colonoscopy").unwrap(),
+        preset: Preset::find("colonoscopy"),
         pose: None,
         case: None,
         screenshot: None,
+        on_screenshot: None,
     }
 }
 

@@ -3,13 +3,14 @@
 //! pixel of a view of the case's scan.
 
 use crate::look::{in_pool, LookArgs};
+use crate::lumen::LumenArgs;
 use crate::optics::LensArgs;
 use crate::parse::{parse_size, parse_vec3};
 use crate::pose_args::PoseArgs;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use endocast_core::annotate::{Annotation, Annotations, ScanIdentity, Shape, SurfaceView};
-use endocast_core::camera::{default_up, Camera};
+use endocast_core::camera::Camera;
 use endocast_core::render::Renderer;
 use endocast_core::Volume;
 use endocast_io::case::{AnnotationRecord, Case, ScanSource};
@@ -217,21 +218,18 @@ fn annotation(add: &AddArgs, points: &[DVec3]) -> Result<Annotation> {
 
 /// The surface points seen at `pixels` of the view `view` describes.
 fn pick(pixels: &[[f64; 2]], view: &PickView, volume: &Volume) -> Result<Vec<DVec3>> {
-    let (Some(eye), Some(look_at)) = (view.pose.eye, view.pose.look_at) else {
+    let Some(pose) = view.pose.pose()? else {
         bail!("--pixel needs the view: --eye and --look-at");
     };
-    let (eye, look_at) = (DVec3::from(eye), DVec3::from(look_at));
-    let look = view.look.on_scan(volume)?;
-    let up = view
-        .pose
-        .up
-        .map_or_else(|| default_up(look_at - eye), DVec3::from);
+    let look = view
+        .look
+        .on_scan(volume, &LumenArgs::default(), Some(pose), view.fov)?;
     let (lo, hi) = volume.geometry().world_bounds();
     let optics = view
         .lens
-        .optics(look.preset.as_ref(), view.fov, 0.0, (hi - lo).length())?;
+        .optics(look.study.preset(), view.fov, 0.0, (hi - lo).length())?;
     let camera: Camera = optics
-        .camera(eye, look_at, up, view.size)
+        .camera(pose.eye_mm, pose.look_at_mm, pose.up, view.size)
         .context("invalid camera")?;
     let renderer = Arc::new(Renderer::new(volume.clone()));
     let prepared = renderer

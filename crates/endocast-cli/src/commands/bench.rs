@@ -4,10 +4,12 @@
 //! ramp and a complex transfer function, then depth peeling; with a scan and `--path` it measures
 //! one setting.
 
-use crate::look::{find_preset, in_pool, LookArgs};
+use crate::look::{find_preset, in_pool, LookArgs, ScanLook};
+use crate::lumen::LumenArgs;
 use crate::optics::{LensArgs, StereoArgs};
 use crate::parse::parse_size;
 use crate::scene_args::SceneArgs;
+use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::StereoRig;
@@ -19,6 +21,7 @@ use endocast_core::render::{
     Camera, Frame, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings, Renderer,
     StereoFrames,
 };
+use endocast_core::Volume;
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::OpenOptions;
 use serde_json::json;
@@ -312,6 +315,21 @@ fn parse_quality(name: &str) -> Result<Quality, String> {
         .ok_or_else(|| format!("{name:?}: expected full, half, quarter or eighth"))
 }
 
+/// The study of `volume` for the options, started at the first of `poses` (no structure is
+/// searched: the path is given), said on stderr.
+fn on_path(args: &BenchArgs, volume: &Volume, poses: &[Pose]) -> Result<ScanLook> {
+    let scan = args.look.on_scan(
+        volume,
+        &LumenArgs::default(),
+        poses.first().copied(),
+        args.fov,
+    )?;
+    if !args.json {
+        study_report::say(&scan.study);
+    }
+    Ok(scan)
+}
+
 /// The colon phantom, its fly path, and the paper's table cells.
 fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> {
     if !(32..=1024).contains(&args.phantom_size) {
@@ -333,7 +351,11 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
         10.0,
     )
     .with_context(|| format!("no fly path of {} frames fits the colon", args.frames))?;
-    let base = args.look.settings()?;
+    let ScanLook {
+        settings: base,
+        look,
+        ..
+    } = on_path(args, &volume, &poses)?;
     let with = |change: &dyn Fn(&mut RenderSettings)| {
         let mut s = base.clone();
         change(&mut s);
@@ -344,7 +366,7 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
         settings: with(&|s| s.mode = Mode::Iso),
         look: None,
     }];
-    if let Some(look) = args.look.look()? {
+    if let Some(look) = look {
         // The look against plain iso on the same path.
         cells.push(Cell {
             name: format!("{} look", args.look.look_name()),
@@ -404,8 +426,7 @@ fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, 
     let mut options = OpenOptions::default();
     options.orientation.clone_from(&args.orientation);
     let loaded = endocast_io::open(volume, &options).context("cannot read the scan")?;
-    let settings = args.look.settings()?;
-    let look = args.look.look()?;
+    let ScanLook { settings, look, .. } = on_path(args, &loaded.volume, &poses)?;
     let what = match look {
         Some(_) => format!("{} look", args.look.look_name()),
         None => settings.mode.name().to_owned(),

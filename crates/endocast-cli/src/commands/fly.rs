@@ -5,12 +5,13 @@
 use crate::case_args::CaseArgs;
 use crate::commands::fly_coverage;
 use crate::input::InputArgs;
-use crate::look::{set_threads, transfer_function, LookArgs};
+use crate::look::{set_threads, transfer_function, LookArgs, ScanLook};
 use crate::lumen::LumenArgs;
 use crate::optics::{beside, LensArgs, StereoArgs};
 use crate::parse::parse_size;
 use crate::progress::Progress;
 use crate::scene_args::SceneArgs;
+use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use endocast_core::coverage::Coverage;
@@ -18,14 +19,15 @@ use endocast_core::flight::{
     lumen_overview, wall_coverage_near, BackwardPass, Flight, FlightOptions, FlightStereo, Layout,
     Route, Shot, ShotSettings, WallSeen,
 };
-use endocast_core::navigate::{default_view, seed_voxel, DefaultView, Lumen};
-use endocast_core::presets::Preset;
+use endocast_core::navigate::{seed_voxel, Lumen};
 use endocast_core::render::{RenderSettings, Renderer};
-use endocast_core::tissue::{self, ScanValues};
+use endocast_core::study::Study;
 use endocast_core::views::slices::Window;
 use endocast_core::views::stereo::StereoOutput;
+use endocast_core::Volume;
 use endocast_io::route_file::read_route;
 use endocast_io::video::{open_sink, FrameSink, VideoOptions};
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -102,11 +104,7 @@ enum LayoutArg {
 
 /// Runs `endocast fly`.
 pub fn run(args: &FlyArgs) -> Result<()> {
-    let preset = args.look.preset()?;
     set_threads(args.look.threads)?;
-    let settings = args.look.settings()?;
-    let look = args.look.look()?;
-    let window = slice_window(args.window.as_deref(), preset)?;
     if !(args.frame_step.is_finite() && args.frame_step > 0.0) {
         bail!(
             "--frame-step must be a positive number of mm, not {}",
@@ -129,17 +127,25 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     let needs_lumen = args.coverage || args.layout == LayoutArg::Dashboard;
+    let first = shots.first().context("the route has no frames")?.pose;
+    // The structure is searched only when the lumen is needed; else the route's first camera
+    // is the start.
+    let pose = (!needs_lumen).then_some(first);
+    let ScanLook {
+        settings,
+        study,
+        look,
+    } = args
+        .look
+        .on_scan(&loaded.volume, &args.lumen, pose, args.fov_deg)?;
+    study_report::say(&study);
+    let window = slice_window(args.window.as_deref(), study.window())?;
     let lumen = if needs_lumen {
-        Some(lumen_at_start(
-            args,
-            preset,
-            &loaded.volume,
-            &settings,
-            &shots,
-        )?)
+        Some(lumen_at_start(&study, &loaded.volume, first.eye_mm)?)
     } else {
         None
     };
+    let preset = study.preset();
     let (lo, hi) = loaded.volume.geometry().world_bounds();
     let optics = args
         .lens
@@ -216,6 +222,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
             "frames": shots.len(),
             "length_mm": route.len_mm(),
             "frames_per_s": progress.rate(),
+            "first_camera": study_report::pose_json(&first),
             "coverage": coverage,
         });
         println!("{}", serde_json::to_string_pretty(&summary)?);
@@ -330,44 +337,27 @@ fn video_options(args: &FlyArgs) -> VideoOptions {
     options
 }
 
-/// The lumen around the route's first camera position: the structure the preset means (the
-/// aorta, not everything as bright as it) when the route starts in it, else the lumen grown
-/// from the start.
-fn lumen_at_start(
-    args: &FlyArgs,
-    preset: Option<&Preset>,
-    volume: &endocast_core::Volume,
-    settings: &RenderSettings,
-    shots: &[Shot],
-) -> Result<Lumen> {
-    let (threshold, side) = args.lumen.resolve(preset, Some(settings.iso_hu))?;
-    let start = shots
-        .first()
-        .context("the route has no frames")?
-        .pose
-        .eye_mm;
-    let seed = seed_voxel(volume, start).context("the route starts outside the volume")?;
-    if let Some(preset) = preset.filter(|p| p.lumen.is_some()) {
-        let mut choice = args.lumen.choice(Some(preset), Some(settings.iso_hu));
-        choice.within = tissue::central_structure(preset, volume, &ScanValues::measure(volume));
-        let view = default_view(volume, Some(&choice), preset.fov_deg);
-        if let DefaultView::InsideLumen { lumen, what, .. } = view {
-            if lumen.contains(seed) {
-                eprintln!("the path starts in the {what}: coverage is measured on its wall");
-                return Ok(*lumen);
-            }
+/// The lumen around the route's start `start_mm`: the structure the study found (the aorta,
+/// not everything as bright as it) when the route starts in it, else the lumen grown from the
+/// start with the study's threshold.
+fn lumen_at_start(study: &Study, volume: &Volume, start_mm: DVec3) -> Result<Lumen> {
+    let (threshold, side) = study.lumen()?;
+    let seed = seed_voxel(volume, start_mm).context("the route starts outside the volume")?;
+    if let Some(lumen) = study.structure().filter(|l| l.contains(seed)) {
+        if let Some(what) = study.structure_name() {
+            eprintln!("the path starts in the {what}: coverage is measured on its wall");
         }
+        return Ok(lumen.clone());
     }
     Lumen::from_seed(volume, seed, threshold, side)
         .with_context(|| format!("the route's start is not in a lumen {side} {threshold}"))
 }
 
-/// The dashboard's slice window: `--window` when given, else the preset's, else the window for
-/// air-filled lumens.
-fn slice_window(text: Option<&str>, preset: Option<&Preset>) -> Result<Window> {
+/// The dashboard's slice window: `--window` when given, else the study's (`default`).
+fn slice_window(text: Option<&str>, default: Window) -> Result<Window> {
     match text {
         Some(text) => parse_window(text),
-        None => Ok(preset.map_or(Window::AIR_TISSUE, |p| p.window)),
+        None => Ok(default),
     }
 }
 
@@ -388,14 +378,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_slice_window_is_the_options_else_the_presets() {
-        let bronchoscopy = Preset::find("bronchoscopy");
-        let lung = slice_window(None, bronchoscopy).unwrap();
-        assert_eq!((lung.level_hu, lung.width_hu), (-600.0, 1500.0));
-        let given = slice_window(Some("40, 400"), bronchoscopy).unwrap();
+    fn the_slice_window_is_the_options_else_the_studys() {
+        let lung = Window::new(-600.0, 1500.0).unwrap();
+        assert_eq!(slice_window(None, lung).unwrap(), lung);
+        let given = slice_window(Some("40, 400"), lung).unwrap();
         assert_eq!(given, Window::SOFT_TISSUE);
-        assert_eq!(slice_window(None, None).unwrap(), Window::AIR_TISSUE);
-        assert!(slice_window(Some("40"), None).is_err());
-        assert!(slice_window(Some("40,-1"), None).is_err());
+        assert!(slice_window(Some("40"), lung).is_err());
+        assert!(slice_window(Some("40,-1"), lung).is_err());
     }
 }

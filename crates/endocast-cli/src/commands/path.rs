@@ -6,12 +6,12 @@ use crate::look::find_preset;
 use crate::lumen::LumenArgs;
 use crate::parse::parse_vec3;
 use crate::structure;
-use anyhow::{bail, Context, Result};
+use crate::study_report;
+use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
-use endocast_core::navigate::{default_view, plan_in, plan_path, DefaultView, PathEnd};
+use endocast_core::navigate::LumenChoiceError;
 use endocast_core::path::SmoothOptions;
-use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
-use endocast_core::tissue::{self, ScanValues};
+use endocast_core::study::{Study, StudyPath, StudyPathError, StudyRequest};
 use endocast_core::Volume;
 use endocast_io::path_file::{write_path_json, PathDocument};
 use endocast_io::route_file::is_markups;
@@ -71,58 +71,31 @@ pub fn run(args: &PathArgs) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     let volume = &loaded.volume;
-    let scan = ScanValues::measure(volume);
-    let preset = match args.preset.as_deref().map(find_preset).transpose()? {
-        Some(preset) => {
-            let resolved = tissue::resolve(preset, volume, &scan);
-            eprintln!("{}", resolved.summary);
-            Some(resolved.preset)
-        }
-        None => None,
+    let request = StudyRequest {
+        preset: args.preset.as_deref().map(find_preset).transpose()?,
+        iso: args.iso,
+        lumen_threshold: args.lumen.lumen_threshold,
+        bright_lumen: args.lumen.bright_lumen,
+        ..StudyRequest::default()
     };
-    let (threshold, side) = args.lumen.resolve(preset.as_ref(), args.iso)?;
     let from = point(volume, args.from, args.from_voxel, "--from")?;
-    let view = match from {
-        Some(_) => None,
-        None => Some(default_start(
-            volume,
-            preset.as_ref(),
-            &scan,
-            &args.lumen,
-            args.iso,
-        )?),
-    };
-    if let Some(path) = &args.show_structure {
-        structure::write(path, volume, view.as_ref(), preset.as_ref())?;
-    }
     let to = point(volume, args.to, args.to_voxel, "--to")?;
+    let clock = Instant::now();
+    let study = Study::resolve(volume, &request);
+    study_report::say(&study);
+    if let Some(path) = &args.show_structure {
+        structure::write(path, volume, &study)?;
+    }
     let options = SmoothOptions {
         control_spacing_mm: args.smoothing,
         step_mm: 0.5,
         ..SmoothOptions::default()
     };
-    let clock = Instant::now();
-    let (lumen, field, planned) = match view {
-        Some(DefaultView::InsideLumen {
-            pose,
-            threshold,
-            lumen,
-            end_mm,
-            ..
-        }) => {
-            // In the structure found: the path may not leave it for the rest of the lumen.
-            let end = to.or(end_mm).map_or(PathEnd::Farthest, PathEnd::Point);
-            let (field, planned) = plan_in(volume, &lumen, pose.eye_mm, end, &options)
-                .with_context(|| format!("no path in the lumen {side} {threshold}"))?;
-            (*lumen, field, planned)
-        }
-        _ => {
-            let start = from.context("give the start with --from X,Y,Z (mm)")?;
-            let end = to.map_or(PathEnd::Farthest, PathEnd::Point);
-            plan_path(volume, threshold, side, start, end, &options)
-                .with_context(|| format!("no path in the lumen {side} {threshold}"))?
-        }
-    };
+    let StudyPath {
+        lumen_voxels,
+        field,
+        planned,
+    } = plan(volume, &study, from, to, &options)?;
     let seconds = clock.elapsed().as_secs_f64();
     let points = planned
         .path
@@ -135,9 +108,10 @@ pub fn run(args: &PathArgs) -> Result<()> {
         "length_mm": planned.path.len_mm(),
         "min_radius_mm": planned.min_radius_mm,
         "mean_radius_mm": planned.mean_radius_mm,
-        "lumen_voxels": lumen.voxel_count(),
+        "lumen_voxels": lumen_voxels,
         "max_radius_mm": field.max_mm(),
         "seconds": seconds,
+        "study": study_report::to_json(&study),
     });
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
@@ -155,42 +129,26 @@ pub fn run(args: &PathArgs) -> Result<()> {
     Ok(())
 }
 
-/// Without `--from`: the preset's default view inside its structure (see [`default_view`]),
-/// whose eye starts the path, said on stderr with what was found; an error naming the options
-/// without a preset or when no structure is found.
-fn default_start(
+/// The study's path ([`Study::plan`]), its errors in terms of the options.
+fn plan(
     volume: &Volume,
-    preset: Option<&Preset>,
-    scan: &ScanValues,
-    lumen: &LumenArgs,
-    iso: Option<f64>,
-) -> Result<DefaultView> {
-    let preset = preset.context(
-        "give the start with --from X,Y,Z (mm) or --from-voxel I,J,K, or a --preset to find it",
-    )?;
-    let mut choice = lumen.choice(Some(preset), iso);
-    choice.within = tissue::central_structure(preset, volume, scan);
-    let view = default_view(volume, Some(&choice), DEFAULT_FOV_DEG);
-    match &view {
-        DefaultView::InsideLumen {
-            pose,
-            threshold,
-            what,
-            ..
-        } => {
-            let p = pose.eye_mm;
-            eprintln!(
-                "found the {what}\nstart in the {} (lumen grown at {threshold:.1}): --from \
-                 {:.2},{:.2},{:.2}",
-                preset.name, p.x, p.y, p.z
-            );
-            Ok(view)
-        }
-        DefaultView::Framing { .. } => bail!(
-            "found no {} lumen in the scan; give the start with --from X,Y,Z (mm)",
-            preset.name
-        ),
-    }
+    study: &Study,
+    from: Option<DVec3>,
+    to: Option<DVec3>,
+    options: &SmoothOptions,
+) -> Result<StudyPath> {
+    study
+        .plan(volume, from, to, options)
+        .map_err(|error| match error {
+            StudyPathError::NoStart(why) => anyhow!(
+                "{why}: --from X,Y,Z (mm) or --from-voxel I,J,K, or a --preset whose structure \
+                 is found"
+            ),
+            StudyPathError::Lumen(LumenChoiceError::Underdetermined) => {
+                anyhow!("give --preset, --iso or --lumen-threshold")
+            }
+            error => error.into(),
+        })
 }
 
 /// A world point from `--NAME X,Y,Z` or `--NAME-voxel I,J,K`, or `None` when neither is given.

@@ -9,16 +9,16 @@ use crate::parse::{parse_pixel, parse_size};
 use crate::pose_args::PoseArgs;
 use crate::scene_args::SceneArgs;
 use crate::structure;
+use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::camera::default_up;
 use endocast_core::look::{self, RayPass};
-use endocast_core::navigate::{default_view, DefaultView, FramingReason};
-use endocast_core::presets::{Preset, DEFAULT_FOV_DEG};
+use endocast_core::presets::Preset;
 use endocast_core::render::{
     Camera, Frame, Prepared, RenderOptions, RenderSettings, Renderer, Still,
 };
-use endocast_core::tissue::{self, ScanValues};
+use endocast_core::study::Study;
+use endocast_core::tissue::short;
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
 use endocast_core::Volume;
@@ -88,18 +88,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
-    let look = args.look.on_scan(&loaded.volume)?;
-    eprintln!("{}", look.summary);
+    let look = args
+        .look
+        .on_scan(&loaded.volume, &args.lumen, args.pose.pose()?, args.fov)?;
+    study_report::say(&look.study);
     if !(1..=MAX_STILL_FRAMES).contains(&args.still) {
         bail!(
             "--still must be between 1 and {MAX_STILL_FRAMES} frames, not {}",
             args.still
         );
     }
-    let (settings, preset) = (look.settings, look.preset.as_ref());
-    let (camera, view) = camera(args, preset, &loaded.volume, &settings)?;
+    let settings = &look.settings;
+    let preset = look.study.preset();
+    let camera = camera(args, preset, &loaded.volume, &look.study)?;
     if let Some(path) = &args.show_structure {
-        structure::write(path, &loaded.volume, view.as_ref(), preset)?;
+        structure::write(path, &loaded.volume, &look.study)?;
     }
     let marks = args.case.annotations(&loaded.volume)?;
     if marks.is_some() && args.stereo.stereo.is_some() {
@@ -107,7 +110,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let renderer = Arc::new(Renderer::new(loaded.volume));
     let mut prepared = renderer
-        .prepare(&settings)
+        .prepare(settings)
         .context("invalid render settings")?;
     let scene = args.scene.scene()?;
     if look.look.is_some() && (scene.is_some() || args.stereo.stereo.is_some()) {
@@ -135,8 +138,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         None => {
             let frame = match &look.look {
                 Some(l) => {
-                    let pass =
-                        RayPass::new(&renderer, &settings, &l.ray).context("invalid look")?;
+                    let pass = RayPass::new(&renderer, settings, &l.ray).context("invalid look")?;
                     in_pool(args.look.threads, || {
                         look::still(&pass, &camera, &l.shading, args.still)
                     })?
@@ -155,7 +157,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             frame
         }
     };
-    warn_if_empty(&frame, &settings, &look.scan);
+    warn_if_empty(&frame, settings, &look.study, renderer.volume().dims());
     let [w, h] = [frame.width as u32, frame.height as u32];
     if let Some(depth) = &args.depth_out {
         endocast_io::image_out::write_npy_f32(depth, w, h, &frame.depth_mm)
@@ -164,7 +166,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&stats_json(&frame, &settings, &camera))?
+            serde_json::to_string_pretty(&stats_json(&frame, settings, &camera, &look.study))?
         );
     } else {
         println!(
@@ -192,40 +194,21 @@ fn still(prepared: &Prepared, camera: &Camera, frames: usize) -> Result<Frame> {
     Ok(still.frame().clone())
 }
 
-/// The camera the options describe; without one, for an endoscopic preset, a view from inside
-/// the structure it means along its axis, else one framing the whole volume from the front
-/// (with the default view it came from).
+/// The camera of the study's start (the user's pose, or inside the structure the preset
+/// means looking along its path, or the whole object framed), with `--up` and the lens options.
 fn camera(
     args: &RenderArgs,
     preset: Option<&Preset>,
     volume: &Volume,
-    settings: &RenderSettings,
-) -> Result<(Camera, Option<DefaultView>)> {
-    let fov_deg = args
-        .fov
-        .unwrap_or_else(|| preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg));
-    let (eye, look_at, up, view) = match (args.pose.eye, args.pose.look_at) {
-        (Some(eye), Some(look_at)) => (DVec3::from(eye), DVec3::from(look_at), None, None),
-        (None, None) => {
-            let view = default_pose(args, preset, volume, settings, fov_deg);
-            let pose = view.pose();
-            (pose.eye_mm, pose.look_at_mm, Some(pose.up), Some(view))
-        }
-        _ => bail!("--eye and --look-at go together"),
-    };
-    let up = args
-        .pose
-        .up
-        .map(DVec3::from)
-        .or(up)
-        .unwrap_or_else(|| default_up(look_at - eye));
+    study: &Study,
+) -> Result<Camera> {
+    let pose = args.pose.with_up(study.start_pose());
     let (lo, hi) = volume.geometry().world_bounds();
     let height_mm = (hi - lo).length();
     let optics = args.lens.optics(preset, args.fov, args.near, height_mm)?;
-    let camera = optics
-        .camera(eye, look_at, up, args.size)
-        .context("invalid camera")?;
-    Ok((camera, view))
+    optics
+        .camera(pose.eye_mm, pose.look_at_mm, pose.up, args.size)
+        .context("invalid camera")
 }
 
 /// Writes a stereo pair as `output` asks: one combined image at `path`, or for a pair
@@ -250,69 +233,40 @@ fn write_stereo(
     write(path, &stereo::combine(&left, &right, output)?)
 }
 
-/// The library's default view (see [`default_view`]) for `--preset` and the lumen options,
-/// saying on stderr what it found, where it put the camera and why it fell back to framing the
-/// volume.
-fn default_pose(
-    args: &RenderArgs,
-    preset: Option<&Preset>,
-    volume: &Volume,
-    settings: &RenderSettings,
-    fov_deg: f64,
-) -> DefaultView {
-    let mut choice = preset.map(|p| args.lumen.choice(Some(p), Some(settings.iso_hu)));
-    if let Some(choice) = choice.as_mut() {
-        choice.within =
-            preset.and_then(|p| tissue::central_structure(p, volume, &ScanValues::measure(volume)));
-    }
-    let clock = std::time::Instant::now();
-    let view = default_view(volume, choice.as_ref(), fov_deg);
-    let found_ms = clock.elapsed().as_secs_f64() * 1e3;
-    match &view {
-        DefaultView::InsideLumen {
-            pose,
-            threshold,
-            side,
-            what,
-            ..
-        } => eprintln!(
-            "found the {what}\ncamera inside the lumen {side} {threshold:.1} (found in \
-             {found_ms:.0} ms): --eye {} --look-at {} --up {}",
-            triple(pose.eye_mm),
-            triple(pose.look_at_mm),
-            triple(pose.up)
-        ),
-        DefaultView::Framing { reason, .. } => match reason {
-            FramingReason::Choice(error) => {
-                eprintln!("warning: {error}; framing the whole volume instead");
-            }
-            FramingReason::NoLumen { threshold, side } => {
-                eprintln!("warning: no lumen {side} {threshold}; framing the whole volume instead");
-            }
-            _ => {}
-        },
-    }
-    view
-}
-
 /// Warns, saying why and what to try, when nothing in the image was hit or drawn.
-fn warn_if_empty(frame: &Frame, settings: &RenderSettings, scan: &ScanValues) {
+fn warn_if_empty(frame: &Frame, settings: &RenderSettings, study: &Study, dims: [usize; 3]) {
     let drawn = frame.color.iter().any(|p| p.transmittance < 0.99);
     if frame.stats.iso_hits > 0 || drawn {
         return;
     }
+    let scan = study.scan();
     let (lo, hi) = scan.range;
-    eprintln!(
-        "warning: the image is empty: no ray met the wall at {:.1} or anything the transfer \
-         function shows (values {lo:.1} to {hi:.1}, {scan}); try --iso {:.1} (background/object \
-         boundary) without --eye, or another --preset",
-        settings.iso_hu, scan.object_threshold
+    let what = format!(
+        "no ray met the wall at {} or anything the transfer function shows (values {} to {}, \
+         {scan})",
+        short(settings.iso_hu),
+        short(lo),
+        short(hi)
     );
-}
-
-/// `x,y,z` with two decimals, as `--eye` takes it.
-fn triple(v: DVec3) -> String {
-    format!("{:.2},{:.2},{:.2}", v.x, v.y, v.z)
+    let advice = if dims.contains(&1) {
+        format!(
+            "the scan is a single slice ({}×{}×{} voxels), not a volume to see into: open the \
+             whole series (its folder) instead",
+            dims[0], dims[1], dims[2]
+        )
+    } else if (settings.iso_hu - scan.object_threshold).abs() > 0.5 {
+        format!(
+            "try --iso {} (the background/object boundary), or another --preset",
+            short(scan.object_threshold)
+        )
+    } else if study.request().pose.is_some() {
+        "the camera placed with --eye sees nothing: leave out --eye and --look-at to frame the \
+         object"
+            .to_owned()
+    } else {
+        "try --mode mip to see the brightest values along each ray".to_owned()
+    };
+    eprintln!("warning: the image is empty: {what}; {advice}");
 }
 
 fn print_trace(prepared: &Prepared, camera: &Camera, x: usize, y: usize) -> Result<()> {
@@ -341,7 +295,12 @@ fn print_trace(prepared: &Prepared, camera: &Camera, x: usize, y: usize) -> Resu
 
 /// The frame's statistics and the camera that took it (world mm, LPS; `field`: degrees across
 /// the image height, or mm of view height for an orthographic lens).
-fn stats_json(frame: &Frame, settings: &RenderSettings, camera: &Camera) -> serde_json::Value {
+fn stats_json(
+    frame: &Frame,
+    settings: &RenderSettings,
+    camera: &Camera,
+    study: &Study,
+) -> serde_json::Value {
     let s = &frame.stats;
     let v = |v: DVec3| [v.x, v.y, v.z];
     json!({
@@ -365,5 +324,6 @@ fn stats_json(frame: &Frame, settings: &RenderSettings, camera: &Camera) -> serd
         "bricks_skipped": s.bricks_skipped,
         "rays_terminated_early": s.terminated_early,
         "iso_hits": s.iso_hits,
+        "study": study_report::to_json(study),
     })
 }

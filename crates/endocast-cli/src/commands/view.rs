@@ -2,13 +2,14 @@
 
 use crate::look::find_preset;
 use crate::pose_args::PoseArgs;
+use crate::study_report;
 use anyhow::{bail, Result};
 use clap::Args;
-use endocast_core::pose::Pose;
-use endocast_viewer::app::{run as run_viewer, ViewerOptions};
+use endocast_viewer::app::{run as run_viewer, ScreenshotHook, ViewerOptions};
 use endocast_viewer::scene::ScanSource;
-use glam::DVec3;
+use endocast_viewer::session::Session;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Arguments of `endocast view`.
 #[derive(Args, Debug)]
@@ -24,9 +25,10 @@ pub struct ViewArgs {
     /// The phantom's largest dimension, voxels.
     #[arg(long, default_value_t = 256)]
     size: usize,
-    /// Clinical defaults: colonoscopy, bronchoscopy, angioscopy, sinus, ventricles.
-    #[arg(long, default_value = "colonoscopy")]
-    preset: String,
+    /// Clinical defaults: colonoscopy, bronchoscopy, angioscopy, sinus, ventricles,
+    /// arthroscopy (default: none, the whole object framed, as `render` does).
+    #[arg(long)]
+    preset: Option<String>,
     /// Reopen a case file (its scan, view, key frames and marks); it is autosaved there.
     #[arg(long, value_name = "FILE.json")]
     case: Option<PathBuf>,
@@ -35,11 +37,15 @@ pub struct ViewArgs {
     /// Write a screenshot of the window (PNG) once the view has refined, then quit.
     #[arg(long, value_name = "FILE.png")]
     screenshot: Option<PathBuf>,
+    /// With --screenshot: print what the session resolved (values, structure, start) and its
+    /// camera as JSON, as `render --json` does.
+    #[arg(long, requires = "screenshot")]
+    json: bool,
 }
 
 /// Runs `endocast view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
-    let preset = find_preset(&args.preset)?;
+    let preset = args.preset.as_deref().map(find_preset).transpose()?;
     let source = match (&args.scan, &args.phantom, &args.case) {
         (Some(path), _, _) => ScanSource::File {
             path: path.clone(),
@@ -57,21 +63,29 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         },
         (None, None, None) => bail!("give a scan, --phantom NAME or --case FILE"),
     };
-    let pose = match (args.pose.eye, args.pose.look_at) {
-        (Some(eye), Some(at)) => Some(Pose {
-            eye_mm: DVec3::from_array(eye),
-            look_at_mm: DVec3::from_array(at),
-            up: DVec3::from_array(args.pose.up.unwrap_or([0.0, 0.0, 1.0])),
-        }),
-        (None, None) => None,
-        _ => bail!("--eye and --look-at go together"),
-    };
+    let on_screenshot = args
+        .json
+        .then(|| ScreenshotHook(Arc::new(|session: &Session| print_session(session))));
     run_viewer(ViewerOptions {
         source,
         preset,
-        pose,
+        pose: args.pose.pose()?,
         case: args.case.clone(),
         screenshot: args.screenshot.clone(),
+        on_screenshot,
     })
     .map_err(anyhow::Error::msg)
+}
+
+/// Prints what `session` resolved and its camera, as JSON on stdout.
+fn print_session(session: &Session) {
+    let camera = session.fly_camera().pose();
+    let report = serde_json::json!({
+        "camera": study_report::pose_json(&camera),
+        "study": study_report::to_json(session.study()),
+    });
+    match serde_json::to_string_pretty(&report) {
+        Ok(text) => println!("{text}"),
+        Err(e) => eprintln!("error: {e}"),
+    }
 }

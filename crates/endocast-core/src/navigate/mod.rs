@@ -49,4 +49,5 @@ pub use nasal::{find_nasal_cavity, NasalCavity, FRONT_SHARE, PASSAGE_HALF_WIDTH_
 pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
 pub use trachea::find_trachea;
+pub(crate) use viewpoint::looking_along;
 pub use viewpoint::{default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason};

@@ -2,6 +2,7 @@
 //! and there CSF is the smaller of the two classes Otsu's threshold splits the box into, dark on
 //! T1 and FLAIR, bright on T2.
 
+use super::extent::object_extent;
 use super::histogram::Histogram;
 use super::ScanValues;
 use crate::navigate::Central;
@@ -94,43 +95,14 @@ pub fn central_structure(preset: &Preset, volume: &Volume, scan: &ScanValues) ->
 /// threshold), [`BOX_HALF`] of its extent each way; `None` for a volume without object.
 pub fn central_box(volume: &Volume, scan: &ScanValues) -> Option<([usize; 3], [usize; 3])> {
     let dims = volume.dims();
-    let map = volume.value_map();
-    let object: Vec<bool> = (0..=u16::MAX)
-        .map(|s| map.physical(s) > scan.object_threshold)
-        .collect();
-    let mut marginals = dims.map(|n| vec![0u64; n]);
-    for (n, &s) in volume.voxels().iter().enumerate() {
-        if object[usize::from(s)] {
-            let v = [n % dims[0], n / dims[0] % dims[1], n / (dims[0] * dims[1])];
-            for a in 0..3 {
-                marginals[a][v[a]] += 1;
-            }
-        }
-    }
+    let (p5, p95) = object_extent(volume, scan, 0.05)?;
     let mut lo = [0; 3];
     let mut hi = [0; 3];
     for a in 0..3 {
-        let (p5, p95) = (
-            percentile(&marginals[a], 0.05)?,
-            percentile(&marginals[a], 0.95)?,
-        );
-        let centre = 0.5 * (p5 + p95) as f64;
-        let half = (BOX_HALF * (p95 - p5) as f64).max(2.0);
+        let centre = 0.5 * (p5[a] + p95[a]) as f64;
+        let half = (BOX_HALF * (p95[a] - p5[a]) as f64).max(2.0);
         lo[a] = (centre - half).max(0.0).round() as usize;
         hi[a] = ((centre + half).round() as usize).min(dims[a] - 1);
     }
     Some((lo, hi))
-}
-
-/// The index below which a fraction `q` of the counts lie.
-fn percentile(counts: &[u64], q: f64) -> Option<usize> {
-    let total: u64 = counts.iter().sum();
-    if total == 0 {
-        return None;
-    }
-    let mut seen = 0;
-    counts.iter().position(|&c| {
-        seen += c;
-        seen as f64 >= q * total as f64
-    })
 }

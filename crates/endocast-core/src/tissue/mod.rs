@@ -17,10 +17,12 @@
 //! ```
 
 mod brain;
+mod extent;
 mod histogram;
 mod resolve;
 
 pub use brain::{central_box, central_structure, measure_csf, CsfContrast};
+pub use extent::{object_extent, object_points, object_world_extent};
 pub use resolve::{default_look, default_settings, resolve, Resolved};
 
 use crate::{Modality, Volume};
@@ -184,7 +186,7 @@ impl fmt::Display for ScanValues {
 }
 
 /// A value with as few decimals as it needs (at most one).
-pub(crate) fn short(v: f64) -> String {
+pub fn short(v: f64) -> String {
     if (v - v.round()).abs() < 0.05 {
         format!("{}", v.round())
     } else {

@@ -10,7 +10,7 @@ import numpy.typing as npt
 _Vec3 = Tuple[float, float, float]
 _Point = Union[_Vec3, Sequence[float], npt.NDArray[np.floating]]
 _Path = Union[str, "os.PathLike[str]"]
-_Mode = Literal["iso", "dvr", "hybrid", "two-iso", "mip", "minip"]
+_Mode = Literal["iso", "dvr", "hybrid", "two-iso", "mip", "minip", "peel"]
 _Lens = Literal["pinhole", "equidistant", "equisolid", "orthographic"]
 _Stereo = Literal["anaglyph", "red-cyan", "dubois", "side-by-side", "top-bottom", "pair"]
 
@@ -118,8 +118,12 @@ def default_view(
     fov: Optional[float] = None,
     lumen_threshold: Optional[float] = None,
     bright_lumen: bool = False,
+    **look: object,
 ) -> Tuple[_Vec3, _Vec3, _Vec3]:
-    """The camera ``render`` uses without ``eye``: (eye, look_at, up), LPS mm."""
+    """The camera ``render`` uses without ``eye``, the same as ``endocast render``'s:
+    (eye, look_at, up), LPS mm. With an endoscopic ``preset`` (carried into the scan's units:
+    HU, HU + 1024, MR) inside the structure it names, looking along the automatic path;
+    without one, the whole object framed from the front. Takes ``render``'s look options."""
 
 def path(
     volume: Volume,
@@ -138,7 +142,9 @@ def path(
     """The centred path through the lumen as ``endocast path`` writes it: (points, radii).
 
     points is (N, 3) LPS mm, every ``step`` mm and the end; radii (N,) the distance to the
-    wall, mm. Without ``end`` the path runs to the farthest point of the lumen."""
+    wall, mm. Without ``start`` the ``preset``'s structure is found and the path starts where
+    ``default_view`` puts the camera; without ``end`` it runs to the structure's known end
+    (the aorta's lowest section), else to the farthest point of the lumen."""
 
 @overload
 def fly(
