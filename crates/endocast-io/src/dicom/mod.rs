@@ -48,9 +48,11 @@
 mod jpegls;
 mod lengths;
 mod pixels;
+mod rle;
 mod scan;
 mod series;
 mod stack;
+mod stream_size;
 mod values;
 
 use crate::error::{ReadError, Result};
@@ -86,6 +88,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let modality = Modality::from_code(&first.modality);
     let invert = monochrome1_inversion(first, &modality, &mut warnings);
     let map = SampleMap::new(&first.path, &first.layout, first.padding, invert)?;
+    pixels::check_high_bit(first, &mut warnings)?;
 
     let dims = [
         usize::from(first.layout.columns),
@@ -173,7 +176,7 @@ fn decode_all(
                 .into_iter()
                 .map(|(k, frame, slot)| (k, (frame, slot)))
                 .unzip();
-            let stats = pixels::decode_file(&files[file].path, ts_names[file], slots, map)?;
+            let stats = pixels::decode_file(&files[file], ts_names[file], slots, map)?;
             progress.advance();
             Ok(ks.into_iter().zip(stats).collect::<Vec<_>>())
         })
