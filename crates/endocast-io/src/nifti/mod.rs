@@ -67,13 +67,16 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let (dims, volumes) = header.volume_dims(path, &mut warnings)?;
     let count = options.limits.check_dims(path, &dims)?;
     let vox_offset = header.data_offset(path)?;
-    if !gzip {
-        check_file_holds(
+    let data_bytes = count as u64 * element.size() as u64;
+    if gzip {
+        compressed::check_inflates_to(
             path,
+            "gzip",
             file_len,
-            vox_offset,
-            count as u64 * element.size() as u64,
+            vox_offset.saturating_add(data_bytes),
         )?;
+    } else {
+        check_file_holds(path, file_len, vox_offset, data_bytes)?;
     }
     skip_to_voxels(
         path,
