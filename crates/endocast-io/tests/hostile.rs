@@ -172,10 +172,15 @@ impl Image {
         self.set((0x7FE0, 0x10), encoded)
     }
 
+    /// The elements after the meta group.
+    fn data_set(&self) -> Vec<u8> {
+        self.0.values().flatten().copied().collect()
+    }
+
     /// The file, in `transfer_syntax` (whose pixel data the test has set).
     fn bytes(&self, transfer_syntax: &str) -> Vec<u8> {
         let mut out = meta(transfer_syntax);
-        self.0.values().for_each(|e| out.extend_from_slice(e));
+        out.extend(self.data_set());
         out
     }
 }
@@ -398,6 +403,26 @@ fn an_image_position_stored_as_un_is_read_from_its_text() {
     let loaded = read_dicom(&path).unwrap();
     let origin = loaded.volume.geometry().origin_mm();
     assert_eq!(origin.to_array(), [10.0, -20.5, 30.0]);
+}
+
+#[test]
+fn a_deflated_file_padded_after_its_stream_is_read() {
+    let image = Image::ct(2, 2);
+    let mut deflate = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::fast());
+    std::io::Write::write_all(&mut deflate, &image.data_set()).unwrap();
+    let mut bytes = meta("1.2.840.10008.1.2.1.99");
+    bytes.extend(deflate.finish().unwrap());
+    bytes.extend_from_slice(&[0; 8]);
+    let (_dir, path) = file_with("padded.dcm", &bytes);
+    let loaded = read_dicom(&path).unwrap();
+    assert_eq!(loaded.volume.dims(), [2, 2, 1]);
+    bytes.extend_from_slice(&[0; 2]);
+    let (_dir, path) = file_with("junk.dcm", &bytes);
+    refused(
+        read_dicom(&path),
+        &path,
+        &["10 bytes follow the end of the stream"],
+    );
 }
 
 // ---------------------------------------------------------------------------------------------

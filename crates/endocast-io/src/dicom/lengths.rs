@@ -10,9 +10,9 @@
 //! (0002,0000) says, not at the first element of another group.
 //!
 //! A deflated data set (transfer syntax 1.2.840.10008.1.2.1.99) is inflated here first: its
-//! deflate stream must reach its final block exactly at the end of the file (raw deflate has no
-//! checksum, so its end and length are what can be checked), and the inflated elements are then
-//! walked like those of any other file.
+//! deflate stream must reach its final block at the end of the file, give or take a few bytes
+//! of padding (raw deflate has no checksum, so its end and length are what can be checked), and
+//! the inflated elements are then walked like those of any other file.
 
 use crate::compressed;
 use crate::error::{ReadError, Result};
@@ -97,8 +97,12 @@ pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()
     }
 }
 
+/// Bytes that may follow a complete deflate stream: some writers pad it to an even length or
+/// append a checksum (dicom-rs ignores them). More is a second stream or junk: corruption.
+const MAX_TRAILING: u64 = 8;
+
 /// Inflates the data set that starts at byte `start` of `file`, requires its stream to end with
-/// the file, and walks the inflated elements.
+/// the file (but for [`MAX_TRAILING`] bytes), and walks the inflated elements.
 fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) -> Result<()> {
     file.seek(SeekFrom::Start(start))
         .map_err(|e| ReadError::io(path, e))?;
@@ -118,7 +122,7 @@ fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) ->
     }
     let trailing =
         io::copy(decoder.get_mut(), &mut io::sink()).map_err(|e| ReadError::io(path, e))?;
-    if trailing > 0 {
+    if trailing > MAX_TRAILING {
         return Err(ReadError::format(
             path,
             format!("the deflate data are corrupt: {trailing} bytes follow the end of the stream"),
