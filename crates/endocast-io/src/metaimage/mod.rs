@@ -1,5 +1,6 @@
 //! MetaImage (ITK's MetaIO format): `.mha` with the voxels after the header
-//! (`ElementDataFile = LOCAL`), or a `.mhd` header beside a `.raw` / `.zraw` data file.
+//! (`ElementDataFile = LOCAL`), or a `.mhd` header beside a `.raw` / `.zraw` data file (a regular
+//! file in the header's folder or below it).
 //!
 //! World coordinates are LPS, as in ITK, so the geometry needs no conversion: `Offset` is the
 //! origin, `ElementSpacing` the spacing and `TransformMatrix` the direction (see

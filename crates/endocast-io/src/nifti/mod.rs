@@ -1,4 +1,5 @@
-//! NIfTI-1 and NIfTI-2 single-file images (`.nii`, `.nii.gz`): reader and NIfTI-1 writer.
+//! NIfTI-1 and NIfTI-2 images: single files (`.nii`, `.nii.gz`) and header/image pairs
+//! (`.hdr` + `.img`, read only): reader and NIfTI-1 writer.
 //!
 //! Reading streams the file (through a gzip decoder when it starts with the gzip magic, whatever
 //! its name) and keeps no more than the header and the first 3-D volume's voxels; a gzip stream
