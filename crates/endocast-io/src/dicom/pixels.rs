@@ -304,7 +304,8 @@ pub(super) fn decode_file(
                 .map(|(frame, out)| native_frame(path, value, frame, out, map))
                 .collect()
         }
-        DicomValue::PixelSequence(_) => {
+        DicomValue::PixelSequence(sequence) => {
+            check_fragment_count(file, sequence.fragments().len())?;
             let uid = object.meta().transfer_syntax();
             let decode = if jpegls::is_jpeg_ls(uid) {
                 jpeg_ls_frame
@@ -360,6 +361,24 @@ fn check_native_length(file: &ImageFile, value: &PrimitiveValue, map: &SampleMap
              not describe these pixels (a truncated file, or a wrong Rows, Columns, \
              NumberOfFrames or BitsAllocated)",
             map.bytes_per_sample
+        ),
+    ))
+}
+
+/// Compressed pixel data hold at least one fragment a frame: fewer means frames are missing
+/// (which would go unnoticed when the frames share one position and all but one are dropped as
+/// duplicates).
+fn check_fragment_count(file: &ImageFile, fragments: usize) -> Result<()> {
+    let frames = file.frames.len();
+    if fragments >= frames {
+        return Ok(());
+    }
+    Err(ReadError::inconsistent(
+        &file.path,
+        format!(
+            "NumberOfFrames (0028,0008) declares {frames} frames, but the compressed pixel data \
+             hold {fragments} fragment(s): frames are missing (a truncated file, or a wrong \
+             NumberOfFrames)"
         ),
     ))
 }
