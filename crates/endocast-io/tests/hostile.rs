@@ -465,6 +465,7 @@ fn unlimited() -> OpenOptions {
 }
 
 #[test]
+#[cfg(unix)]
 fn a_data_file_that_never_ends_is_refused_at_once() {
     let header = nrrd_header("2 2 2", "raw", Some("/dev/zero"));
     let (_dir, path) = file_with("zero.nhdr", header.as_bytes());
@@ -595,6 +596,24 @@ fn coordinates_beyond_a_kilometre_are_refused_naming_the_point() {
     let error = route_file::read_camera_path(&path).unwrap_err().to_string();
     assert!(
         error.contains("camera 0") && error.contains("eye"),
+        "{error}"
+    );
+}
+
+#[test]
+#[cfg(unix)]
+fn a_mesh_that_is_a_device_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("zero.stl");
+    std::os::unix::fs::symlink("/dev/zero", &path).unwrap();
+    let error = within(Duration::from_secs(5), {
+        let path = path.clone();
+        move || mesh::read_mesh(&path).map(|_| ())
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(
+        error.contains("zero.stl") && error.contains("not a regular file"),
         "{error}"
     );
 }
