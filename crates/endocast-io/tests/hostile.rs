@@ -264,7 +264,7 @@ fn rle_frames_are_checked_against_their_header_and_the_image_size() {
     // 2 × 2 samples of 16 bits: high bytes 0, low bytes 1, 2, 3, 4 (literal runs).
     let valid = rle_fragment(&[vec![253, 0], vec![3, 1, 2, 3, 4]]);
     let mut image = Image::ct(2, 2);
-    image.fragments(&[valid.clone()]);
+    image.fragments(std::slice::from_ref(&valid));
     let (_dir, path) = file_with("rle.dcm", &image.bytes(RLE));
     let loaded = read_dicom(&path).unwrap();
     assert_eq!(loaded.volume.physical(1, 1, 0), Some(4.0 - 1024.0));
@@ -282,7 +282,7 @@ fn rle_frames_are_checked_against_their_header_and_the_image_size() {
     // Three frames declared (sharing the top-level position), one stored.
     image
         .text((0x28, 8), b"IS", "3")
-        .fragments(&[valid.clone()]);
+        .fragments(std::slice::from_ref(&valid));
     let (_dir, path) = file_with("missing-rle-frames.dcm", &image.bytes(RLE));
     refused(
         read_dicom(&path),
