@@ -41,6 +41,26 @@ pub(crate) fn finish(
     Ok(())
 }
 
+/// The most one stored byte of a deflate stream (gzip, zlib, raw deflate) inflates to: 1032,
+/// the format's best case (a long run of one byte).
+const MAX_INFLATION: u64 = 1032;
+
+/// Refuses `stored` bytes of `kind` data (`gzip`, `zlib`) that could not inflate to the `needed`
+/// bytes a header describes, before anything that size is allocated.
+pub(crate) fn check_inflates_to(path: &Path, kind: &str, stored: u64, needed: u64) -> Result<()> {
+    let most = stored.saturating_mul(MAX_INFLATION);
+    if needed > most {
+        return Err(ReadError::format(
+            path,
+            format!(
+                "the header describes {needed} bytes of samples, but the {stored} bytes of \
+                 {kind} data inflate to at most {most}: the sizes or the file are wrong"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// A decompressor's error: an operating-system failure stays an I/O error, anything else
 /// (bad checksum, invalid code, a stream cut short) is a fault of the file.
 pub(crate) fn corrupt(path: &Path, kind: &str, e: io::Error) -> ReadError {

@@ -20,6 +20,7 @@
 pub mod atomic;
 pub mod case;
 mod compressed;
+mod detached;
 pub mod dicom;
 mod encode;
 pub mod error;

@@ -192,16 +192,31 @@ fn control_point(point: &Value) -> std::result::Result<Option<(DVec3, String)>, 
     Ok(Some((position, label)))
 }
 
-/// `[x, y, z]`, three numbers, or what was found instead. The JSON parser has already refused
-/// NaN, infinities and numbers beyond an f64, so every number here is finite.
+/// Largest coordinate (mm, either sign) a point may have. No patient is a kilometre wide, and
+/// numbers near f64's limits overflow the path arithmetic (lengths become infinite or NaN).
+pub(crate) const MAX_COORDINATE_MM: f64 = 1e6;
+
+/// `[x, y, z]`, three numbers within [`MAX_COORDINATE_MM`], or what was found instead. The JSON
+/// parser has already refused NaN, infinities and numbers beyond an f64.
 pub(crate) fn vec3(value: &Value) -> std::result::Result<DVec3, String> {
     let numbers: Option<Vec<f64>> = match value {
         Value::Array(items) if items.len() == 3 => items.iter().map(Value::as_f64).collect(),
         _ => None,
     };
-    numbers
-        .map(|n| DVec3::new(n[0], n[1], n[2]))
-        .ok_or_else(|| format!("expected [x, y, z] numbers, found {}", short(value)))
+    let numbers =
+        numbers.ok_or_else(|| format!("expected [x, y, z] numbers, found {}", short(value)))?;
+    within_range(&numbers)?;
+    Ok(DVec3::new(numbers[0], numbers[1], numbers[2]))
+}
+
+/// Refuses a coordinate beyond ±[`MAX_COORDINATE_MM`].
+pub(crate) fn within_range(numbers: &[f64]) -> std::result::Result<(), String> {
+    match numbers.iter().find(|x| x.abs() > MAX_COORDINATE_MM) {
+        Some(x) => Err(format!(
+            "coordinate {x:e} is beyond ±{MAX_COORDINATE_MM:e} mm (a corrupt or mistyped number)"
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The string under `key`, `None` when absent, an error when not a string.

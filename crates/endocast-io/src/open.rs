@@ -103,7 +103,9 @@ fn sniff(path: &Path) -> Result<Format> {
     } else if head.starts_with(b"NRRD000") {
         Ok(Format::Nrrd)
     } else if head.starts_with(&[0x1f, 0x8b])
-        || (head.len() >= 348 && (&head[344..348] == b"n+1\0" || &head[4..8] == b"n+2\0"))
+        || (head.len() >= 348
+            && (matches!(&head[344..348], b"n+1\0" | b"ni1\0")
+                || matches!(&head[4..8], b"n+2\0" | b"ni2\0")))
     {
         // A gzip stream without a telling name is most likely a .nii.gz.
         Ok(Format::Nifti)

@@ -22,7 +22,7 @@
 //! know. Files are written in LPS, one point or key frame per line.
 
 use crate::error::{ReadError, Result};
-use crate::markups::{short, vec3, CoordinateSystem};
+use crate::markups::{short, vec3, within_range, CoordinateSystem};
 use endocast_core::animation::KeyFrame;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -205,6 +205,9 @@ fn key_frames(
 /// One key frame from its JSON object.
 fn key_frame(value: &Value, system: CoordinateSystem) -> std::result::Result<KeyFrame, String> {
     let k = KeyFrameJson::deserialize(value).map_err(|e| e.to_string())?;
+    for (name, numbers) in [("eye", k.eye), ("forward", k.forward), ("up", k.up)] {
+        within_range(&numbers).map_err(|why| format!("{name}: {why}"))?;
+    }
     let lps = |v: [f64; 3]| system.to_lps(DVec3::from(v));
     let mut key = KeyFrame::new(
         lps(k.eye),

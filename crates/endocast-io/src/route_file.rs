@@ -85,7 +85,9 @@ pub fn parse_camera_path(file: &Path, text: &str) -> Result<CameraPath> {
             .as_array()
             .and_then(|a| a.iter().map(Value::as_f64).collect());
         match v.as_deref() {
-            Some(&[x, y, z]) => Ok(DVec3::new(x, y, z)),
+            Some(&[x, y, z]) => markups::within_range(&[x, y, z])
+                .map(|()| DVec3::new(x, y, z))
+                .map_err(|why| ReadError::format(file, format!("camera {n} {key:?}: {why}"))),
             _ => Err(ReadError::format(
                 file,
                 format!("camera {n} has no {key:?} of three numbers"),

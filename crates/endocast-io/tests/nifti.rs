@@ -424,6 +424,31 @@ fn bad_files_are_errors() {
     }
 }
 
+/// A `.hdr` (magic `ni1`, vox_offset 0) and the `.img` holding its samples read like the single
+/// file, plain or gzip, whatever the case of the names; without its `.img` it is an error
+/// naming the `.img`.
+#[test]
+fn header_and_image_pairs_read_like_single_files() {
+    let dir = scratch();
+    let single = Hdr::nifti1(false).with_samples();
+    let header = &Hdr::nifti1(false).magic(344, b"ni1\0").f32(108, 0.0).bytes[..348];
+    let samples = &single[352..];
+    for (hdr, img, pack) in [
+        ("a.hdr", "a.img", false),
+        ("B.HDR", "B.IMG", false),
+        ("c.hdr.gz", "c.img.gz", true),
+    ] {
+        let pack = |bytes: &[u8]| if pack { gzip(bytes) } else { bytes.to_vec() };
+        write_temp(&dir, img, &pack(samples));
+        let path = write_temp(&dir, hdr, &pack(header));
+        let loaded = open(&path, &OpenOptions::default()).unwrap();
+        assert_samples(&loaded);
+    }
+    std::fs::remove_file(dir.path().join("a.img")).unwrap();
+    let e = read(&dir.path().join("a.hdr")).unwrap_err();
+    assert!(e.to_string().contains("a.img"), "{e}");
+}
+
 #[test]
 fn huge_dims_hit_the_limit_before_allocating() {
     let dir = scratch();

@@ -6,6 +6,7 @@ mod case;
 mod corruption;
 mod cross_format;
 mod dicom;
+mod hostile;
 mod image_out;
 mod mesh;
 mod metaimage;

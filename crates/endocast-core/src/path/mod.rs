@@ -58,6 +58,9 @@ pub enum PathError {
         /// The limit.
         limit: usize,
     },
+    /// The path's length overflows f64 (points near f64's limits, e.g. 1e308 mm).
+    #[error("the path is too long to measure: are its points in millimetres?")]
+    TooLong,
     /// [`Path::smooth_until`] found no smoothing the caller accepted, down to passing through
     /// every raw point.
     #[error("no smoothing of the path was accepted, down to a control point at every raw point")]

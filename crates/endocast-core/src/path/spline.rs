@@ -169,6 +169,9 @@ impl ArcTable {
             }
         }
         segment_starts.push(entries.len() - 1);
+        if !arc_mm.is_finite() {
+            return Err(PathError::TooLong);
+        }
         Ok(Self {
             entries,
             segment_starts,

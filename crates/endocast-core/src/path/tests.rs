@@ -71,6 +71,15 @@ fn helix(s: f64) -> DVec3 {
 }
 
 #[test]
+fn a_path_too_long_for_f64_is_an_error() {
+    let points = [DVec3::ZERO, DVec3::new(1e308, 0.0, 0.0), DVec3::X];
+    assert_eq!(
+        Path::from_points_exact(&points, 1.0).err(),
+        Some(PathError::TooLong)
+    );
+}
+
+#[test]
 fn passes_through_its_control_points() {
     let raw = staircase(helix, 60.0);
     let path = Path::smooth(&raw, &SmoothOptions::default()).unwrap();

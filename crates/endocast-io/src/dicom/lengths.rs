@@ -1,15 +1,18 @@
 //! A pre-flight walk over a DICOM file's element headers that refuses any element whose declared
-//! length runs past the end of the file.
+//! length runs past the end of the file, and sequences nested deeper than [`MAX_NESTING`].
 //!
 //! dicom-rs reserves the declared length of an element before reading it, so one flipped byte in
-//! a length field makes it ask for gigabytes. Walking the headers first (seeking over values,
-//! descending into sequences and items) costs a few hundred small reads per file and keeps every
-//! allocation bounded by the file's real size.
+//! a length field makes it ask for gigabytes; and it parses nested sequences recursively, so a
+//! small file of thousands of nested sequences overflows the stack. Walking the headers first
+//! (iteratively, seeking over values, descending into sequences and items) costs a few hundred
+//! small reads per file and keeps every allocation bounded by the file's real size. The walk
+//! splits the file where dicom-rs does: the file meta group ends where its group length
+//! (0002,0000) says, not at the first element of another group.
 //!
 //! A deflated data set (transfer syntax 1.2.840.10008.1.2.1.99) is inflated here first: its
-//! deflate stream must reach its final block exactly at the end of the file (raw deflate has no
-//! checksum, so its end and length are what can be checked), and the inflated elements are then
-//! walked like those of any other file.
+//! deflate stream must reach its final block at the end of the file, give or take a few bytes
+//! of padding (raw deflate has no checksum, so its end and length are what can be checked), and
+//! the inflated elements are then walked like those of any other file.
 
 use crate::compressed;
 use crate::error::{ReadError, Result};
@@ -33,6 +36,10 @@ const KNOWN_VRS: [&[u8; 2]; 34] = [
     b"UC", b"UI", b"UL", b"UN", b"UR", b"US", b"UT", b"UV",
 ];
 
+/// Sequences and items open at once beyond which a file is refused (two per level of nesting:
+/// the sequence and its item). Real files nest a few levels; dicom-rs recurses once per level.
+const MAX_NESTING: usize = 64;
+
 /// How the data set after the file meta group is encoded.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Encoding {
@@ -45,6 +52,9 @@ struct Walker<R> {
     reader: BufReader<R>,
     pos: u64,
     len: u64,
+    /// The sequences and items open at `pos`: where each ends, `None` for an undefined length
+    /// (closed by its delimiter).
+    open: Vec<Option<u64>>,
 }
 
 /// Where a walk stopped.
@@ -65,6 +75,7 @@ pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()
         reader: BufReader::with_capacity(4096, file),
         pos: 0,
         len,
+        open: Vec::new(),
     };
     let io = |e| ReadError::io(path, e);
     let mut magic = [0u8; 4];
@@ -86,8 +97,12 @@ pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()
     }
 }
 
+/// Bytes that may follow a complete deflate stream: some writers pad it to an even length or
+/// append a checksum (dicom-rs ignores them). More is a second stream or junk: corruption.
+const MAX_TRAILING: u64 = 8;
+
 /// Inflates the data set that starts at byte `start` of `file`, requires its stream to end with
-/// the file, and walks the inflated elements.
+/// the file (but for [`MAX_TRAILING`] bytes), and walks the inflated elements.
 fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) -> Result<()> {
     file.seek(SeekFrom::Start(start))
         .map_err(|e| ReadError::io(path, e))?;
@@ -107,7 +122,7 @@ fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) ->
     }
     let trailing =
         io::copy(decoder.get_mut(), &mut io::sink()).map_err(|e| ReadError::io(path, e))?;
-    if trailing > 0 {
+    if trailing > MAX_TRAILING {
         return Err(ReadError::format(
             path,
             format!("the deflate data are corrupt: {trailing} bytes follow the end of the stream"),
@@ -118,6 +133,7 @@ fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) ->
         reader: BufReader::with_capacity(4096, Cursor::new(data)),
         pos: 0,
         len,
+        open: Vec::new(),
     };
     w.walk()
         .map(|_| ())
@@ -169,15 +185,19 @@ impl<R: Read + Seek> Walker<R> {
         // `None` once the meta group has named the deflated transfer syntax.
         let mut encoding = Some(Encoding::ExplicitLittle);
         let mut in_meta = true;
+        // Where the meta group ends by its group length (dicom-rs stops there).
+        let mut meta_end = u64::MAX;
         let mut in_fragments = false;
         while self.pos + 8 <= self.len {
+            self.close_ended();
+            let start = self.pos;
             let Some(head) = self.take::<8>() else { break };
             let group_le = u16::from_le_bytes([head[0], head[1]]);
-            in_meta &= group_le == 0x0002;
+            in_meta &= group_le == 0x0002 && start < meta_end;
             let current = match (in_meta, encoding) {
                 (true, _) => Encoding::ExplicitLittle,
                 (false, Some(encoding)) => encoding,
-                (false, None) => return Ok(Walked::Deflated(self.pos - 8)),
+                (false, None) => return Ok(Walked::Deflated(start)),
             };
             let (tag, length, vr) = self.element_header(head, current)?;
             if tag.0 == 0xFFFE {
@@ -185,13 +205,22 @@ impl<R: Read + Seek> Walker<R> {
                 continue;
             }
             if length == UNDEFINED {
+                // A sequence (or encapsulated pixel data): its items follow inline.
                 in_fragments |= tag == (0x7FE0, 0x0010);
-                continue; // a sequence (or encapsulated pixel data): its items follow inline
+                self.open(None)?;
+                continue;
             }
             self.check(tag, length)?;
-            if tag == (0x0002, 0x0010) {
+            let end = self.pos + u64::from(length);
+            if tag == (0x0002, 0x0000) && in_meta {
+                meta_end = self
+                    .group_length(length)?
+                    .map_or(u64::MAX, |n| self.pos + n);
+            } else if tag == (0x0002, 0x0010) && in_meta {
                 encoding = self.transfer_syntax(length)?;
-            } else if vr != Some(*b"SQ") && !self.starts_with_item(length, current)? {
+            } else if vr == Some(*b"SQ") || self.starts_with_item(length, current)? {
+                self.open(Some(end))?;
+            } else {
                 self.skip(u64::from(length))?;
             }
         }
@@ -200,6 +229,38 @@ impl<R: Read + Seek> Walker<R> {
             // A deflated data set that is empty (or a meta group cut short): inflating it fails.
             None => Walked::Deflated(self.pos),
         })
+    }
+
+    /// Opens a sequence or item ending at `end` (`None`: at its delimiter); refuses one nested
+    /// deeper than [`MAX_NESTING`].
+    fn open(&mut self, end: Option<u64>) -> Result<(), String> {
+        if self.open.len() >= MAX_NESTING {
+            return Err(format!(
+                "sequences are nested more than {} levels deep (at byte {}); real files nest a \
+                 few, so the file is corrupt or hostile",
+                MAX_NESTING / 2,
+                self.pos
+            ));
+        }
+        self.open.push(end);
+        Ok(())
+    }
+
+    /// Closes the defined-length sequences and items that end at or before `pos`.
+    fn close_ended(&mut self) {
+        while let Some(Some(end)) = self.open.last() {
+            if *end > self.pos {
+                break;
+            }
+            self.open.pop();
+        }
+    }
+
+    /// Closes the innermost sequence or item of undefined length, at its delimiter.
+    fn close_delimited(&mut self) {
+        if let Some(None) = self.open.last() {
+            self.open.pop();
+        }
     }
 
     /// Tag, length and (explicit VR only) the VR of the element whose first 8 bytes are `head`.
@@ -259,13 +320,23 @@ impl<R: Read + Seek> Walker<R> {
                 self.skip(u64::from(length))?;
                 Ok(true)
             }
-            0xE000 => {
-                if length != UNDEFINED {
-                    self.check(tag, length)?;
-                }
+            0xE000 if length == UNDEFINED => {
+                self.open(None)?;
                 Ok(false) // the item's elements follow inline
             }
-            0xE0DD => Ok(false),
+            0xE000 => {
+                self.check(tag, length)?;
+                self.open(Some(self.pos + u64::from(length)))?;
+                Ok(false)
+            }
+            0xE00D => {
+                self.close_delimited();
+                Ok(in_fragments)
+            }
+            0xE0DD => {
+                self.close_delimited();
+                Ok(false)
+            }
             _ => Ok(in_fragments),
         }
     }
@@ -287,6 +358,19 @@ impl<R: Read + Seek> Walker<R> {
             [0xFE, 0xFF, 0x00, 0xE0]
         };
         Ok(head == item)
+    }
+
+    /// Reads the value of the meta group length (0002,0000): `None` unless it is 4 bytes long
+    /// (dicom-rs refuses such a file anyway).
+    fn group_length(&mut self, length: u32) -> Result<Option<u64>, String> {
+        if length != 4 {
+            self.skip(u64::from(length))?;
+            return Ok(None);
+        }
+        let value = self
+            .take::<4>()
+            .ok_or("the file ends inside the meta group length")?;
+        Ok(Some(u64::from(u32::from_le_bytes(value))))
     }
 
     /// Reads the transfer syntax UID value; `None` for a deflated data set (walked once

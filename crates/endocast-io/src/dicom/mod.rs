@@ -11,8 +11,8 @@
 //! 3. `stack`: frames (a file is one frame, an enhanced multi-frame file many) are ordered by
 //!    the projection of ImagePositionPatient on the slice normal (row × column cosine), never
 //!    by file name or InstanceNumber, which scanners number in either direction.
-//! 4. `pixels`: each file is decoded (any transfer syntax dicom-rs decodes: uncompressed
-//!    little/big endian, RLE, JPEG lossless, JPEG-LS, JPEG 2000, deflate) straight into its
+//! 4. `pixels`: each file is decoded (uncompressed little/big endian, deflate, JPEG, JPEG 2000
+//!    through dicom-rs; RLE and JPEG-LS through our own `rle` and `jpegls`) straight into its
 //!    slice of the final voxel buffer, files in parallel. Peak memory is that buffer plus one
 //!    file per thread (a multi-frame file is held whole while its frames are decoded).
 //! 5. `values`: one value map for the series (exact when all slices share their rescale).
@@ -28,7 +28,8 @@
 //! - Spacing is PixelSpacing (DICOM lists the spacing between rows first, so `i` takes its
 //!   second value and `j` its first) and the mean step between slice positions, never
 //!   SliceThickness (which may overlap or leave gaps). A single slice, with no neighbour to
-//!   measure, takes its SliceThickness (or 1 mm).
+//!   measure, takes its SliceThickness (or 1 mm, warned). PixelSpacing outside 0.001–1000 mm
+//!   is refused; `0\0` means unknown, like a missing one (1 mm, warned).
 //! - Slices must lie on one line (else [`ReadError::Inconsistent`]). When the gaps between
 //!   them differ by more than 1 %, the stack is resampled onto a uniform step (the smallest
 //!   gap, at most 4× the original slice count) by linear interpolation between the two
@@ -48,9 +49,11 @@
 mod jpegls;
 mod lengths;
 mod pixels;
+mod rle;
 mod scan;
 mod series;
 mod stack;
+mod stream_size;
 mod values;
 
 use crate::error::{ReadError, Result};
@@ -86,6 +89,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let modality = Modality::from_code(&first.modality);
     let invert = monochrome1_inversion(first, &modality, &mut warnings);
     let map = SampleMap::new(&first.path, &first.layout, first.padding, invert)?;
+    pixels::check_high_bit(first, &mut warnings)?;
 
     let dims = [
         usize::from(first.layout.columns),
@@ -173,7 +177,7 @@ fn decode_all(
                 .into_iter()
                 .map(|(k, frame, slot)| (k, (frame, slot)))
                 .unzip();
-            let stats = pixels::decode_file(&files[file].path, ts_names[file], slots, map)?;
+            let stats = pixels::decode_file(&files[file], ts_names[file], slots, map)?;
             progress.advance();
             Ok(ks.into_iter().zip(stats).collect::<Vec<_>>())
         })

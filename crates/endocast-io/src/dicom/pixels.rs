@@ -6,13 +6,14 @@
 //! (`raw = stored + type_min`). The table is 128 KiB for 16-bit data and makes the inner loop
 //! one load per voxel.
 
-use super::jpegls;
-use super::scan::{chain, open_error, PixelLayout};
+use super::scan::{chain, open_error, ImageFile, PixelLayout};
+use super::{jpegls, rle, stream_size};
 use crate::error::{ReadError, Result};
 use crate::guard;
 use dicom_core::value::DicomValueType;
 use dicom_core::{DicomValue, PrimitiveValue};
 use dicom_dictionary_std::tags;
+use dicom_encoding::adapters::PixelDataObject;
 use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
 use dicom_object::{DefaultDicomObject, OpenFileOptions};
 use dicom_pixeldata::PixelDecoder;
@@ -224,6 +225,38 @@ fn validate(path: &Path, layout: &PixelLayout) -> Result<SampleBits> {
     })
 }
 
+/// HighBit above BitsStored − 1 (the standard's value): in compressed data an error, since
+/// decoders return samples from bit 0 and shifting them would corrupt every value; in
+/// uncompressed data the samples are taken where HighBit says (as some old scanners stored
+/// them), with a warning, since a corrupt header looks the same. (A HighBit below is refused by
+/// [`SampleMap::new`].)
+pub(super) fn check_high_bit(file: &ImageFile, warnings: &mut Vec<String>) -> Result<()> {
+    let (stored, high) = (file.layout.bits_stored, file.layout.high_bit);
+    if u32::from(high) + 1 == u32::from(stored) {
+        return Ok(());
+    }
+    let found = format!(
+        "HighBit {high} with BitsStored {stored} (expected HighBit {})",
+        stored.saturating_sub(1)
+    );
+    let compressed = TransferSyntaxRegistry
+        .get(&file.transfer_syntax)
+        .is_some_and(|ts| ts.is_encapsulated_pixel_data());
+    if compressed {
+        return Err(ReadError::format(
+            &file.path,
+            format!("{found}: compressed samples start at bit 0, so the header is wrong (correct HighBit or BitsStored)"),
+        ));
+    }
+    warnings.push(format!(
+        "{}: {found}: the samples were taken from bits {}–{high}; if the values look wrong, \
+         the header is",
+        file.path.display(),
+        (high + 1).saturating_sub(stored)
+    ));
+    Ok(())
+}
+
 /// What one decoded frame holds, in voxel values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct FrameStats {
@@ -248,14 +281,15 @@ impl FrameStats {
     }
 }
 
-/// Reads `path` whole and decodes each `(frame number, slot)` into its slot, in parallel for
+/// Reads `file` whole and decodes each `(frame number, slot)` into its slot, in parallel for
 /// compressed multi-frame files. Returns the statistics of each frame, in the order given.
 pub(super) fn decode_file(
-    path: &Path,
+    file: &ImageFile,
     ts_name: &str,
     frames: Vec<(u32, &mut [u16])>,
     map: &SampleMap,
 ) -> Result<Vec<FrameStats>> {
+    let path = file.path.as_path();
     let object = guard::quietly(|| OpenFileOptions::new().open_file(path))
         .map_err(|panicked| ReadError::format(path, panicked.to_string()))?
         .map_err(|e| open_error(path, &e))?;
@@ -263,13 +297,20 @@ pub(super) fn decode_file(
         .get(tags::PIXEL_DATA)
         .ok_or_else(|| ReadError::format(path, "expected a PixelData element, found none"))?;
     match pixel_data.value() {
-        DicomValue::Primitive(value) => frames
-            .into_iter()
-            .map(|(frame, out)| native_frame(path, value, frame, out, map))
-            .collect(),
-        DicomValue::PixelSequence(_) => {
-            let decode = if jpegls::is_jpeg_ls(object.meta().transfer_syntax()) {
+        DicomValue::Primitive(value) => {
+            check_native_length(file, value, map)?;
+            frames
+                .into_iter()
+                .map(|(frame, out)| native_frame(path, value, frame, out, map))
+                .collect()
+        }
+        DicomValue::PixelSequence(sequence) => {
+            check_fragment_count(file, sequence.fragments().len())?;
+            let uid = object.meta().transfer_syntax();
+            let decode = if jpegls::is_jpeg_ls(uid) {
                 jpeg_ls_frame
+            } else if rle::is_rle(uid) {
+                rle_frame
             } else {
                 registry_frame
             };
@@ -295,6 +336,53 @@ pub(super) fn decode_file(
     }
 }
 
+/// Uncompressed pixel data must hold exactly the frames the header declares (plus the pad byte
+/// of an odd length): fewer would leave slices unread, more means the header is wrong about
+/// the image (its size, sample width or NumberOfFrames).
+fn check_native_length(file: &ImageFile, value: &PrimitiveValue, map: &SampleMap) -> Result<()> {
+    let found = match value {
+        PrimitiveValue::U8(bytes) => bytes.len(),
+        PrimitiveValue::U16(words) => words.len() * 2,
+        PrimitiveValue::I16(words) => words.len() * 2,
+        // Another type: refused, naming it, by the frame conversion.
+        _ => return Ok(()),
+    };
+    let layout = &file.layout;
+    let (rows, columns, frames) = (layout.rows, layout.columns, file.frames.len());
+    let expected = usize::from(rows) * usize::from(columns) * frames * map.bytes_per_sample;
+    if found == expected || (expected % 2 == 1 && found == expected + 1) {
+        return Ok(());
+    }
+    Err(ReadError::inconsistent(
+        &file.path,
+        format!(
+            "PixelData (7FE0,0010) holds {found} bytes, but Rows × Columns × NumberOfFrames × \
+             BitsAllocated/8 = {rows} × {columns} × {frames} × {} = {expected}: the header does \
+             not describe these pixels (a truncated file, or a wrong Rows, Columns, \
+             NumberOfFrames or BitsAllocated)",
+            map.bytes_per_sample
+        ),
+    ))
+}
+
+/// Compressed pixel data hold at least one fragment a frame: fewer means frames are missing
+/// (which would go unnoticed when the frames share one position and all but one are dropped as
+/// duplicates).
+fn check_fragment_count(file: &ImageFile, fragments: usize) -> Result<()> {
+    let frames = file.frames.len();
+    if fragments >= frames {
+        return Ok(());
+    }
+    Err(ReadError::inconsistent(
+        &file.path,
+        format!(
+            "NumberOfFrames (0028,0008) declares {frames} frames, but the compressed pixel data \
+             hold {fragments} fragment(s): frames are missing (a truncated file, or a wrong \
+             NumberOfFrames)"
+        ),
+    ))
+}
+
 /// Why a compressed frame could not be converted.
 enum FrameError {
     /// The decoder's message.
@@ -303,17 +391,62 @@ enum FrameError {
     Short { needed: usize, found: usize },
 }
 
-/// Decodes frame `frame` through dicom-rs's registry of decoders into `out`.
+/// Decodes frame `frame` through dicom-rs's registry of decoders into `out`, once the size
+/// the stream declares (JPEG, JPEG 2000) is known to be Rows × Columns.
 fn registry_frame(
     object: &DefaultDicomObject,
     frame: u32,
     out: &mut [u16],
     map: &SampleMap,
 ) -> std::result::Result<FrameStats, FrameError> {
+    check_stream_size(object, frame)?;
     let decoded = guarded(|| object.decode_pixel_data_frame(frame))
         .and_then(|decoded| decoded.map_err(|e| chain(&e)))
         .map_err(FrameError::Decode)?;
-    let bytes = decoded.data();
+    converted(decoded.data(), out, map)
+}
+
+/// Refuses a compressed frame whose stream declares another size than Rows × Columns.
+fn check_stream_size(
+    object: &DefaultDicomObject,
+    frame: u32,
+) -> std::result::Result<(), FrameError> {
+    let declared = object
+        .frame_pixel_data(frame)
+        .and_then(|data| stream_size::declared_size(&data));
+    let (Some((columns, rows)), Some(header_rows), Some(header_columns)) =
+        (declared, object.rows(), object.cols())
+    else {
+        return Ok(());
+    };
+    if (rows, columns) == (u32::from(header_rows), u32::from(header_columns)) {
+        return Ok(());
+    }
+    Err(FrameError::Decode(format!(
+        "the compressed stream holds {rows} rows × {columns} columns, but Rows × Columns \
+         (0028,0010/0011) declare {header_rows} × {header_columns}: the header is wrong (the \
+         missing pixels would read as 0)"
+    )))
+}
+
+/// Decodes RLE frame `frame` through [`rle`] into `out`.
+fn rle_frame(
+    object: &DefaultDicomObject,
+    frame: u32,
+    out: &mut [u16],
+    map: &SampleMap,
+) -> std::result::Result<FrameStats, FrameError> {
+    let bytes =
+        rle::decode_frame(object, frame, map.bytes_per_sample).map_err(FrameError::Decode)?;
+    converted(&bytes, out, map)
+}
+
+/// Maps decoded little-endian sample `bytes` into `out`; too few bytes are an error.
+fn converted(
+    bytes: &[u8],
+    out: &mut [u16],
+    map: &SampleMap,
+) -> std::result::Result<FrameStats, FrameError> {
     let needed = out.len() * map.bytes_per_sample;
     if bytes.len() < needed {
         return Err(FrameError::Short {

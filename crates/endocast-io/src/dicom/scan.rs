@@ -7,7 +7,8 @@ use crate::guard;
 use crate::limits::Limits;
 use crate::progress::Progress;
 use crate::samples::Rescale;
-use dicom_core::Tag;
+use dicom_core::header::HasLength;
+use dicom_core::{Tag, VR};
 use dicom_dictionary_std::tags;
 use dicom_object::{InMemDicomObject, OpenFileOptions};
 use glam::DVec3;
@@ -227,6 +228,15 @@ fn image_file(
     ) else {
         return Ok(None);
     };
+    if rows == 0 || columns == 0 {
+        return Err(ReadError::format(
+            path,
+            format!(
+                "Rows {rows} / Columns {columns}: an image needs at least one row and one \
+                 column; the header is corrupt"
+            ),
+        ));
+    }
     let bits_stored = integer(object, tags::BITS_STORED).unwrap_or(0u16);
     let layout = PixelLayout {
         rows,
@@ -280,30 +290,41 @@ fn frame_header(path: &Path, object: &InMemDicomObject, frame: u32) -> Result<Fr
         top: object,
     };
     let position = scope
-        .floats(tags::PLANE_POSITION_SEQUENCE, tags::IMAGE_POSITION_PATIENT)
+        .floats(
+            path,
+            "ImagePositionPatient",
+            tags::PLANE_POSITION_SEQUENCE,
+            tags::IMAGE_POSITION_PATIENT,
+        )?
         .map(|v| vector3(path, "ImagePositionPatient", &v))
         .transpose()?;
     let orientation = scope
         .floats(
+            path,
+            "ImageOrientationPatient",
             tags::PLANE_ORIENTATION_SEQUENCE,
             tags::IMAGE_ORIENTATION_PATIENT,
-        )
+        )?
         .map(|v| orientation(path, &v))
         .transpose()?;
+    let measures = tags::PIXEL_MEASURES_SEQUENCE;
     let pixel_spacing = scope
-        .floats(tags::PIXEL_MEASURES_SEQUENCE, tags::PIXEL_SPACING)
+        .floats(path, "PixelSpacing", measures, tags::PIXEL_SPACING)?
         .map(|v| pixel_spacing(path, &v))
-        .transpose()?;
+        .transpose()?
+        .flatten();
     let thickness = scope
-        .floats(tags::PIXEL_MEASURES_SEQUENCE, tags::SLICE_THICKNESS)
-        .and_then(|v| v.first().copied())
-        .filter(|t| t.is_finite() && *t > 0.0);
+        .floats(path, "SliceThickness", measures, tags::SLICE_THICKNESS)?
+        .and_then(|v| v.first().copied());
     let transform = tags::PIXEL_VALUE_TRANSFORMATION_SEQUENCE;
-    let slope = scope.floats(transform, tags::RESCALE_SLOPE);
-    let intercept = scope.floats(transform, tags::RESCALE_INTERCEPT);
+    let first = |name, tag| -> Result<Option<f64>> {
+        Ok(scope
+            .floats(path, name, transform, tag)?
+            .and_then(|v| v.first().copied()))
+    };
     let rescale = Rescale {
-        slope: slope.and_then(|v| v.first().copied()).unwrap_or(1.0),
-        intercept: intercept.and_then(|v| v.first().copied()).unwrap_or(0.0),
+        slope: first("RescaleSlope", tags::RESCALE_SLOPE)?.unwrap_or(1.0),
+        intercept: first("RescaleIntercept", tags::RESCALE_INTERCEPT)?.unwrap_or(0.0),
     };
     if !rescale.slope.is_finite() || rescale.slope == 0.0 || !rescale.intercept.is_finite() {
         return Err(ReadError::format(
@@ -331,16 +352,18 @@ struct FrameScope<'a> {
 }
 
 impl FrameScope<'_> {
-    /// The numbers of `tag` inside the functional group `sequence`, or at the top level.
-    fn floats(&self, sequence: Tag, tag: Tag) -> Option<Vec<f64>> {
-        self.groups
-            .iter()
-            .flatten()
-            .find_map(|group| {
-                let item = first_items(group, sequence)?.first()?;
-                floats(item, tag)
-            })
-            .or_else(|| floats(self.top, tag))
+    /// The numbers of `tag` (called `name` in errors) inside the functional group `sequence`,
+    /// or at the top level; `None` when absent or empty.
+    fn floats(&self, path: &Path, name: &str, sequence: Tag, tag: Tag) -> Result<Option<Vec<f64>>> {
+        for group in self.groups.iter().flatten() {
+            let Some(item) = first_items(group, sequence).and_then(<[_]>::first) else {
+                continue;
+            };
+            if let Some(values) = floats(path, name, item, tag)? {
+                return Ok(Some(values));
+            }
+        }
+        floats(path, name, self.top, tag)
     }
 }
 
@@ -348,12 +371,53 @@ fn first_items(object: &InMemDicomObject, tag: Tag) -> Option<&[InMemDicomObject
     object.get(tag)?.items()
 }
 
-fn floats(object: &InMemDicomObject, tag: Tag) -> Option<Vec<f64>> {
-    object
-        .get(tag)?
-        .to_multi_float64()
-        .ok()
-        .filter(|v| !v.is_empty())
+/// The numbers of `tag` (called `name` in errors): `None` when absent or empty, an error when
+/// present but not numbers (a value read as 0 would shift every voxel or slice). A value of VR
+/// UN (an implicit-VR file converted by a tool that did not know the tag) is read from its
+/// text.
+fn floats(
+    path: &Path,
+    name: &str,
+    object: &InMemDicomObject,
+    tag: Tag,
+) -> Result<Option<Vec<f64>>> {
+    let Some(element) = object.get(tag) else {
+        return Ok(None);
+    };
+    if element.is_empty() {
+        return Ok(None);
+    }
+    let numbers = match element.vr() {
+        VR::UN => element
+            .to_bytes()
+            .ok()
+            .and_then(|bytes| decimal_strings(&bytes)),
+        _ => element.to_multi_float64().ok(),
+    };
+    match numbers {
+        Some(values) if !values.is_empty() => Ok(Some(values)),
+        _ => {
+            let found = element.to_str().map(|s| s.into_owned()).unwrap_or_default();
+            Err(ReadError::format(
+                path,
+                format!(
+                    "{name} ({:04X},{:04X}) must hold numbers, found {found:?}; correct or \
+                     remove the attribute",
+                    tag.group(),
+                    tag.element()
+                ),
+            ))
+        }
+    }
+}
+
+/// Backslash-separated decimal numbers (DICOM's DS) from raw bytes, padding trimmed.
+fn decimal_strings(bytes: &[u8]) -> Option<Vec<f64>> {
+    let text = std::str::from_utf8(bytes).ok()?;
+    text.trim_matches(['\0', ' '])
+        .split('\\')
+        .map(|n| n.trim().parse().ok())
+        .collect()
 }
 
 /// An integer attribute that fits `T` (`None` when absent, malformed or out of range).
@@ -404,14 +468,25 @@ fn orientation(path: &Path, values: &[f64]) -> Result<[DVec3; 2]> {
     Ok([row.normalize(), column.normalize()])
 }
 
-fn pixel_spacing(path: &Path, values: &[f64]) -> Result<[f64; 2]> {
+/// Pixel spacings (mm) outside this range are not a scan's: a corrupt or mistyped header.
+const PIXEL_SPACING_MM: std::ops::RangeInclusive<f64> = 1e-3..=1e3;
+
+/// PixelSpacing: two numbers within [`PIXEL_SPACING_MM`], or `None` for `0\0`, which some
+/// tools write for "unknown" (the reader then warns and assumes 1 mm, as for a missing one).
+fn pixel_spacing(path: &Path, values: &[f64]) -> Result<Option<[f64; 2]>> {
     match values {
-        [between_rows, between_columns] if values.iter().all(|v| v.is_finite() && *v > 0.0) => {
-            Ok([*between_rows, *between_columns])
+        [between_rows, between_columns] if values.iter().all(|v| PIXEL_SPACING_MM.contains(v)) => {
+            Ok(Some([*between_rows, *between_columns]))
         }
+        [0.0, 0.0] => Ok(None),
         _ => Err(ReadError::format(
             path,
-            format!("PixelSpacing must be 2 positive numbers (mm), found {values:?}"),
+            format!(
+                "PixelSpacing (0028,0030) must be 2 numbers from {} to {} mm, found {values:?}; \
+                 correct the header's PixelSpacing",
+                PIXEL_SPACING_MM.start(),
+                PIXEL_SPACING_MM.end()
+            ),
         )),
     }
 }

@@ -95,7 +95,7 @@ impl Stack {
         };
         let step = match offsets.last() {
             Some(&span) if offsets.len() > 1 => span / (offsets.len() - 1) as f64,
-            _ => placed.single_thickness,
+            _ => single_slice_thickness(&files[order[0].1].path, placed.thickness, warnings),
         };
         warn_tilt(root, stack_direction, normal, warnings);
         let slices = order
@@ -176,7 +176,8 @@ struct Placement {
     positions: Vec<DVec3>,
     orientation: [DVec3; 2],
     pixel_spacing: [f64; 2],
-    single_thickness: f64,
+    /// SliceThickness of the first frame, as stored.
+    thickness: Option<f64>,
 }
 
 fn place_frames(
@@ -226,7 +227,8 @@ fn place_frames(
         Some(spacing) => spacing,
         None => {
             warnings.push(format!(
-                "{}: no PixelSpacing; assuming 1 mm pixels",
+                "{}: no PixelSpacing (or 0\\0, \"unknown\"); assuming 1 mm pixels, so distances \
+                 and sizes in millimetres may be wrong",
                 first_path.display()
             ));
             [1.0, 1.0]
@@ -247,9 +249,24 @@ fn place_frames(
         positions,
         orientation,
         pixel_spacing,
-        // One slice has no neighbour to measure a step from: its thickness is the best guess.
-        single_thickness: first.thickness.unwrap_or(1.0),
+        thickness: first.thickness,
     })
+}
+
+/// The step of a volume of one slice, which has no neighbour to measure one from: its
+/// SliceThickness when that is a positive number, else 1 mm with a warning.
+fn single_slice_thickness(path: &Path, thickness: Option<f64>, warnings: &mut Vec<String>) -> f64 {
+    let found = match thickness {
+        Some(t) if t.is_finite() && t > 0.0 => return t,
+        Some(t) => format!("SliceThickness {t} is not a positive number"),
+        None => "no SliceThickness".to_owned(),
+    };
+    warnings.push(format!(
+        "{}: {found}; the single slice is taken as 1 mm thick, so its depth in millimetres \
+         is a guess",
+        path.display()
+    ));
+    1.0
 }
 
 /// Rows, columns and sample format must agree across the series.

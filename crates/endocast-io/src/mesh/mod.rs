@@ -55,9 +55,15 @@ impl MeshFormat {
 /// Reads the mesh in `path` (STL, OBJ or PLY by its extension).
 pub fn read_mesh(path: &Path) -> Result<TriangleMesh> {
     let format = MeshFormat::of(path)?;
-    let size = std::fs::metadata(path)
-        .map_err(|e| ReadError::io(path, e))?
-        .len();
+    let meta = std::fs::metadata(path).map_err(|e| ReadError::io(path, e))?;
+    if !meta.is_file() {
+        // A device or pipe has no size to check and may never end (/dev/zero).
+        return Err(ReadError::format(
+            path,
+            "not a regular file (a device, pipe or folder): give the mesh file itself",
+        ));
+    }
+    let size = meta.len();
     if size > MAX_FILE_BYTES {
         return Err(limit(path, "file bytes", size, MAX_FILE_BYTES));
     }

@@ -72,6 +72,7 @@ fn ascii(path: &Path, bytes: &[u8]) -> Result<Parts> {
         .map_err(|_| ReadError::format(path, "ASCII STL with bytes that are not text"))?;
     let mut vertices = Vec::new();
     let mut in_loop = 0usize;
+    let mut ended = false;
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let at = |what: &str| format!("line {}: {what}", number + 1);
@@ -86,6 +87,7 @@ fn ascii(path: &Path, bytes: &[u8]) -> Result<Parts> {
                 check_count(path, "vertices", vertices.len() as u64)?;
             }
             Some("outer") => in_loop = 0,
+            Some("endsolid") => ended = true,
             Some("endloop") if in_loop != 3 => {
                 let message = format!("a facet with {in_loop} vertices (STL needs 3)");
                 return Err(ReadError::format(path, at(&message)));
@@ -95,6 +97,12 @@ fn ascii(path: &Path, bytes: &[u8]) -> Result<Parts> {
     }
     if vertices.len() % 3 != 0 {
         return Err(ReadError::format(path, "the last facet is incomplete"));
+    }
+    if !ended {
+        return Err(ReadError::format(
+            path,
+            "the ASCII STL ends without its endsolid line: the file is truncated",
+        ));
     }
     Ok(unshared(vertices))
 }

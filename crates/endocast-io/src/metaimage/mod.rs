@@ -1,5 +1,6 @@
 //! MetaImage (ITK's MetaIO format): `.mha` with the voxels after the header
-//! (`ElementDataFile = LOCAL`), or a `.mhd` header beside a `.raw` / `.zraw` data file.
+//! (`ElementDataFile = LOCAL`), or a `.mhd` header beside a `.raw` / `.zraw` data file (a regular
+//! file in the header's folder or below it).
 //!
 //! World coordinates are LPS, as in ITK, so the geometry needs no conversion: `Offset` is the
 //! origin, `ElementSpacing` the spacing and `TransformMatrix` the direction (see
@@ -17,6 +18,7 @@ pub use header::{read_header, DataFile, DataStart, Header};
 pub use write::write;
 
 use crate::compressed;
+use crate::detached;
 use crate::error::{ReadError, Result};
 use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::{read_voxels, Endian, Rescale};
@@ -44,7 +46,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         DataFile::Local => path,
         DataFile::Detached(file) => file.as_path(),
     };
-    let mut data = open_data(data_path, &header, count, &mut warnings)?;
+    let mut data = open_data(path, data_path, &header, count, &mut warnings)?;
     let (voxels, map) = read_voxels(
         data_path,
         &mut data,
@@ -186,24 +188,21 @@ impl Data {
     }
 }
 
-/// Opens the data file positioned at the voxels, bounded to the bytes they may occupy, and
-/// inflating when compressed. Lengths are checked before anything is read; bytes after the
-/// data are ignored with a warning.
+/// Opens the data file (`data_path`, named by the header at `path`) positioned at the voxels,
+/// bounded to the bytes they may occupy, and inflating when compressed. Lengths are checked
+/// before anything is read or allocated; bytes after the data are ignored with a warning.
 fn open_data(
+    path: &Path,
     data_path: &Path,
     header: &Header,
     count: usize,
     warnings: &mut Vec<String>,
 ) -> Result<Data> {
-    let file = File::open(data_path).map_err(|e| ReadError::io(data_path, e))?;
-    let file_len = file
-        .metadata()
-        .map_err(|e| ReadError::io(data_path, e))?
-        .len();
-    let base = match header.data_file {
-        DataFile::Local => header.text_bytes,
-        DataFile::Detached(_) => 0,
+    let (base, file_len) = match header.data_file {
+        DataFile::Local => (header.text_bytes, file_len(path)?),
+        DataFile::Detached(_) => (0, detached::data_file_len(path, data_path)?),
     };
+    let file = File::open(data_path).map_err(|e| ReadError::io(data_path, e))?;
     let raw_bytes = count as u64 * header.element.size() as u64;
     let ends_early = |start: u64, bytes: u64| {
         ReadError::format(
@@ -235,6 +234,9 @@ fn open_data(
     if start.saturating_add(stored_bytes) > file_len {
         return Err(ends_early(start, stored_bytes));
     }
+    if header.compressed {
+        compressed::check_inflates_to(data_path, "zlib", stored_bytes, raw_bytes)?;
+    }
     let surplus = file_len - start - stored_bytes;
     if surplus > 0 {
         warnings.push(format!(
@@ -251,4 +253,10 @@ fn open_data(
     } else {
         Data::Plain(bounded)
     })
+}
+
+fn file_len(path: &Path) -> Result<u64> {
+    Ok(std::fs::metadata(path)
+        .map_err(|e| ReadError::io(path, e))?
+        .len())
 }

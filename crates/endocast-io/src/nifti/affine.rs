@@ -190,6 +190,7 @@ mod tests {
         Header {
             version: Version::One,
             endian: Endian::Little,
+            paired: false,
             dim: [3, 2, 2, 2, 1, 1, 1, 1],
             datatype: 2,
             bitpix: 8,

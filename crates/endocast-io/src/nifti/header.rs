@@ -47,6 +47,8 @@ pub(super) const NIFTI1_VOX_OFFSET: usize = 352;
 pub(super) struct Header {
     pub version: Version,
     pub endian: Endian,
+    /// A `.hdr` whose voxels are in the `.img` beside it (magic `ni1`/`ni2`), not after it.
+    pub paired: bool,
     /// `dim[0]` is the number of dimensions, `dim[1..=dim[0]]` their sizes.
     pub dim: [i64; 8],
     pub datatype: i16,
@@ -158,14 +160,16 @@ impl Fields<'_> {
     }
 }
 
-fn check_magic(path: &Path, found: &[u8], single: &[u8], pair: &[u8], version: &str) -> Result<()> {
-    if found == single {
-        Ok(())
-    } else if found == pair {
-        Err(ReadError::unsupported(
-            path,
-            format!("{version} header/image pair (.hdr + .img): only single-file .nii is read"),
-        ))
+/// Whether the magic `found` is a pair's (`.hdr` + `.img`) rather than a single file's.
+fn check_magic(
+    path: &Path,
+    found: &[u8],
+    single: &[u8],
+    pair: &[u8],
+    version: &str,
+) -> Result<bool> {
+    if found == single || found == pair {
+        Ok(found == pair)
     } else {
         Err(ReadError::format(
             path,
@@ -179,10 +183,11 @@ fn check_magic(path: &Path, found: &[u8], single: &[u8], pair: &[u8], version: &
 }
 
 fn decode_nifti1(path: &Path, f: &Fields) -> Result<Header> {
-    check_magic(path, &f.bytes[344..348], b"n+1\0", b"ni1\0", "NIfTI-1")?;
+    let paired = check_magic(path, &f.bytes[344..348], b"n+1\0", b"ni1\0", "NIfTI-1")?;
     Ok(Header {
         version: Version::One,
         endian: f.endian,
+        paired,
         dim: f.array(40, 2, Fields::i16_wide),
         datatype: f.i16(70),
         bitpix: f.i16(72),
@@ -200,10 +205,11 @@ fn decode_nifti1(path: &Path, f: &Fields) -> Result<Header> {
 }
 
 fn decode_nifti2(path: &Path, f: &Fields) -> Result<Header> {
-    check_magic(path, &f.bytes[4..8], b"n+2\0", b"ni2\0", "NIfTI-2")?;
+    let paired = check_magic(path, &f.bytes[4..8], b"n+2\0", b"ni2\0", "NIfTI-2")?;
     Ok(Header {
         version: Version::Two,
         endian: f.endian,
+        paired,
         dim: f.array(16, 8, Fields::i64),
         datatype: f.i16(12),
         bitpix: f.i16(14),
@@ -312,7 +318,12 @@ impl Header {
 
     /// The byte offset of the first voxel, validated: a whole number, not inside the header.
     pub(super) fn data_offset(&self, path: &Path) -> Result<u64> {
-        let min = self.version.header_size() as f64;
+        // A pair's voxels are in their own file, from its first byte by default.
+        let min = if self.paired {
+            0.0
+        } else {
+            self.version.header_size() as f64
+        };
         let offset = self.vox_offset;
         if !offset.is_finite() || offset.fract() != 0.0 || offset < min || offset > 2f64.powi(53) {
             return Err(ReadError::format(
@@ -380,6 +391,7 @@ mod tests {
         Header {
             version: Version::One,
             endian: Endian::Little,
+            paired: false,
             dim: [3, 4, 5, 6, 1, 1, 1, 1],
             datatype: 4,
             bitpix: 16,

@@ -1,4 +1,5 @@
-//! NIfTI-1 and NIfTI-2 single-file images (`.nii`, `.nii.gz`): reader and NIfTI-1 writer.
+//! NIfTI-1 and NIfTI-2 images: single files (`.nii`, `.nii.gz`) and header/image pairs
+//! (`.hdr` + `.img`, read only): reader and NIfTI-1 writer.
 //!
 //! Reading streams the file (through a gzip decoder when it starts with the gzip magic, whatever
 //! its name) and keeps no more than the header and the first 3-D volume's voxels; a gzip stream
@@ -22,6 +23,7 @@ mod write;
 pub use write::write;
 
 use crate::compressed;
+use crate::detached;
 use crate::error::{ReadError, Result};
 use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::{read_voxels, Endian, Rescale};
@@ -30,29 +32,19 @@ use flate2::read::MultiGzDecoder;
 use header::Header;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Reads a NIfTI-1 or NIfTI-2 file, plain or gzip-compressed.
+/// Reads a NIfTI-1 or NIfTI-2 file, plain or gzip-compressed: a single file (`.nii`), or a
+/// header (`.hdr`) whose voxels are in the `.img` beside it (each plain or gzip).
 ///
 /// Only the first volume of a 4-D series is read (with a warning). Errors: a header that is
-/// neither NIfTI version, a `.hdr`/`.img` pair, RGB or complex voxels (unsupported), bad dims,
-/// pixdim or `vox_offset`, a transform that is not a voxel grid, more voxels than
+/// neither NIfTI version, RGB or complex voxels (unsupported), bad dims, pixdim or
+/// `vox_offset`, a missing `.img`, a transform that is not a voxel grid, more voxels than
 /// `options.limits` allow, and data that ends early.
 pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
-    let file = File::open(path).map_err(|e| ReadError::io(path, e))?;
-    let file_len = file.metadata().map_err(|e| ReadError::io(path, e))?.len();
-    let mut buffered = BufReader::new(file);
-    let gzip = buffered
-        .fill_buf()
-        .map_err(|e| ReadError::io(path, e))?
-        .starts_with(&[0x1f, 0x8b]);
-    let mut reader: Box<dyn Read> = if gzip {
-        Box::new(MultiGzDecoder::new(buffered))
-    } else {
-        Box::new(buffered)
-    };
-
-    let header = header::read_header(path, &mut reader)?;
+    let mut stream = Stream::open(path)?;
+    let header = header::read_header(path, &mut stream.reader)?;
+    stream.position = header.version.header_size() as u64;
     let mut warnings = Vec::new();
     let element = header.element_type(path)?;
     if i64::from(header.bitpix) != 8 * element.size() as i64 {
@@ -67,23 +59,19 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let (dims, volumes) = header.volume_dims(path, &mut warnings)?;
     let count = options.limits.check_dims(path, &dims)?;
     let vox_offset = header.data_offset(path)?;
-    if !gzip {
-        check_file_holds(
-            path,
-            file_len,
-            vox_offset,
-            count as u64 * element.size() as u64,
-        )?;
-    }
-    skip_to_voxels(
-        path,
-        &mut reader,
-        header.version.header_size() as u64,
-        vox_offset,
-    )?;
+    let mut data = if header.paired {
+        let image = image_file(path)?;
+        detached::data_file_len(path, &image)?;
+        Stream::open(&image)?
+    } else {
+        stream
+    };
+    let data_bytes = count as u64 * element.size() as u64;
+    data.check_holds(vox_offset, data_bytes)?;
+    data.skip_to(vox_offset)?;
     let (voxels, map) = read_voxels(
-        path,
-        &mut reader,
+        &data.path,
+        &mut data.reader,
         element,
         header.endian,
         count,
@@ -91,16 +79,15 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         &mut warnings,
     )
     .map_err(|e| {
-        if gzip {
+        if data.gzip {
             compressed::io_as_corrupt(e, "gzip")
         } else {
             e
         }
     })?;
-    if gzip {
-        let volume_bytes = count as u64 * element.size() as u64;
-        let rest = (volumes - 1).saturating_mul(volume_bytes);
-        compressed::finish(path, &mut reader, "gzip", rest)?;
+    if data.gzip {
+        let rest = (volumes - 1).saturating_mul(data_bytes);
+        compressed::finish(&data.path, &mut data.reader, "gzip", rest)?;
     }
 
     // check_dims proved the product fits usize, so each factor does.
@@ -110,9 +97,101 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         .map_err(|e| ReadError::format(path, e.to_string()))?;
     Ok(Loaded {
         volume,
-        source: SourceInfo::new(Format::Nifti, stored_type(&header, element.name(), gzip)),
+        source: SourceInfo::new(
+            Format::Nifti,
+            stored_type(&header, element.name(), data.gzip),
+        ),
         warnings,
     })
+}
+
+/// The `.img` of the pair whose header is `path` (`x.hdr` → `x.img`, `x.hdr.gz` → `x.img.gz`,
+/// in the header's case).
+fn image_file(path: &Path) -> Result<PathBuf> {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    let lower = name.to_ascii_lowercase();
+    let Some(at) = lower
+        .rfind(".hdr")
+        .filter(|&at| matches!(&lower[at + 4..], "" | ".gz"))
+    else {
+        return Err(ReadError::format(
+            path,
+            "the header of a .hdr/.img pair (magic ni1 or ni2) must be named .hdr or .hdr.gz",
+        ));
+    };
+    let img = if &name[at + 1..at + 4] == "HDR" {
+        "IMG"
+    } else {
+        "img"
+    };
+    Ok(path.with_file_name(format!("{}.{img}{}", &name[..at], &name[at + 4..])))
+}
+
+/// A NIfTI file being read: its bytes, inflated when it starts with the gzip magic.
+struct Stream {
+    path: PathBuf,
+    reader: Box<dyn Read>,
+    gzip: bool,
+    /// The file's length on disk.
+    len: u64,
+    /// Bytes of the (inflated) data read so far.
+    position: u64,
+}
+
+impl Stream {
+    fn open(path: &Path) -> Result<Self> {
+        let file = File::open(path).map_err(|e| ReadError::io(path, e))?;
+        let len = file.metadata().map_err(|e| ReadError::io(path, e))?.len();
+        let mut buffered = BufReader::new(file);
+        let gzip = buffered
+            .fill_buf()
+            .map_err(|e| ReadError::io(path, e))?
+            .starts_with(&[0x1f, 0x8b]);
+        let reader: Box<dyn Read> = if gzip {
+            Box::new(MultiGzDecoder::new(buffered))
+        } else {
+            Box::new(buffered)
+        };
+        Ok(Self {
+            path: path.to_path_buf(),
+            reader,
+            gzip,
+            len,
+            position: 0,
+        })
+    }
+
+    /// Refuses a file that cannot hold `data_bytes` of voxels from `vox_offset` (stored, or
+    /// inflated from what is stored), before they are allocated.
+    fn check_holds(&self, vox_offset: u64, data_bytes: u64) -> Result<()> {
+        if self.gzip {
+            let needed = vox_offset.saturating_add(data_bytes);
+            return compressed::check_inflates_to(&self.path, "gzip", self.len, needed);
+        }
+        check_file_holds(&self.path, self.len, vox_offset, data_bytes)
+    }
+
+    /// Skips the extensions (or whatever lies) before `vox_offset`, storing nothing.
+    fn skip_to(&mut self, vox_offset: u64) -> Result<()> {
+        let wanted = vox_offset - self.position;
+        let skipped = io::copy(&mut (&mut self.reader).take(wanted), &mut io::sink())
+            .map_err(|e| ReadError::io(&self.path, e))?;
+        if skipped < wanted {
+            return Err(ReadError::format(
+                &self.path,
+                format!(
+                    "vox_offset {vox_offset} lies beyond the end of the decompressed data ({} \
+                     bytes)",
+                    self.position + skipped
+                ),
+            ));
+        }
+        self.position = vox_offset;
+        Ok(())
+    }
 }
 
 /// E.g. `uint8 (NIfTI-1, gzip)` or `int16 (NIfTI-2, big-endian)`.
@@ -142,28 +221,6 @@ fn check_file_holds(path: &Path, file_len: u64, vox_offset: u64, data_bytes: u64
             format!(
                 "the voxel data ends early: the header needs {needed} bytes \
                  ({data_bytes} from offset {vox_offset}), the file has {file_len}"
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// Skips the extensions between the header (already read) and `vox_offset`, storing nothing.
-fn skip_to_voxels(
-    path: &Path,
-    reader: &mut dyn Read,
-    header_size: u64,
-    vox_offset: u64,
-) -> Result<()> {
-    let wanted = vox_offset - header_size;
-    let skipped =
-        io::copy(&mut reader.take(wanted), &mut io::sink()).map_err(|e| ReadError::io(path, e))?;
-    if skipped < wanted {
-        return Err(ReadError::format(
-            path,
-            format!(
-                "vox_offset {vox_offset} lies beyond the end of the decompressed data ({} bytes)",
-                header_size + skipped
             ),
         ));
     }

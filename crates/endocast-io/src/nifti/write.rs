@@ -77,6 +77,7 @@ fn header_for(volume: &Volume) -> Header {
     Header {
         version: Version::One,
         endian: Endian::Little,
+        paired: false,
         dim: [3, ni, nj, nk, 1, 1, 1, 1],
         datatype: header::datatype_code(element),
         bitpix: 8 * element.size() as i16,

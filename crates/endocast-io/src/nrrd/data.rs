@@ -9,6 +9,7 @@
 use super::fields::{ByteSkip, DataFiles, Encoding};
 use super::header::Header;
 use crate::compressed;
+use crate::detached;
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
 use crate::samples::{read_voxels, ElementType, Endian, Rescale};
@@ -17,6 +18,10 @@ use flate2::read::MultiGzDecoder;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, ErrorKind, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
+
+/// Most surplus bytes counted after a segment's samples: enough to warn, never a read to the
+/// end of a huge file.
+const SURPLUS_PROBE: u64 = 1 << 20;
 
 /// One file's share of the samples.
 #[derive(Debug)]
@@ -40,8 +45,9 @@ pub(super) fn read_samples(
 ) -> Result<(Vec<u16>, ValueMap)> {
     let segments = segments(header_path, header, count, limits)?;
     for segment in &segments {
-        // Name a missing slice before reading any of the others.
-        std::fs::metadata(&segment.path).map_err(|e| ReadError::io(&segment.path, e))?;
+        // Name a missing, misplaced or short slice before allocating or reading anything.
+        let len = detached::data_file_len(header_path, &segment.path)?;
+        check_holds(segment, header, len)?;
     }
     let mut chain = Chain {
         segments: &segments,
@@ -72,9 +78,14 @@ pub(super) fn read_samples(
         (Err(_), Some(failure)) => Err(failure),
         (result, _) => {
             for (path, bytes) in chain.surplus {
+                let at_least = if bytes == SURPLUS_PROBE {
+                    "at least "
+                } else {
+                    ""
+                };
                 warnings.push(format!(
-                    "{}: {bytes} bytes of data beyond the samples that sizes {:?} describe \
-                     were ignored",
+                    "{}: {at_least}{bytes} bytes of data beyond the samples that sizes {:?} \
+                     describe were ignored",
                     path.display(),
                     header.sizes
                 ));
@@ -134,6 +145,39 @@ fn segments(
             bytes: per_file * sample_bytes,
         })
         .collect())
+}
+
+/// Refuses a file too small to hold its segment's samples in the header's encoding, before
+/// the voxels are allocated: `len` is the file's length. A line skip only adds to what is
+/// needed, so this lower bound never refuses a valid file.
+fn check_holds(segment: &Segment, header: &Header, len: u64) -> Result<()> {
+    let stored = len.saturating_sub(segment.offset);
+    let skip = match header.byte_skip {
+        ByteSkip::Bytes(n) => n,
+        ByteSkip::ToEnd => 0,
+    };
+    let needed = segment.bytes.saturating_add(skip);
+    let holds = match header.encoding {
+        Encoding::Raw => needed <= stored,
+        Encoding::Gzip => {
+            return compressed::check_inflates_to(&segment.path, "gzip", stored, needed)
+        }
+        // At least one digit a sample; two hex digits a byte.
+        Encoding::Ascii => segment.bytes / header.element.size() as u64 <= stored,
+        Encoding::Hex => needed <= stored / 2,
+    };
+    if holds {
+        return Ok(());
+    }
+    Err(ReadError::format(
+        &segment.path,
+        format!(
+            "the header's sizes {:?} need {needed} bytes of samples here, but the file holds \
+             only {stored} bytes of {} data: the sizes or the file are wrong",
+            header.sizes,
+            header.encoding.name()
+        ),
+    ))
 }
 
 /// The segments' decoded bytes, one after the other, as one stream.
@@ -210,13 +254,14 @@ impl Read for Chain<'_> {
 
 /// Reads what a segment holds after its share of the samples: a gzip stream must end there
 /// (its CRC and length checked; more inflated data is corruption), other encodings may carry
-/// surplus bytes, whose count is returned (to be warned about).
+/// surplus bytes, whose count (up to [`SURPLUS_PROBE`]) is returned (to be warned about).
 fn finish_segment(segment: &Segment, encoding: Encoding, reader: &mut dyn Read) -> Result<u64> {
     if encoding == Encoding::Gzip {
         compressed::finish(&segment.path, reader, "gzip", 0)?;
         return Ok(0);
     }
-    io::copy(reader, &mut io::sink()).map_err(|e| segment_error(segment, e))
+    io::copy(&mut reader.take(SURPLUS_PROBE), &mut io::sink())
+        .map_err(|e| segment_error(segment, e))
 }
 
 /// Operating-system errors stay I/O errors; anything else (a short file, a corrupt gzip

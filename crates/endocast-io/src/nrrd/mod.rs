@@ -1,13 +1,14 @@
 //! NRRD, the format of teem and 3D Slicer: a text header followed by the samples (`.nrrd`), or
 //! a header naming the file(s) that hold them (`.nhdr`).
 //!
-//! Read: every sample type of the spec, raw, gzip, ascii or hex encoding (not bzip2), either byte order, `line skip` and
-//! `byte skip` (−1 included), a single detached file, a `LIST` of files or a `%d` pattern of
-//! slice files, 2-D images (as one slice) and 4-D files whose first axis has size 1. Geometry
-//! comes from `space directions` and `space origin` in any anatomical space (converted to LPS),
-//! or from the older `spacings` and `axis mins` as an axis-aligned grid. Spaces without an
-//! anatomical meaning (`scanner-xyz`, `3D-right-handed`, `3D-left-handed`) are read as LPS with
-//! a warning.
+//! Read: every sample type of the spec, raw, gzip, ascii or hex encoding (not bzip2), either
+//! byte order, `line skip` and `byte skip` (−1 included), a single detached file, a `LIST` of
+//! files or a `%d` pattern of slice files (regular files in the header's folder or below it,
+//! each checked to hold its share of the samples before anything is allocated), 2-D images (as
+//! one slice) and 4-D files whose first axis has size 1. Geometry comes from `space directions`
+//! and `space origin` in any anatomical space (converted to LPS), or from the older `spacings`
+//! and `axis mins` as an axis-aligned grid. Spaces without an anatomical meaning
+//! (`scanner-xyz`, `3D-right-handed`, `3D-left-handed`) are read as LPS with a warning.
 //!
 //! Written: see [`write`].
 
