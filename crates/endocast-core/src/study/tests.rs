@@ -94,7 +94,7 @@ fn the_lumen_threshold_follows_the_wall_but_never_comes_near_air() {
 fn a_scan_stored_as_hu_plus_1024_resolves_the_preset_in_its_own_units() {
     let hu = phantom(Phantom::Sinus, 48);
     let shifted = Volume::new(
-        hu.geometry().clone(),
+        *hu.geometry(),
         hu.voxels().to_vec(),
         ValueMap::new(1.0, 0.0).unwrap(),
         Modality::Unknown,
