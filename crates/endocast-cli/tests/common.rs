@@ -67,3 +67,10 @@ pub fn read_npy(path: &std::path::Path) -> ((usize, usize), Vec<f32>) {
         .collect();
     ((dims[0], dims[1]), values)
 }
+
+/// The share of the pixels of a `--depth-out` image whose ray met the wall.
+pub fn hit_share(depth: &std::path::Path) -> f64 {
+    let (_, values) = read_npy(depth);
+    let hits = values.iter().filter(|d| d.is_finite()).count();
+    hits as f64 / values.len() as f64
+}

@@ -2,7 +2,7 @@
 //! every phantom (the wall on the scan's own background/object boundary), and a path that would
 //! run away is refused at once with a message that says why.
 
-use crate::common::{endocast, read_npy};
+use crate::common::{endocast, hit_share};
 use endocast_testdata::shared_data;
 use std::path::Path;
 
@@ -36,9 +36,7 @@ fn hit_fraction(volume: &Path, dir: &Path) -> (f64, String) {
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(out.status.success(), "{}: {stderr}", volume.display());
-    let (_, values) = read_npy(&depth);
-    let hits = values.iter().filter(|d| d.is_finite()).count();
-    (hits as f64 / values.len() as f64, stderr)
+    (hit_share(&depth), stderr)
 }
 
 /// The object fills part of the frame, not none of it and not all of it, and no warning says

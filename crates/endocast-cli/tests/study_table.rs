@@ -4,7 +4,7 @@
 //! automatic path; and without a preset the object fills at least a third of the image.
 //! (Python's `default_view` is compared with `render --json` in the Python suite.)
 
-use crate::common::{endocast, numbers, read_npy};
+use crate::common::{endocast, hit_share, numbers};
 use endocast_core::presets::Preset;
 use endocast_testdata::shared_data;
 use endocast_viewer::scene::{ScanSource, Scene};

@@ -4,7 +4,7 @@
 //! compiler alone. Only single-component (grey-scale) streams are decoded, which is all a
 //! volume can hold.
 
-use dicom_encoding::adapters::PixelDataObject;
+use super::frame::compressed_frame;
 use dicom_object::DefaultDicomObject;
 
 /// JPEG-LS Lossless and JPEG-LS Lossy (Near-Lossless).
@@ -23,13 +23,7 @@ pub(super) fn decode_frame(
     frame: u32,
     max_sample: u16,
 ) -> Result<Vec<u16>, String> {
-    let (rows, columns) = match (object.rows(), object.cols()) {
-        (Some(rows), Some(columns)) => (rows, columns),
-        _ => return Err("Rows or Columns is missing".into()),
-    };
-    let data = object
-        .frame_pixel_data(frame)
-        .ok_or_else(|| format!("no compressed data for frame {frame}"))?;
+    let (rows, columns, data) = compressed_frame(object, frame)?;
     // The decoder refuses a stream whose size differs from the one given.
     let (samples, _, _) =
         jpegls::decode(&data, u32::from(columns), u32::from(rows)).map_err(|e| e.to_string())?;

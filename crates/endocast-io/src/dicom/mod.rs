@@ -46,6 +46,7 @@
 //! PixelPaddingValue voxels take the lowest real value of the series (warned). MONOCHROME1 is
 //! inverted so that bright means high, except for CT, whose Hounsfield units are kept.
 
+mod frame;
 mod jpegls;
 mod lengths;
 mod pixels;

@@ -8,7 +8,7 @@
 //! bytes: nothing is allocated beyond the frame, and a segment that decodes to fewer bytes is
 //! an error, not a zero-filled image.
 
-use dicom_encoding::adapters::PixelDataObject;
+use super::frame::compressed_frame;
 use dicom_object::DefaultDicomObject;
 
 /// RLE Lossless.
@@ -28,13 +28,7 @@ pub(super) fn decode_frame(
     frame: u32,
     bytes_per_sample: usize,
 ) -> Result<Vec<u8>, String> {
-    let (rows, columns) = match (object.rows(), object.cols()) {
-        (Some(rows), Some(columns)) => (rows, columns),
-        _ => return Err("Rows or Columns is missing".into()),
-    };
-    let data = object
-        .frame_pixel_data(frame)
-        .ok_or_else(|| format!("no compressed data for frame {frame}"))?;
+    let (rows, columns, data) = compressed_frame(object, frame)?;
     let pixels = usize::from(rows) * usize::from(columns);
     let segments = segments(&data, bytes_per_sample)?;
     let mut out = vec![0u8; pixels * bytes_per_sample];
