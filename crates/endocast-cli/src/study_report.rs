@@ -13,10 +13,19 @@ use serde_json::{json, Value};
 pub fn say(study: &Study) {
     eprintln!("{}", study.summary());
     if let Some(what) = study.structure_name() {
+        if study.confident() {
+            eprintln!("found the {what}");
+        } else {
+            eprintln!("warning: {what}");
+        }
         let p = study.start_pose();
+        let along = if study.path().is_some() {
+            "looking along the automatic path"
+        } else {
+            "looking along the structure"
+        };
         eprintln!(
-            "found the {what}\nstart inside it, looking along the automatic path: --eye {} \
-             --look-at {} --up {}",
+            "start inside it, {along}: --eye {} --look-at {} --up {}",
             triple(p.eye_mm),
             triple(p.look_at_mm),
             triple(p.up)
@@ -50,6 +59,7 @@ pub fn to_json(study: &Study) -> Value {
         "lumen": lumen,
         "window": {"level": window.level_hu, "width": window.width_hu},
         "structure": study.structure_name(),
+        "confident": study.confident(),
         "framing": study.framing(),
         "start": pose_json(&study.start_pose()),
         "path_mm": study.path().map(|p| p.path.len_mm()),

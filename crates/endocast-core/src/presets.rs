@@ -118,6 +118,9 @@ pub enum Structure {
     /// mid-sagittal plane, cut off from the outside air at the nostrils (see
     /// [`crate::navigate::find_nasal_cavity`]).
     NasalCavity,
+    /// A joint space: the dark gap where the two largest bones' marrow comes closest (see
+    /// [`crate::navigate::find_joint`]).
+    Joint,
 }
 
 /// The scale a preset's values are written on; [`crate::tissue::resolve`] carries them to a
@@ -360,11 +363,11 @@ pub const ALL: &[Preset] = &[
     Preset {
         name: "arthroscopy",
         description:
-            "T1 MRI joint: from inside one bone, the opposing bone's surface past the joint \
-                      space (peel back into tissue above 30)",
+            "T1 MRI joint: from the joint space, the surfaces of the bones around it (peel \
+                      back into tissue above 30)",
         mode: Mode::Peel,
         tf: "arthroscopy",
-        // The peel draws the opposing bone as an opaque surface.
+        // The peel draws the bones' surface as an opaque one.
         iso: 30.0,
         iso_opacity: 1.0,
         iso_color: Some([0.93, 0.88, 0.78]),
@@ -373,19 +376,20 @@ pub const ALL: &[Preset] = &[
         // two-class Otsu splits the dark joint space, cortex and menisci (mean 24) from marrow
         // (48) at 36, but 36 lies inside the femoral marrow's texture (median 41, quartile 34),
         // which would peel; 30 lies midway between the dark class and the tibial marrow's 10th
-        // percentile (35). From inside one bone the first crossing back above it is the other.
+        // percentile (35). From the joint space the first crossing above it is a bone's surface.
         peel: Some(PresetPeel {
             threshold: 30.0,
             falling: false,
             layer: PeelLayer::Nth(1),
             tf_after: "arthroscopy",
         }),
-        // The bones' marrow is the "lumen" the eye starts in.
+        // The dark joint space between the bones is the lumen the eye starts in: from there
+        // the peel's first rise above 30 is the bones' surface.
         lumen: Some(PresetLumen {
             threshold: 30.0,
-            side: LumenSide::Above,
-            tissue: "marrow",
-            structure: Structure::Largest,
+            side: LumenSide::Below,
+            tissue: "joint space",
+            structure: Structure::Joint,
         }),
         // T1 intensity units: joint space black, marrow light grey.
         window: Window {
@@ -396,9 +400,10 @@ pub const ALL: &[Preset] = &[
         fov_deg: DEFAULT_FOV_DEG,
         reference: Reference::AsGiven,
         look: PresetLook {
-            // The marrow is the "lumen" (above the threshold): the secretion lies above too.
+            // The joint space is the lumen (below the threshold): fluid in it (the secretion,
+            // off) lies below too.
             tissue: 30.0,
-            secretion: 40.0,
+            secretion: 20.0,
             secretion_mode: SecretionMode::Off,
             wetness: 0.3,
             texture: "none",

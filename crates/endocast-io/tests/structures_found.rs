@@ -1,14 +1,18 @@
-//! Issue 17 on the shared scans: each endoscopic preset, with no point given, finds the
-//! structure it means and starts inside it — the aorta (not the spine or the kidneys) on the
-//! abdomen and the stent CTA, the colon (not the lung) on the abdomen, the airway tree on the
-//! chest, the nasal air on CThead. Each start is checked three ways: the value at the eye is on
-//! the lumen side, the eye lies in a landmark region written down from the data, and most rays
-//! of a small iso render from it hit the wall at depths that organ allows. Each scan is loaded
-//! once.
+//! Issues 17 and 31 on the shared scans: each endoscopic preset, with no point given, finds
+//! the structure it means and starts inside it — the aorta (not the spine or the kidneys) on
+//! the abdomen and the stent CTA, the colon (not the lung) on the abdomen, the airway tree on
+//! the chest, the nasal air on CThead and the GE head (away from the scan's cut faces), the
+//! lateral ventricles on the skull-stripped FLAIR, the joint space on both knees — and the
+//! nasal path keeps an endoscope's clearance to the nasopharynx. Each start is checked three
+//! ways: the value at the eye is on the lumen side, the eye lies in a landmark region written
+//! down from the data, and most rays of a small iso render from it hit the wall at depths that
+//! organ allows. Each scan is loaded once.
 
 use endocast_core::navigate::{
-    default_view, find_aorta, DefaultView, Lumen, LumenChoice, LumenSide,
+    default_view, find_aorta, find_nasal_cavity, plan_in, DefaultView, DistanceField, Lumen,
+    LumenChoice, LumenSide, PathEnd, FACE_MARGIN_MM, NOT_CONFIDENT, SCOPE_RADIUS_MM,
 };
+use endocast_core::path::SmoothOptions;
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::{Camera, Mode, RenderSettings, Renderer};
@@ -41,6 +45,7 @@ fn load(name: &'static str) -> Option<&'static Volume> {
 /// What a preset found with no point given.
 struct Start {
     pose: Pose,
+    threshold: f64,
     lumen: Lumen,
     end_mm: Option<DVec3>,
     what: String,
@@ -104,6 +109,7 @@ fn start(volume: &Volume, name: &str) -> Start {
     );
     Start {
         pose,
+        threshold,
         eye_in_lumen: side.holds(value, threshold),
         lumen: *lumen,
         end_mm,
@@ -311,4 +317,146 @@ fn colonoscopy_on_the_abdomen_starts_in_colon_gas_not_the_lung_nor_the_table() {
     assert!(!s
         .lumen
         .contains(to_voxel(DVec3::new(-152.54, 231.18, 460.91))));
+}
+
+/// The lumen's volume, ml.
+fn ml(volume: &Volume, lumen: &Lumen) -> f64 {
+    let s = volume.geometry().spacing_mm();
+    lumen.voxel_count() as f64 * s.x * s.y * s.z / 1000.0
+}
+
+#[test]
+fn ventricles_on_the_skull_stripped_flair_are_the_lateral_ventricles_not_a_pocket() {
+    let Some(flair) = load("brain-mri-flair-nrrd/FLAIR.nrrd") else {
+        return;
+    };
+    let s = start(flair, "ventricles");
+    let volume_ml = ml(flair, &s.lumen);
+    eprintln!(
+        "ventricles on the FLAIR: {volume_ml:.1} ml at {}",
+        s.threshold
+    );
+    // It took a 1.0 ml pocket beside them: in this skull-stripped scan the ventricles join
+    // the background (0) through the CSF at the brain's surface at every threshold.
+    assert!(s.what.starts_with("central CSF component"), "{}", s.what);
+    assert!((7.0..=30.0).contains(&volume_ml), "{volume_ml} ml");
+    assert!(s.eye_in_lumen, "the eye is in the wall");
+    // Measured on the axial slices (1 mm voxels, oblique; CSF 16-47 against tissue 100-150):
+    // the two lateral ventricles' bodies at i 50-56 and 62-66, j 75-105, k 80-84.
+    for v in [[52, 95, 84], [54, 100, 84], [64, 95, 84]] {
+        assert!(s.lumen.contains(v), "{v:?} not in the ventricles");
+    }
+}
+
+#[test]
+fn arthroscopy_on_both_knees_starts_in_the_joint_space_and_plans_a_path_in_it() {
+    // Measured on the slices (1 x 0.97 x 1 mm, identity; k runs up the leg): the tibial
+    // plateau's marrow ends and the femoral condyles' begins across a dark gap (below 30) at
+    // dataT: i 60-95, k 47-53; dataR: i 75-100, k 42-50 (j 10-50 both).
+    for (name, i, k) in [
+        ("knee-mri/knee3D_dataT.mha", 60.0..=95.0, 44.0..=56.0),
+        ("knee-mri/knee3D_dataR.mha", 75.0..=100.0, 40.0..=52.0),
+    ] {
+        let Some(knee) = load(name) else {
+            return;
+        };
+        let s = start(knee, "arthroscopy");
+        let v = knee
+            .geometry()
+            .voxel_from_world()
+            .transform_point3(s.pose.eye_mm);
+        eprintln!("{name}: eye voxel {v:.1}, {:.1} ml", ml(knee, &s.lumen));
+        // It started in the tibial marrow, in a "lumen" of everything above 30 (126-138 ml).
+        assert!(s.what.starts_with("joint space"), "{name}: {}", s.what);
+        assert!(s.eye_in_lumen, "{name}: the eye is not in the dark gap");
+        assert!(
+            i.contains(&v.x) && k.contains(&v.z) && (10.0..=50.0).contains(&v.y),
+            "{name}: eye at voxel {v}: not in the joint"
+        );
+        assert!(s.lumen.leak().is_none(), "{name}: the joint space leaks");
+        // `path --preset arthroscopy` refused the lumen the preset found: now a path runs.
+        let (_, planned) = plan_in(
+            knee,
+            &s.lumen,
+            s.pose.eye_mm,
+            PathEnd::Farthest,
+            &SmoothOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        eprintln!("{name}: path {:.1} mm", planned.path.len_mm());
+    }
+}
+
+#[test]
+fn sinus_on_the_gantry_tilt_head_starts_away_from_the_scans_cut_faces() {
+    let Some(head) = load("head-ct-ge-gantry-tilt/GE") else {
+        return;
+    };
+    let s = start(head, "sinus");
+    assert!(s.eye_in_lumen, "the eye is in the wall");
+    // The camera sat 4 mm above the bottom slice: a third of the image was the cut plane.
+    let v = head
+        .geometry()
+        .voxel_from_world()
+        .transform_point3(s.pose.eye_mm);
+    let dims = head.dims();
+    let spacing = head.geometry().spacing_mm().to_array();
+    let from_faces = (0..3)
+        .map(|a| v[a].min(dims[a] as f64 - 1.0 - v[a]) * spacing[a])
+        .fold(f64::INFINITY, f64::min);
+    eprintln!("GE sinus: eye voxel {v:.1}, {from_faces:.1} mm from the faces");
+    assert!(from_faces >= FACE_MARGIN_MM, "{from_faces} mm from a face");
+    // The 28 slices run from the skull base up: the passages an endoscope would take are not
+    // in the scan, and the finder says so.
+    assert!(s.what.starts_with(NOT_CONFIDENT), "{}", s.what);
+}
+
+#[test]
+fn the_nasal_path_on_cthead_keeps_the_scopes_clearance_and_ends_at_the_nasopharynx() {
+    let Some(head) = load("head-ct-stanford-cthead/CThead.nhdr") else {
+        return;
+    };
+    let s = start(head, "sinus");
+    assert!(!s.what.starts_with(NOT_CONFIDENT), "{}", s.what);
+    let end = s
+        .end_mm
+        .expect("the nasal cavity's path ends at the nasopharynx");
+    let (_, planned) = plan_in(
+        head,
+        &s.lumen,
+        s.pose.eye_mm,
+        PathEnd::Point(end),
+        &SmoothOptions::default(),
+    )
+    .unwrap();
+    // Against the walls of all the passages, not only of the route.
+    let passages = find_nasal_cavity(head, s.threshold).unwrap().passages;
+    let field = DistanceField::new(&passages, head.geometry());
+    let clearance = planned
+        .path
+        .samples()
+        .iter()
+        .map(|p| field.distance_mm(p.position_mm))
+        .fold(f64::INFINITY, f64::min);
+    let last = planned.path.samples().last().unwrap().position_mm;
+    eprintln!(
+        "CThead nasal path: {:.1} mm, clearance {clearance:.2} mm, from {:.1} to {last:.1}",
+        planned.path.len_mm(),
+        s.pose.eye_mm
+    );
+    // It ran 208 mm to the farthest point, a loop ending 10 mm from its start, through gaps
+    // of 0.25 mm. Measured on the sagittal slices near the septum (world x = i, y = j,
+    // z = 2k): the inferior meatus runs back at k 56-60 from the start (j 47) to the
+    // choanae (j 95-107, k 46-66).
+    assert!(clearance >= SCOPE_RADIUS_MM, "{clearance} mm from the wall");
+    assert!(
+        last.distance(s.pose.eye_mm) > 40.0,
+        "{last}: back near the start"
+    );
+    assert!(last.y >= 90.0, "{last}: not at the choanae");
+    assert!(
+        planned.path.len_mm() < 100.0,
+        "{} mm",
+        planned.path.len_mm()
+    );
 }

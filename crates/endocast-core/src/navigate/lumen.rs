@@ -253,30 +253,81 @@ impl Lumen {
         volume: &Volume,
         threshold: f64,
         side: LumenSide,
+        region: ([usize; 3], [usize; 3]),
+    ) -> Result<Option<Self>, NavError> {
+        Self::largest_through_box_in(volume, threshold, side, region, None)
+    }
+
+    /// [`Lumen::largest_through_box`] among the voxels `allowed` (one bit per voxel of the
+    /// volume) holds, when given: the ventricles cut off from the CSF at the brain's surface.
+    pub(crate) fn largest_through_box_in(
+        volume: &Volume,
+        threshold: f64,
+        side: LumenSide,
         (lo, hi): ([usize; 3], [usize; 3]),
+        allowed: Option<&BitGrid>,
     ) -> Result<Option<Self>, NavError> {
         check_finite("threshold", threshold, false)?;
         let dims = volume.dims();
         let hi = [0, 1, 2].map(|a| hi[a].min(dims[a] - 1));
         let test = ValueTest::new(volume.value_map(), threshold, side);
+        let on_side = test.on(volume);
+        let holds = |n: usize| on_side(n) && allowed.is_none_or(|a| a.get_linear(n));
         let mut visited = BitGrid::new(dims);
         let mut best: Option<Component> = None;
         for k in lo[2]..=hi[2] {
             for j in lo[1]..=hi[1] {
                 for i in lo[0]..=hi[0] {
                     let v = [i, j, k];
-                    if visited.get(v) || !test.holds(volume.voxels()[volume.index(i, j, k)]) {
+                    if visited.get(v) || !holds(volume.index(i, j, k)) {
                         continue;
                     }
-                    let c = fill(dims, test.on(volume), v, &mut visited);
+                    let c = fill(dims, holds, v, &mut visited);
                     if !c.touches_border(dims) && best.is_none_or(|b| c.count > b.count) {
                         best = Some(c);
                     }
                 }
             }
         }
-        best.map(|c| Self::from_seed(volume, c.seed, threshold, side))
-            .transpose()
+        best.map(|c| match allowed {
+            Some(allowed) => Self::within(volume, c.seed, threshold, side, allowed),
+            None => Self::from_seed(volume, c.seed, threshold, side),
+        })
+        .transpose()
+    }
+
+    /// The object of `volume`: the largest component of the voxels not 6-connected to the
+    /// volume's border through voxels on `side` of `threshold` (the background around it), its
+    /// holes filled whatever they hold: a skull-stripped brain with the dark CSF inside it.
+    /// It keeps the background's threshold and side. `Ok(None)` when the background fills the
+    /// volume.
+    pub(crate) fn object(
+        volume: &Volume,
+        threshold: f64,
+        side: LumenSide,
+    ) -> Result<Option<Self>, NavError> {
+        check_finite("threshold", threshold, false)?;
+        let dims = volume.dims();
+        let test = ValueTest::new(volume.value_map(), threshold, side);
+        let on_side = test.on(volume);
+        let mut background = BitGrid::new(dims);
+        for n in 0..dims[0] * dims[1] * dims[2] {
+            let v = [n % dims[0], n / dims[0] % dims[1], n / (dims[0] * dims[1])];
+            let border = (0..3).any(|a| v[a] == 0 || v[a] + 1 == dims[a]);
+            if border && on_side(n) && !background.get_linear(n) {
+                fill(dims, &on_side, v, &mut background);
+            }
+        }
+        let inside = |n: usize| !background.get_linear(n);
+        let Some(largest) = components_where(dims, inside)
+            .into_iter()
+            .max_by_key(|c| c.count)
+        else {
+            return Ok(None);
+        };
+        let mut visited = BitGrid::new(dims);
+        let c = fill(dims, inside, largest.seed, &mut visited);
+        Ok(Some(Self::from_visited(&visited, c, dims, threshold, side)))
     }
 
     /// Copies the component's bits out of the volume-wide visited set into its bounding box.
@@ -465,6 +516,23 @@ impl<'a> LumenNumbering<'a> {
         let below = self.lumen.mask.words[n >> 6] & ((1u64 << (n & 63)) - 1);
         Some(self.before[n >> 6] + below.count_ones() as usize)
     }
+}
+
+/// The `count` largest 6-connected components of the bits set in `grid` (largest first), each
+/// as a grid of its own over the same box.
+pub(crate) fn largest_components(grid: &BitGrid, count: usize) -> Vec<BitGrid> {
+    let dims = grid.dims;
+    let set = |n: usize| grid.get_linear(n);
+    let mut all = components_where(dims, set);
+    all.sort_by_key(|c| std::cmp::Reverse(c.count));
+    all.into_iter()
+        .take(count)
+        .map(|c| {
+            let mut own = BitGrid::new(dims);
+            fill(dims, set, c.seed, &mut own);
+            own
+        })
+        .collect()
 }
 
 /// Every component of the voxels on `side` of `threshold`, in the order their first voxel comes.

@@ -20,11 +20,14 @@
 
 mod aorta;
 mod axial;
+mod central;
 mod centreline;
 mod collision;
 mod colon;
 mod distance;
 mod error;
+mod faces;
+mod joint;
 mod lumen;
 mod nasal;
 mod plan;
@@ -37,6 +40,7 @@ mod trachea;
 mod viewpoint;
 
 pub use aorta::{find_aorta, Aorta};
+pub use central::{CENTRAL_DEPTH_MM, CENTRAL_ML};
 pub use centreline::{
     centreline, snap_radius_mm, CentrelinePath, PathEnd, SNAP_RADIUS_MM, SNAP_RADIUS_VOXELS,
 };
@@ -44,10 +48,17 @@ pub use collision::Collider;
 pub use colon::find_colon;
 pub use distance::DistanceField;
 pub use error::NavError;
+pub use faces::FACE_MARGIN_MM;
+pub use joint::{find_joint, Joint, BONE_CORE_DEPTH_MM, JOINT_REACH_MM, MAX_JOINT_GAP_MM};
 pub use lumen::{Lumen, LumenSide};
-pub use nasal::{find_nasal_cavity, NasalCavity, FRONT_SHARE, PASSAGE_HALF_WIDTH_MM};
+pub use nasal::{
+    find_nasal_cavity, NasalCavity, FRONT_SHARE, MIN_ROUTE_MM, PASSAGE_HALF_WIDTH_MM,
+    SCOPE_RADIUS_MM,
+};
 pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
 pub use trachea::find_trachea;
 pub(crate) use viewpoint::looking_along;
-pub use viewpoint::{default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason};
+pub use viewpoint::{
+    default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason, NOT_CONFIDENT,
+};

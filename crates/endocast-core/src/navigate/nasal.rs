@@ -11,6 +11,7 @@
 
 use super::axial::BodyAxes;
 use super::distance::DistanceField;
+use super::faces::Faces;
 use super::lumen::{BitGrid, Lumen, LumenSide};
 use super::section::neighbours4;
 use crate::Volume;
@@ -34,7 +35,20 @@ pub struct NasalCavity {
     /// Where an endoscope starts, world mm: the most central point of the passages' front
     /// [`FRONT_SHARE`] (anterior, −y in LPS), just behind the nostrils.
     pub start_mm: DVec3,
+    /// Where an endoscope of [`SCOPE_RADIUS_MM`] goes from the start: the passages' voxels
+    /// that far from the wall's surface, joined to the start; `None` when the start itself is
+    /// narrower.
+    pub route: Option<Lumen>,
+    /// Where a flight through the passages ends, world mm: the route's most posterior voxel,
+    /// the nasopharynx behind the choanae (the start where there is no route).
+    pub end_mm: DVec3,
 }
+
+/// The endoscope's radius, mm: the route through the passages keeps it clear of the wall.
+pub const SCOPE_RADIUS_MM: f64 = 1.0;
+/// The shortest route from the start to the nasopharynx taken for the nasal passages, mm
+/// (they are 5–7 cm long in adults).
+pub const MIN_ROUTE_MM: f64 = 20.0;
 
 /// The share of the passages' front-to-back extent in which the start lies: the nasal cavity
 /// proper, before the nasopharynx and the sphenoid sinus behind it, which are wider.
@@ -43,8 +57,9 @@ pub const FRONT_SHARE: f64 = 1.0 / 3.0;
 /// The nasal cavity below `threshold` (air, −500 HU): the largest 6-connected component of the
 /// air holes of the axial slices (air not 4-connected to the slice's border within the slice)
 /// whose extent along `i` (left–right) spans the head's middle (the mean `i` of the voxels at
-/// or above `threshold`), and its passages near that middle. `None` when no such component
-/// exists.
+/// or above `threshold`), its passages near that middle, the start in them, the route an
+/// endoscope of [`SCOPE_RADIUS_MM`] takes from there and its end at their back. `None` when no
+/// such component exists.
 pub fn find_nasal_cavity(volume: &Volume, threshold: f64) -> Option<NasalCavity> {
     if !threshold.is_finite() {
         return None;
@@ -60,35 +75,75 @@ pub fn find_nasal_cavity(volume: &Volume, threshold: f64) -> Option<NasalCavity>
     let reach = (PASSAGE_HALF_WIDTH_MM / spacing[lr]).round() as usize;
     holes.keep_along(lr, middle.saturating_sub(reach)..=middle + reach);
     let passages = Lumen::largest_within(volume, threshold, below, &holes, spans).ok()??;
-    let start_mm = front_centre(volume, &passages);
+    let field = DistanceField::new(&passages, volume.geometry());
+    let start = front_centre(volume, &passages, &field);
+    let start_mm = field.world_of_voxel(start);
+    let route = route_from(volume, &passages, &field, start, threshold);
+    let end_mm = route
+        .as_ref()
+        .and_then(|route| {
+            route
+                .voxels()
+                .map(|v| field.world_of_voxel(v))
+                .max_by(|a, b| a.y.total_cmp(&b.y))
+        })
+        .unwrap_or(start_mm);
     Some(NasalCavity {
         lumen,
         passages,
         start_mm,
+        route,
+        end_mm,
     })
 }
 
-/// The most central voxel (largest distance to the wall) of the front [`FRONT_SHARE`] of
-/// `passages` along world `y`, world mm.
-fn front_centre(volume: &Volume, passages: &Lumen) -> DVec3 {
-    let field = DistanceField::new(passages, volume.geometry());
-    let world: Vec<DVec3> = passages.voxels().map(|v| field.world_of_voxel(v)).collect();
-    let (front, back) = world
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p.y), hi.max(p.y))
+/// The voxels of `passages` (with their distance `field`) at least [`SCOPE_RADIUS_MM`] from
+/// the wall's surface (which lies half a voxel before the wall voxels' centres the field
+/// measures to) joined to `start`; `None` when `start` is not among them.
+fn route_from(
+    volume: &Volume,
+    passages: &Lumen,
+    field: &DistanceField,
+    start: [usize; 3],
+    threshold: f64,
+) -> Option<Lumen> {
+    let clearance = SCOPE_RADIUS_MM + 0.5 * field.min_spacing_mm();
+    let mut wide = BitGrid::new(volume.dims());
+    for v in passages.voxels() {
+        if field.distance_at_voxel(v) >= clearance {
+            wide.set(v);
+        }
+    }
+    Lumen::within(volume, start, threshold, LumenSide::Below, &wide).ok()
+}
+
+/// The most central voxel (largest distance to the wall `field`) of the front [`FRONT_SHARE`]
+/// of `passages` along world `y` that lies [`FACE_MARGIN_MM`](super::FACE_MARGIN_MM) from the
+/// volume's faces; where none does, of the voxels clear of the faces behind it, else of the
+/// front share.
+fn front_centre(volume: &Volume, passages: &Lumen, field: &DistanceField) -> [usize; 3] {
+    let faces = Faces::of(volume);
+    let (front, back) = passages
+        .voxels()
+        .map(|v| field.world_of_voxel(v).y)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+            (lo.min(y), hi.max(y))
         });
     let limit = front + FRONT_SHARE * (back - front);
+    let rank = |v: &[usize; 3]| {
+        (
+            faces.clear(*v),
+            field.world_of_voxel(*v).y <= limit,
+            field.distance_at_voxel(*v),
+        )
+    };
     passages
         .voxels()
-        .zip(&world)
-        .filter(|(_, p)| p.y <= limit)
         .max_by(|a, b| {
-            field
-                .distance_at_voxel(a.0)
-                .total_cmp(&field.distance_at_voxel(b.0))
+            let (a, b) = (rank(a), rank(b));
+            (a.0, a.1).cmp(&(b.0, b.1)).then(a.2.total_cmp(&b.2))
         })
-        .map_or(world[0], |(_, &p)| p)
+        .unwrap_or(passages.seed())
 }
 
 /// The air holes of every axial slice (across `axes.superior`; one bit per voxel), and the mean

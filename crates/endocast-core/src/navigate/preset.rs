@@ -35,13 +35,18 @@ pub struct LumenChoice<'a> {
 /// reaches into `region` and does not touch the volume's border. Where the lumen at the
 /// threshold leaks out (ventricles joined to the CSF around the brain, and through a dark
 /// skull to the background), the threshold is moved towards `floor` in steps until it does
-/// not.
+/// not; where it never does (a skull-stripped brain), the lumen is cut at the object's
+/// surface (see [`crate::navigate::CENTRAL_DEPTH_MM`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Central {
     /// Inclusive voxel box, lowest and highest corner.
     pub region: ([usize; 3], [usize; 3]),
     /// The lumen's own level (CSF), physical units: the threshold never reaches it.
     pub floor: f64,
+    /// The background's level, physical units: the voxels below it joined to the volume's
+    /// border lie outside the object (the head, or a skull-stripped brain), and the structure
+    /// lies deep inside that (see [`crate::navigate::CENTRAL_DEPTH_MM`]).
+    pub background: f64,
 }
 
 /// A lumen choice that names no threshold.

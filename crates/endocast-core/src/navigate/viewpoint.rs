@@ -2,10 +2,13 @@
 //! relevant lumen, looking along it.
 
 use super::aorta::{find_aorta, Aorta};
+use super::central::{find_central, CENTRAL_ML};
 use super::colon::find_colon;
 use super::distance::DistanceField;
+use super::faces::Faces;
+use super::joint::{find_joint, Joint, JOINT_REACH_MM, MAX_JOINT_GAP_MM};
 use super::lumen::{Lumen, LumenSide};
-use super::nasal::{find_nasal_cavity, NasalCavity};
+use super::nasal::{find_nasal_cavity, NasalCavity, MIN_ROUTE_MM, SCOPE_RADIUS_MM};
 use super::preset::{Central, LumenChoice, LumenChoiceError};
 use super::trachea::find_trachea;
 use crate::camera::framing_pose;
@@ -37,11 +40,13 @@ pub fn default_viewpoint(volume: &Volume, threshold_hu: f64, side: LumenSide) ->
     Some(viewpoint_in(volume, &lumen))
 }
 
-/// The camera inside `lumen` (a component of `volume`): at its most central voxel, looking
-/// along its local long axis towards the longer free run (see [`default_viewpoint`]).
+/// The camera inside `lumen` (a component of `volume`): at its most central voxel
+/// [`FACE_MARGIN_MM`](super::FACE_MARGIN_MM) from the volume's faces (where the lumen reaches
+/// that far in), looking along its local long axis towards the longer free run (see
+/// [`default_viewpoint`]).
 pub fn viewpoint_in(volume: &Volume, lumen: &Lumen) -> Pose {
     let field = DistanceField::new(lumen, volume.geometry());
-    let eye_voxel = most_central(lumen, &field);
+    let eye_voxel = most_central(volume, lumen, &field);
     let eye_mm = field.world_of_voxel(eye_voxel);
     let reach_mm = AXIS_REACH * field.max_mm();
     let axis = principal_axis(lumen, &field, eye_mm, reach_mm);
@@ -85,9 +90,11 @@ pub enum DefaultView {
         /// The structure's lumen: its mask, and what a path through it must stay in.
         lumen: Box<Lumen>,
         /// Where a path through it ends, world mm, for a tube whose far end is known (the
-        /// aorta's lowest section); `None`: at the farthest point.
+        /// aorta's lowest section, the nasopharynx behind the nasal passages); `None`: at the
+        /// farthest point.
         end_mm: Option<DVec3>,
-        /// What was found, in words (e.g. "aorta: 402 mm, radius 11.3 mm").
+        /// What was found, in words (e.g. "aorta: 402 mm, radius 11.3 mm"); beginning with
+        /// [`NOT_CONFIDENT`] where the finder is not sure (see [`DefaultView::confident`]).
         what: String,
     },
     /// The whole volume framed from the front (see [`crate::camera::framing_pose`]).
@@ -106,7 +113,18 @@ impl DefaultView {
             Self::InsideLumen { pose, .. } | Self::Framing { pose, .. } => *pose,
         }
     }
+
+    /// Whether the view is inside the structure its finder was sure of: false for a `what`
+    /// beginning with [`NOT_CONFIDENT`], and for a view framing the volume.
+    pub fn confident(&self) -> bool {
+        matches!(self, Self::InsideLumen { what, .. } if !what.starts_with(NOT_CONFIDENT))
+    }
 }
+
+/// How a [`DefaultView::InsideLumen`]'s `what` begins when its finder is not sure it found the
+/// structure the preset means; the rest of the line says what it found instead and what it
+/// would need.
+pub const NOT_CONFIDENT: &str = "not confident: ";
 
 /// Why a [`DefaultView`] frames the volume from outside.
 #[derive(Debug, Clone, PartialEq)]
@@ -149,14 +167,24 @@ impl Found {
             end_mm: None,
         }
     }
+
+    /// The same, its `what` beginning with [`NOT_CONFIDENT`] and ending with `why` in
+    /// brackets (what the finder missed or would need).
+    fn doubted(self, why: &str) -> Self {
+        Self {
+            what: format!("{NOT_CONFIDENT}{} ({why})", self.what),
+            ..self
+        }
+    }
 }
 
 /// The default camera for `volume`: with a `lumen` choice (an endoscopic preset), inside the
-/// structure it means — the airway tree from the trachea, the aorta, the colon, the central
-/// CSF component, else the largest lumen ([`default_viewpoint`]) — looking along it; without
-/// one, or when the choice gives no threshold or the scan no such lumen, the whole volume
-/// framed from the front for the vertical field of view `fov_deg` ([`framing_pose`]), with the
-/// reason.
+/// structure it means — the airway tree from the trachea, the aorta, the colon, the nasal
+/// passages, the central CSF component, a joint space, else the largest lumen
+/// ([`default_viewpoint`]) — looking along it, saying in its `what` when the finder is not
+/// sure ([`NOT_CONFIDENT`]); without one, or when the choice gives no threshold or the scan no
+/// such lumen, the whole volume framed from the front for the vertical field of view `fov_deg`
+/// ([`framing_pose`]), with the reason.
 pub fn default_view(volume: &Volume, lumen: Option<&LumenChoice<'_>>, fov_deg: f64) -> DefaultView {
     let framing = |reason| DefaultView::Framing {
         pose: framing_pose(volume.geometry(), fov_deg),
@@ -184,7 +212,7 @@ pub fn default_view(volume: &Volume, lumen: Option<&LumenChoice<'_>>, fov_deg: f
 }
 
 /// The structure a preset means (see [`default_view`]); a specific finder that finds nothing
-/// falls back to the largest lumen.
+/// falls back to the largest lumen, not confident, saying what it missed.
 fn find_structure(
     volume: &Volume,
     threshold: f64,
@@ -192,18 +220,31 @@ fn find_structure(
     within: Option<Central>,
     structure: Option<Structure>,
 ) -> Option<Found> {
-    let largest = || {
+    let largest = |missing: Option<&str>| {
         let lumen = Lumen::largest(volume, threshold, side, side == LumenSide::Below).ok()??;
-        Some(Found::central(volume, lumen, threshold, "largest lumen"))
+        let found = Found::central(volume, lumen, threshold, "largest lumen");
+        Some(match missing {
+            Some(why) => found.doubted(why),
+            None => found,
+        })
     };
     match (within, structure, side) {
         (Some(central), _, _) => central_lumen(volume, threshold, side, &central),
         (None, Some(Structure::Trachea), LumenSide::Below) => find_trachea(volume, threshold)
             .map(|(tree, t)| Found::central(volume, tree, t, "airway tree from the trachea"))
-            .or_else(largest),
+            .or_else(|| {
+                largest(Some(
+                    "no trachea found: it needs a round air section in the top axial slices",
+                ))
+            }),
         (None, Some(Structure::Aorta), _) => find_aorta(volume, threshold, side)
             .map(|aorta| aorta_found(aorta, threshold))
-            .or_else(largest),
+            .or_else(|| {
+                largest(Some(
+                    "no aorta found: it needs a chain of round contrast sections of 7-16 mm radius \
+                     in the axial slices",
+                ))
+            }),
         (None, Some(Structure::Colon), LumenSide::Below) => find_colon(volume, threshold)
             .map(|colon| {
                 Found::central(
@@ -213,34 +254,111 @@ fn find_structure(
                     "colon (largest gas inside the body)",
                 )
             })
-            .or_else(largest),
+            .or_else(|| {
+                largest(Some(
+                    "no colon found: it needs gas inside the body, not lung",
+                ))
+            }),
         (None, Some(Structure::NasalCavity), LumenSide::Below) => {
             find_nasal_cavity(volume, threshold)
                 .map(|nose| nasal_found(volume, nose, threshold))
-                .or_else(largest)
+                .or_else(|| {
+                    largest(Some(
+                        "no nasal cavity found: it needs air enclosed in the axial slices across \
+                         the head's midline",
+                    ))
+                })
         }
-        _ => largest(),
+        (None, Some(Structure::Joint), LumenSide::Below) => find_joint(volume, threshold)
+            .map(|joint| joint_found(volume, joint, threshold))
+            .or_else(|| {
+                largest(Some(
+                    "no joint space found: it needs two bones' marrow, thicker than the fat around \
+                     them, with a dark gap between them",
+                ))
+            }),
+        _ => largest(None),
+    }
+}
+
+/// The camera in the joint space between the bones (at its darkest point where they come
+/// closest) looking along it: along the principal axis of the joint space within
+/// [`JOINT_REACH_MM`], less its part along the bones' axis, towards the longer free run. Not
+/// confident where the dark gap there is wider than [`MAX_JOINT_GAP_MM`].
+fn joint_found(volume: &Volume, joint: Joint, threshold: f64) -> Found {
+    let field = DistanceField::new(&joint.space, volume.geometry());
+    let eye = joint.gap_mm;
+    let bones = (joint.cores_mm[1] - joint.cores_mm[0]).normalize_or_zero();
+    let axis = principal_axis(&joint.space, &field, eye, JOINT_REACH_MM);
+    let along = (axis - bones * axis.dot(bones))
+        .try_normalize()
+        .unwrap_or_else(|| bones.any_orthonormal_vector());
+    let forward = if free_run(&field, eye, along) >= free_run(&field, eye, -along) {
+        along
+    } else {
+        -along
+    };
+    let s = volume.geometry().spacing_mm();
+    let what = format!(
+        "joint space between the two largest bones: a gap of {:.1} mm, {:.1} ml around it",
+        joint.width_mm,
+        joint.space.voxel_count() as f64 * s.x * s.y * s.z / 1000.0
+    );
+    let found = Found {
+        pose: looking_along(eye, forward, JOINT_REACH_MM),
+        what,
+        lumen: joint.space,
+        threshold,
+        end_mm: None,
+    };
+    if joint.width_mm <= MAX_JOINT_GAP_MM {
+        found
+    } else {
+        found.doubted(&format!(
+            "a joint space is at most {MAX_JOINT_GAP_MM} mm wide: it needs the bones nearer"
+        ))
     }
 }
 
 /// The camera at the nasal cavity's start looking back (posterior, +y in LPS) along the
-/// passages, the mask the whole air joined to them (sinuses, pharynx).
+/// passages; the mask, the route an endoscope of [`SCOPE_RADIUS_MM`] takes from there, the
+/// path's end at its back (the nasopharynx). Not confident where the start is too narrow for
+/// the endoscope (the mask is then the passages) or the route shorter than [`MIN_ROUTE_MM`].
 fn nasal_found(volume: &Volume, nose: NasalCavity, threshold: f64) -> Found {
     let s = volume.geometry().spacing_mm();
     let ml = |lumen: &Lumen| lumen.voxel_count() as f64 * s.x * s.y * s.z / 1000.0;
     let field = DistanceField::new(&nose.passages, volume.geometry());
     let radius = field.distance_mm(nose.start_mm).max(1.0);
-    Found {
+    let what = format!(
+        "nasal cavity: {:.1} ml with the sinuses and pharynx joined to it ({:.1} ml of \
+         passages near the midline, {:.1} ml of them wide enough for an endoscope of \
+         {SCOPE_RADIUS_MM} mm radius, {:.0} mm from front to back)",
+        ml(&nose.lumen),
+        ml(&nose.passages),
+        nose.route.as_ref().map_or(0.0, ml),
+        nose.end_mm.distance(nose.start_mm),
+    );
+    let doubt = match &nose.route {
+        None => Some(format!(
+            "the start is narrower than the endoscope: it needs passages of {SCOPE_RADIUS_MM} \
+             mm radius"
+        )),
+        Some(_) if nose.end_mm.distance(nose.start_mm) < MIN_ROUTE_MM => Some(format!(
+            "a route under {MIN_ROUTE_MM} mm: it needs the passages to the choanae in the \
+             scan, wider than the endoscope"
+        )),
+        Some(_) => None,
+    };
+    let found = Found {
         pose: looking_along(nose.start_mm, DVec3::Y, radius),
-        what: format!(
-            "nasal cavity: {:.1} ml with the sinuses and pharynx joined to it ({:.1} ml of \
-             passages near the midline)",
-            ml(&nose.lumen),
-            ml(&nose.passages)
-        ),
-        lumen: nose.lumen,
+        what,
+        lumen: nose.route.unwrap_or(nose.passages),
         threshold,
-        end_mm: None,
+        end_mm: Some(nose.end_mm),
+    };
+    match doubt {
+        Some(why) => found.doubted(&why),
+        None => found,
     }
 }
 
@@ -274,53 +392,49 @@ fn aorta_found(aorta: Aorta, threshold: f64) -> Found {
     }
 }
 
-/// Thresholds tried for a [`Central`] structure, from the given one towards its floor.
-const CENTRAL_STEPS: usize = 6;
-/// The smallest central structure taken, mm³ (the lateral ventricles hold 7–30 ml).
-const CENTRAL_MIN_MM3: f64 = 1000.0;
-
-/// The camera in the [`Central`] structure and the threshold it was found at: the first of
-/// [`CENTRAL_STEPS`] thresholds from `threshold` towards the floor whose central component
-/// holds at least [`CENTRAL_MIN_MM3`]; the largest one found otherwise.
+/// The camera in the [`Central`] structure (see [`find_central`]); not confident where its
+/// size is not a pair of lateral ventricles' ([`CENTRAL_ML`]).
 fn central_lumen(
     volume: &Volume,
     threshold: f64,
     side: LumenSide,
     central: &Central,
 ) -> Option<Found> {
-    let spacing = volume.geometry().spacing_mm();
-    let voxel_mm3 = spacing.x * spacing.y * spacing.z;
-    let mut best: Option<(Lumen, f64)> = None;
-    for step in 0..CENTRAL_STEPS {
-        let t = threshold + (central.floor - threshold) * step as f64 / CENTRAL_STEPS as f64;
-        let Ok(Some(lumen)) = Lumen::largest_through_box(volume, t, side, central.region) else {
-            continue;
-        };
-        let big = lumen.voxel_count() as f64 * voxel_mm3 >= CENTRAL_MIN_MM3;
-        if best
-            .as_ref()
-            .is_none_or(|(b, _)| lumen.voxel_count() > b.voxel_count())
-        {
-            best = Some((lumen, t));
-        }
-        if big {
-            break;
-        }
-    }
-    best.map(|(lumen, t)| Found::central(volume, lumen, t, "central CSF component"))
+    let (lumen, t, sized) = find_central(volume, threshold, side, central)?;
+    let found = Found::central(volume, lumen, t, "central CSF component");
+    Some(if sized {
+        found
+    } else {
+        found.doubted(&format!(
+            "the lateral ventricles, together or one, hold {}-{} ml: it needs a CSF/tissue \
+             contrast at which they part from the CSF around the brain",
+            CENTRAL_ML.start(),
+            CENTRAL_ML.end()
+        ))
+    })
 }
 
 /// The voxel nearest the lumen's centroid among those within half a voxel of the largest
-/// distance to the wall (ties on a lattice are common: a straight tube's whole axis).
-fn most_central(lumen: &Lumen, field: &DistanceField) -> [usize; 3] {
+/// distance to the wall (ties on a lattice are common: a straight tube's whole axis), both
+/// among the voxels [`FACE_MARGIN_MM`](super::FACE_MARGIN_MM) from the volume's faces where
+/// the lumen has any.
+fn most_central(volume: &Volume, lumen: &Lumen, field: &DistanceField) -> [usize; 3] {
+    let faces = Faces::of(volume);
+    let any_clear = lumen.voxels().any(|v| faces.clear(v));
+    let eligible = |v: &[usize; 3]| !any_clear || faces.clear(*v);
     let mut sum = DVec3::ZERO;
     for v in lumen.voxels() {
         sum += field.world_of_voxel(v);
     }
     let centroid = sum / lumen.voxel_count() as f64;
-    let floor = field.max_mm() - 0.5 * field.min_spacing_mm();
+    let widest = lumen
+        .voxels()
+        .filter(eligible)
+        .map(|v| field.distance_at_voxel(v))
+        .fold(0.0, f64::max);
+    let floor = widest - 0.5 * field.min_spacing_mm();
     let mut best = (f64::INFINITY, field.max_voxel());
-    for v in lumen.voxels() {
+    for v in lumen.voxels().filter(eligible) {
         if field.distance_at_voxel(v) >= floor {
             let d = field.world_of_voxel(v).distance_squared(centroid);
             if d < best.0 {
@@ -470,5 +584,28 @@ mod tests {
                 }
             );
         }
+    }
+
+    #[test]
+    fn a_finder_that_finds_nothing_says_so_in_one_line_and_still_gives_a_view_inside() {
+        use crate::presets::Preset;
+        let (volume, _) = phantom::straight_tube(&options(32));
+        let arthroscopy = LumenChoice {
+            preset: Preset::find("arthroscopy"),
+            ..LumenChoice::default()
+        };
+        // A tube has no bones: the largest lumen, said to be a guess, with what was missing.
+        let view = default_view(&volume, Some(&arthroscopy), 90.0);
+        let DefaultView::InsideLumen { what, .. } = &view else {
+            panic!("{view:?}");
+        };
+        assert!(
+            what.starts_with("not confident: largest lumen")
+                && what.contains("no joint space found: it needs")
+                && !what.contains('\n'),
+            "{what}"
+        );
+        assert!(!view.confident());
+        assert!(!default_view(&volume, None, 90.0).confident());
     }
 }

@@ -290,6 +290,11 @@ impl Study {
         }
     }
 
+    /// Whether the structure was found with confidence; `false` also when none was found.
+    pub fn confident(&self) -> bool {
+        self.found().is_some_and(DefaultView::confident)
+    }
+
     /// The camera the study starts at: the user's, else inside the structure looking along the
     /// automatic path, else the whole object framed.
     pub fn start_pose(&self) -> Pose {

@@ -79,15 +79,18 @@ pub fn measure_csf(volume: &Volume, scan: &ScanValues) -> Option<CsfContrast> {
 }
 
 /// The central structure `preset` (in the scan's units) means on `volume`: the box at the
-/// object's centre and the CSF level; `None` for presets that mean the largest lumen, and for
-/// a scan without a clear CSF/tissue contrast at its centre.
+/// object's centre, the CSF level and the background's (midway between the scan's lowest
+/// value and its darker class); `None` for presets that mean the largest lumen, and for a
+/// scan without a clear CSF/tissue contrast at its centre.
 pub fn central_structure(preset: &Preset, volume: &Volume, scan: &ScanValues) -> Option<Central> {
     if preset.lumen?.structure != Structure::Central {
         return None;
     }
+    let csf = measure_csf(volume, scan)?;
     Some(Central {
         region: central_box(volume, scan)?,
-        floor: measure_csf(volume, scan)?.csf,
+        floor: csf.csf,
+        background: 0.5 * (scan.range.0 + csf.csf.min(csf.tissue)),
     })
 }
 
