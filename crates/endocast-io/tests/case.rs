@@ -1,10 +1,10 @@
 //! Case files: annotations and the scan's fingerprint round-trip, bad files are refused with
-//! the file and the problem, a kill during a save leaves a whole file, and a large case opens
-//! at once.
+//! the file and the problem, a kill during a save leaves a whole file, changes made at once
+//! are all kept, and a large case opens at once.
 
 use endocast_core::annotate::{Annotation, Annotations, ScanIdentity, Shape};
 use endocast_core::phantom::{Phantom, PhantomOptions};
-use endocast_io::case::{AnnotationRecord, Case, ScanSource};
+use endocast_io::case::{AnnotationRecord, Case, CaseError, ScanSource};
 use glam::DVec3;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
@@ -212,6 +212,41 @@ fn a_kill_during_a_save_leaves_the_old_or_the_new_case_whole() {
         );
         assert_eq!(case.annotations.len(), 300);
     }
+}
+
+#[test]
+fn changes_made_at_once_are_all_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    let (source, identity) = tube();
+    let add = |n: usize| {
+        Case::update(
+            &path,
+            || Ok::<_, CaseError>(Case::new(source.clone(), Some(&identity))),
+            |case| {
+                let mut marks = case.annotations(&path)?;
+                marks.add(Annotation::new(Shape::Point(DVec3::splat(n as f64))));
+                case.set_annotations(&marks);
+                Ok(())
+            },
+        )
+    };
+    std::thread::scope(|scope| {
+        for writer in 0..8 {
+            scope.spawn(move || (0..10).for_each(|k| add(writer * 10 + k).unwrap()));
+        }
+    });
+    let case = Case::read(&path).unwrap();
+    assert_eq!(case.annotations.len(), 80);
+    assert_eq!(case.revision, 80);
+    // A failed change writes nothing.
+    let failed: Result<(), _> = Case::update(
+        &path,
+        || unreachable!(),
+        |_| Err(CaseError::new(&path, "no")),
+    );
+    assert!(failed.is_err());
+    assert_eq!(Case::read(&path).unwrap(), case);
 }
 
 #[test]
