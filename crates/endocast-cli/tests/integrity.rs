@@ -1,7 +1,8 @@
 //! What the tool does with hostile sizes, names and signals: a frame too large for memory is a
-//! clear error before anything is allocated, an interrupted `fly` leaves no temporary file, a
-//! killed one leaves its folder of frames old and whole, `-o x.jpg` writes a JPEG (other endings
-//! are refused), and no control character from a file reaches the terminal.
+//! clear error before anything is allocated (so are frame and thread counts beyond the limits),
+//! an interrupted `fly` leaves no temporary file, a killed one leaves its folder of frames old
+//! and whole, `-o x.jpg` writes a JPEG (other endings are refused), and no control character
+//! from a file reaches the terminal.
 
 use crate::common::{endocast, fails_with};
 use std::path::Path;
@@ -261,4 +262,55 @@ fn a_folder_holding_a_folder_is_not_replaced_by_frames() {
         "holds notes besides frames and files",
     );
     assert!(folder.join("notes").is_dir());
+}
+
+#[test]
+fn counts_beyond_the_limits_are_refused_before_anything_is_allocated() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tube, _) = tube_and_path(dir.path());
+    let bench = ["bench", "--phantom-size", "32", "--size", "8x8"];
+    fails_with(
+        &[&bench[..], &["--frames", "1000000000"]].concat(),
+        "--frames: the frame count needs 1000000000 but the limit is 100000",
+    );
+    let view = dir.path().join("v.png");
+    let render = [
+        "render",
+        &tube,
+        "--size",
+        "8x8",
+        "-o",
+        view.to_str().unwrap(),
+    ];
+    fails_with(
+        &[&render[..], &["--threads", "100000"]].concat(),
+        "--threads: the worker threads (8 a core at most) needs 100000",
+    );
+}
+
+#[test]
+fn a_render_too_large_for_the_address_space_is_refused_not_aborted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tube, _) = tube_and_path(dir.path());
+    let view = dir.path().join("v.png");
+    // 4 GiB of address space: 14000² pixels take far more.
+    let out = Command::new("prlimit")
+        .args(["--as=4294967296", env!("CARGO_BIN_EXE_endocast")])
+        .args([
+            "render",
+            &tube,
+            "--size",
+            "14000x14000",
+            "-o",
+            view.to_str().unwrap(),
+        ])
+        .output()
+        .expect("prlimit (util-linux) runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("rendering a frame of 14000×14000 pixels"),
+        "{stderr}"
+    );
+    assert!(!view.exists());
 }
