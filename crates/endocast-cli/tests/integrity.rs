@@ -267,7 +267,7 @@ fn a_folder_holding_a_folder_is_not_replaced_by_frames() {
 #[test]
 fn counts_beyond_the_limits_are_refused_before_anything_is_allocated() {
     let dir = tempfile::tempdir().unwrap();
-    let (tube, _) = tube_and_path(dir.path());
+    let (tube, path) = tube_and_path(dir.path());
     let bench = ["bench", "--phantom-size", "32", "--size", "8x8"];
     fails_with(
         &[&bench[..], &["--frames", "1000000000"]].concat(),
@@ -285,6 +285,23 @@ fn counts_beyond_the_limits_are_refused_before_anything_is_allocated() {
     fails_with(
         &[&render[..], &["--threads", "100000"]].concat(),
         "--threads: the worker threads (8 a core at most) needs 100000",
+    );
+    // 36 mm every nanometre.
+    let film = dir.path().join("f.gif");
+    fails_with(
+        &[
+            "fly",
+            &tube,
+            "--path",
+            &path,
+            "--size",
+            "8x8",
+            "--frame-step",
+            "1e-9",
+            "-o",
+            film.to_str().unwrap(),
+        ],
+        "--frame-step: the frame count needs",
     );
 }
 
