@@ -11,6 +11,7 @@ use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, RenderSettings, TransferFunction};
 use endocast_core::study::{Study, StudyRequest};
 use endocast_core::Volume;
+use endocast_io::Limits;
 
 /// How a scan is rendered.
 #[derive(Args, Debug, Clone)]
@@ -298,11 +299,9 @@ pub fn transfer_function(spec: &str) -> Result<TransferFunction> {
 
 /// Runs `work` on a pool of `threads` workers (all cores when `None`).
 pub fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T> {
-    match threads {
+    match pool(threads)? {
         None => Ok(work()),
-        Some(0) => bail!("--threads must be at least 1"),
-        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
+        Some(pool) => Ok(pool
             .build()
             .context("cannot start the worker threads")?
             .install(work)),
@@ -312,12 +311,23 @@ pub fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send)
 /// Makes every later parallel render use `threads` workers (all cores when `None`), for
 /// commands whose work loop cannot move into a pool.
 pub fn set_threads(threads: Option<usize>) -> Result<()> {
-    match threads {
+    match pool(threads)? {
         None => Ok(()),
-        Some(0) => bail!("--threads must be at least 1"),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
+        Some(pool) => pool
             .build_global()
             .context("cannot start the worker threads"),
     }
+}
+
+/// A pool of `--threads` workers (`None`: the default pool, all cores), after checking the
+/// count: at least one, at most the limit ([`Limits::check_threads`]).
+fn pool(threads: Option<usize>) -> Result<Option<rayon::ThreadPoolBuilder>> {
+    let Some(n) = threads else {
+        return Ok(None);
+    };
+    if n == 0 {
+        bail!("--threads must be at least 1");
+    }
+    Limits::default().check_threads("--threads", n)?;
+    Ok(Some(rayon::ThreadPoolBuilder::new().num_threads(n)))
 }

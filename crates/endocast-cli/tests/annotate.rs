@@ -262,3 +262,34 @@ encoding: raw\n\n"
     render[7] = "LPI";
     run(&render);
 }
+
+#[test]
+fn annotations_added_at_once_by_many_processes_are_all_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let scan = phantom(dir.path(), "shell.nii.gz", "24");
+    let case = dir.path().join("case.json");
+    let c = case.to_str().unwrap();
+    run(&[
+        "annotate", c, "--scan", &scan, "add", "point", "--at", "0,0,0",
+    ]);
+    // Eight writers, ten annotations each, one process an annotation.
+    std::thread::scope(|scope| {
+        for writer in 0..8 {
+            scope.spawn(move || {
+                for k in 0..10 {
+                    let at = format!("{writer},{k},1");
+                    let said = run(&["annotate", c, "add", "point", "--at", &at]);
+                    assert!(said.starts_with("added "), "{said}");
+                }
+            });
+        }
+    });
+    let listed: serde_json::Value =
+        serde_json::from_str(&run(&["annotate", c, "list", "--json"])).unwrap();
+    let records = listed.as_array().unwrap();
+    assert_eq!(records.len(), 81, "the first and 8 × 10 more");
+    let mut ids: Vec<u64> = records.iter().map(|r| r["id"].as_u64().unwrap()).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids.len(), 81);
+}

@@ -5,8 +5,9 @@
 //! Both take pixels row by row, row 0 at the top of the image, left to right within a row, and
 //! write through [`write_file`] so a failed write never leaves a half file behind.
 
-use crate::atomic::write_file;
+use crate::atomic::{write_file, write_new};
 use crate::error::{ReadError, Result};
+use std::io::Write;
 use std::path::Path;
 
 /// The formats a rendered view is written in, by the output's ending.
@@ -139,22 +140,50 @@ fn write_png(
     color: png::ColorType,
     pixels: &[u8],
 ) -> Result<()> {
+    check_png(path, width, height, color, pixels)?;
+    write_file(path, |w| encode_png(w, width, height, color, pixels))
+}
+
+/// Writes a fly-through's frame, an 8-bit RGB PNG, as a new file in a folder only this
+/// process writes (see [`crate::atomic::write_new`]).
+pub(crate) fn write_frame_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()> {
+    let color = png::ColorType::Rgb;
+    check_png(path, width, height, color, rgb)?;
+    write_new(path, |w| encode_png(w, width, height, color, rgb))
+}
+
+/// Fails unless `pixels` make a PNG of `width × height` and `color`.
+fn check_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    pixels: &[u8],
+) -> Result<()> {
     if width == 0 || height == 0 {
         return Err(ReadError::format(
             path,
             format!("a PNG needs at least one pixel, the image is {width}×{height}"),
         ));
     }
-    check_len(path, width, height, color.samples(), pixels.len())?;
-    write_file(path, |w| {
-        let mut encoder = png::Encoder::new(w, width, height);
-        encoder.set_color(color);
-        encoder.set_depth(png::BitDepth::Eight);
-        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let mut writer = encoder.write_header().map_err(png_to_io)?;
-        writer.write_image_data(pixels).map_err(png_to_io)?;
-        writer.finish().map_err(png_to_io)
-    })
+    check_len(path, width, height, color.samples(), pixels.len())
+}
+
+/// Encodes `pixels` (checked by [`check_png`]) into `w`.
+fn encode_png(
+    w: &mut dyn Write,
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    pixels: &[u8],
+) -> std::io::Result<()> {
+    let mut encoder = png::Encoder::new(w, width, height);
+    encoder.set_color(color);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let mut writer = encoder.write_header().map_err(png_to_io)?;
+    writer.write_image_data(pixels).map_err(png_to_io)?;
+    writer.finish().map_err(png_to_io)
 }
 
 /// Fails unless `len` equals `width·height·channels` (computed without overflow).

@@ -2,7 +2,7 @@
 //! with or without alpha, 8 or 16 bits) read as its luminance, 0–1.
 
 use crate::error::{ReadError, Result};
-use endocast_core::look::Texture;
+use endocast_core::look::{Texture, MAX_TEXELS};
 use std::io::BufReader;
 use std::path::Path;
 
@@ -15,6 +15,7 @@ pub fn read_texture(path: &Path) -> Result<Texture> {
     decoder.set_transformations(png::Transformations::normalize_to_color8());
     let bad = |e: png::DecodingError| ReadError::format(path, format!("not a readable PNG: {e}"));
     let mut reader = decoder.read_info().map_err(bad)?;
+    check_size(path, reader.info().size())?;
     let size = reader
         .output_buffer_size()
         .ok_or_else(|| ReadError::format(path, "a PNG too large to decode"))?;
@@ -34,6 +35,21 @@ pub fn read_texture(path: &Path) -> Result<Texture> {
         })
         .collect();
     Texture::from_luma(width, height, luma).map_err(|e| ReadError::format(path, e.to_string()))
+}
+
+/// Refuses a texture of more than [`MAX_TEXELS`] pixels along an edge, from its header, before
+/// any pixel is decoded (a 20000² PNG of a few kilobytes would take gigabytes).
+fn check_size(path: &Path, (width, height): (u32, u32)) -> Result<()> {
+    let longer = u64::from(width.max(height));
+    if longer > MAX_TEXELS as u64 {
+        return Err(ReadError::Limit {
+            path: path.to_path_buf(),
+            what: format!("a texture of {width}×{height} pixels (its longer edge)"),
+            requested: longer,
+            limit: MAX_TEXELS as u64,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -57,5 +73,54 @@ mod tests {
         std::fs::write(&not_png, b"not a png").unwrap();
         let error = read_texture(&not_png).unwrap_err().to_string();
         assert!(error.contains("x.png") && error.contains("PNG"), "{error}");
+    }
+
+    /// A PNG header claiming 20000 × 20000 grey pixels, with a few bytes of image data.
+    fn forged_png(width: u32, height: u32) -> Vec<u8> {
+        let chunk = |kind: &[u8], data: &[u8]| {
+            let mut crc = flate2::Crc::new();
+            crc.update(kind);
+            crc.update(data);
+            let length = u32::try_from(data.len()).unwrap().to_be_bytes();
+            [&length[..], kind, data, &crc.sum().to_be_bytes()].concat()
+        };
+        let header = [
+            &width.to_be_bytes()[..],
+            &height.to_be_bytes(),
+            &[8, 0, 0, 0, 0],
+        ]
+        .concat();
+        let data = [0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01];
+        [
+            &b"\x89PNG\r\n\x1a\n"[..],
+            &chunk(b"IHDR", &header),
+            &chunk(b"IDAT", &data),
+            &chunk(b"IEND", &[]),
+        ]
+        .concat()
+    }
+
+    #[test]
+    fn a_huge_png_is_refused_from_its_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.png");
+        std::fs::write(&path, forged_png(20_000, 20_000)).unwrap();
+        let error = read_texture(&path).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                ReadError::Limit {
+                    requested: 20_000,
+                    limit: 8192,
+                    ..
+                }
+            ),
+            "{error}"
+        );
+        let message = error.to_string();
+        assert!(
+            message.contains("huge.png") && message.contains("20000×20000"),
+            "{message}"
+        );
     }
 }

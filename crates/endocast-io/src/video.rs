@@ -4,9 +4,11 @@
 //!
 //! Every sink streams: a frame is encoded (or handed to `ffmpeg`) when it is pushed and nothing
 //! keeps the frames, so a flight of any length runs in bounded memory. No sink leaves a half
-//! file behind: PNGs are written atomically one by one, and the GIF and MP4 are written under a
-//! temporary name beside the target and renamed only when [`FrameSink::finish`] succeeds (a sink
-//! dropped unfinished removes its temporary file).
+//! output behind: the GIF and MP4 are written under a temporary name beside the target and
+//! renamed only when [`FrameSink::finish`] succeeds, and a folder of PNGs is written as a
+//! temporary folder beside it and swapped in whole then, so that the folder holds the old frames
+//! or all the new ones, never a mix (a sink dropped unfinished removes its temporary file or
+//! folder; see [`crate::atomic`]).
 //!
 //! ```no_run
 //! use endocast_io::video::{open_sink, VideoOptions};
@@ -19,10 +21,11 @@
 //! # Ok::<(), endocast_io::ReadError>(())
 //! ```
 
-use crate::atomic::Pending;
+use crate::atomic::{Temporary, TemporaryFolder};
 use crate::error::{ReadError, Result};
-use crate::image_out::write_png_rgb8;
+use crate::image_out::write_frame_png;
 use endocast_core::views::Image;
+use std::ffi::OsString;
 use std::fs::File;
 use std::io::{BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
@@ -174,98 +177,79 @@ fn no_frames(path: &Path) -> ReadError {
     ReadError::format(path, "no frames were pushed, nothing to write")
 }
 
-/// A file written under a temporary name beside its target and renamed over it on
-/// [`commit`](Self::commit); dropped uncommitted, the temporary file is removed.
-#[derive(Debug)]
-struct TempTarget {
-    target: PathBuf,
-    temporary: PathBuf,
-    committed: bool,
-    /// Lists the temporary file for a signal handler (see [`remove_temporary_files`]).
-    ///
-    /// [`remove_temporary_files`]: crate::atomic::remove_temporary_files
-    _listed: Pending,
-}
-
-impl TempTarget {
-    fn new(target: &Path) -> Result<Self> {
-        let name = target
-            .file_name()
-            .ok_or_else(|| ReadError::format(target, "the output path names no file"))?;
-        let temporary = target.with_file_name(format!(
-            ".{}.{}.tmp",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        Ok(Self {
-            target: target.to_path_buf(),
-            _listed: Pending::new(&temporary),
-            temporary,
-            committed: false,
-        })
-    }
-
-    fn commit(&mut self) -> Result<PathBuf> {
-        std::fs::rename(&self.temporary, &self.target)
-            .map_err(|e| ReadError::io(&self.target, e))?;
-        self.committed = true;
-        Ok(self.target.clone())
-    }
-}
-
-impl Drop for TempTarget {
-    fn drop(&mut self) {
-        if !self.committed {
-            // Best effort: the temporary file is ours and useless now.
-            let _ = std::fs::remove_file(&self.temporary);
-        }
-    }
-}
-
-/// A folder of `frame_00000.png`, `frame_00001.png`, ... (five digits, more past 99 999).
+/// A folder of `frame_00000.png`, `frame_00001.png`, ... (five digits, more past 99 999),
+/// written into a temporary folder that replaces the folder on [`FrameSink::finish`]. The
+/// other files of a folder flown into before stay (linked into the new one); the old frames go.
 #[derive(Debug)]
 struct PngFolder {
     dir: PathBuf,
+    folder: TemporaryFolder,
     size: FrameSize,
     frames: usize,
 }
 
 impl PngFolder {
     fn create(dir: &Path) -> Result<Self> {
-        std::fs::create_dir_all(dir).map_err(|e| ReadError::io(dir, e))?;
+        other_files(dir)?;
         Ok(Self {
             dir: dir.to_path_buf(),
+            folder: TemporaryFolder::create(dir)?,
             size: FrameSize::default(),
             frames: 0,
         })
     }
 
-    /// Removes `frame_NNNNN.png` files numbered past this flight's last frame: leftovers of an
-    /// earlier, longer flight into the same folder, which would otherwise play on after ours.
-    fn remove_stale_frames(&self) -> Result<()> {
-        let entries = std::fs::read_dir(&self.dir).map_err(|e| ReadError::io(&self.dir, e))?;
-        for entry in entries.flatten() {
-            let name = entry.file_name();
-            let number = name
-                .to_str()
-                .and_then(|n| n.strip_prefix("frame_")?.strip_suffix(".png"))
-                .filter(|digits| digits.len() >= 5 && digits.bytes().all(|b| b.is_ascii_digit()))
-                .and_then(|digits| digits.parse::<usize>().ok());
-            if number.is_some_and(|n| n >= self.frames) {
-                let path = entry.path();
-                std::fs::remove_file(&path).map_err(|e| ReadError::io(&path, e))?;
-            }
+    /// Links the files of the old folder that are not frames into the new one.
+    fn keep_other_files(&self) -> Result<()> {
+        for name in other_files(&self.dir)? {
+            let (from, to) = (self.dir.join(&name), self.folder.path().join(&name));
+            std::fs::hard_link(&from, &to).map_err(|e| ReadError::io(&from, e))?;
         }
         Ok(())
     }
+}
+
+/// The names of the files in the folder `dir` (none when it does not exist) that are not
+/// frames; an error for anything there but frames and plain files (a folder or a link in it
+/// would be lost when the new frames replace it).
+fn other_files(dir: &Path) -> Result<Vec<OsString>> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(Vec::new());
+    };
+    let mut names = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| ReadError::io(dir, e))?;
+        let name = entry.file_name();
+        if name.to_str().is_some_and(is_frame_name) {
+            continue;
+        }
+        if !entry.file_type().is_ok_and(|t| t.is_file()) {
+            let message = format!(
+                "holds {} besides frames and files, which writing frames into it would lose: \
+                 write them into another folder",
+                name.to_string_lossy()
+            );
+            return Err(ReadError::format(dir, crate::escape(&message)));
+        }
+        names.push(name);
+    }
+    Ok(names)
+}
+
+/// Whether `name` is a frame's, `frame_NNNNN.png` (five digits or more).
+fn is_frame_name(name: &str) -> bool {
+    name.strip_prefix("frame_")
+        .and_then(|n| n.strip_suffix(".png"))
+        .is_some_and(|digits| digits.len() >= 5 && digits.bytes().all(|b| b.is_ascii_digit()))
 }
 
 impl FrameSink for PngFolder {
     fn push(&mut self, rgb: &[u8], width: usize, height: usize) -> Result<()> {
         self.size
             .check(&self.dir, rgb, (width, height), u32::MAX as usize)?;
-        let path = self.dir.join(format!("frame_{:05}.png", self.frames));
-        write_png_rgb8(&path, width as u32, height as u32, rgb)?;
+        let name = format!("frame_{:05}.png", self.frames);
+        let path = self.folder.path().join(name);
+        write_frame_png(&path, width as u32, height as u32, rgb)?;
         self.frames += 1;
         Ok(())
     }
@@ -278,8 +262,9 @@ impl FrameSink for PngFolder {
         if self.frames == 0 {
             return Err(no_frames(&self.dir));
         }
-        self.remove_stale_frames()?;
-        Ok(self.dir.clone())
+        self.keep_other_files()?;
+        self.folder.commit()?;
+        Ok(self.dir)
     }
 }
 
@@ -287,7 +272,7 @@ impl FrameSink for PngFolder {
 /// crate's): smooth endoscopic shading keeps far more of its gradients than with one fixed
 /// palette for the whole flight.
 struct GifSink {
-    target: TempTarget,
+    target: Temporary,
     speed: i32,
     /// Delay between frames, hundredths of a second.
     delay_cs: u16,
@@ -300,8 +285,7 @@ struct GifSink {
 
 impl GifSink {
     fn create(path: &Path, options: &VideoOptions) -> Result<Self> {
-        let target = TempTarget::new(path)?;
-        let file = File::create(&target.temporary).map_err(|e| ReadError::io(path, e))?;
+        let (target, file) = Temporary::create(path)?;
         Ok(Self {
             delay_cs: (100.0 / options.fps).round().clamp(1.0, 65535.0) as u16,
             speed: options.gif_speed,
@@ -318,7 +302,7 @@ impl GifSink {
             gif::EncodingError::Io(io) => io,
             other => std::io::Error::other(other),
         };
-        ReadError::io(&self.target.target, io)
+        ReadError::io(self.target.target(), io)
     }
 
     /// The encoder, created (with its header and a loop-forever extension) at the first frame.
@@ -332,13 +316,13 @@ impl GifSink {
         }
         self.encoder
             .as_mut()
-            .ok_or_else(|| ReadError::format(&self.target.target, "the GIF encoder failed before"))
+            .ok_or_else(|| ReadError::format(self.target.target(), "the GIF encoder failed before"))
     }
 }
 
 impl FrameSink for GifSink {
     fn push(&mut self, rgb: &[u8], width: usize, height: usize) -> Result<()> {
-        let path = self.target.target.clone();
+        let path = self.target.target().to_path_buf();
         self.size
             .check(&path, rgb, (width, height), usize::from(u16::MAX))?;
         // Both edges fit a u16: checked above.
@@ -356,7 +340,7 @@ impl FrameSink for GifSink {
     }
 
     fn finish(mut self: Box<Self>) -> Result<PathBuf> {
-        let path = self.target.target.clone();
+        let path = self.target.target().to_path_buf();
         let encoder = self.encoder.take().ok_or_else(|| no_frames(&path))?;
         let io = |e| ReadError::io(&path, e);
         // `into_inner` writes the trailer.
@@ -364,14 +348,16 @@ impl FrameSink for GifSink {
         let file = writer.into_inner().map_err(|e| io(e.into_error()))?;
         file.sync_all().map_err(io)?;
         drop(file);
-        self.target.commit()
+        self.target.commit()?;
+        Ok(path)
     }
 }
 
-/// H.264 in MP4 by the built-in encoder ([`h264`]) and muxer ([`mp4`]), into a temporary file
-/// created at the first frame.
+/// H.264 in MP4 by the built-in encoder ([`h264`]) and muxer ([`mp4`]), into a temporary file.
 struct H264Sink {
-    target: TempTarget,
+    target: Temporary,
+    /// The open temporary file until the first frame makes the muxer.
+    file: Option<File>,
     fps: f64,
     coder: Option<(h264::H264Encoder, mp4::Mp4Muxer<BufWriter<File>>)>,
     size: FrameSize,
@@ -379,8 +365,10 @@ struct H264Sink {
 
 impl H264Sink {
     fn create(path: &Path, options: &VideoOptions) -> Result<Self> {
+        let (target, file) = Temporary::create(path)?;
         Ok(Self {
-            target: TempTarget::new(path)?,
+            target,
+            file: Some(file),
             fps: options.fps,
             coder: None,
             size: FrameSize::default(),
@@ -389,14 +377,17 @@ impl H264Sink {
 
     /// The encoder and the muxer for frames of `width × height`, made at the first frame.
     fn start(
-        &self,
+        &mut self,
         width: usize,
         height: usize,
     ) -> Result<(h264::H264Encoder, mp4::Mp4Muxer<BufWriter<File>>)> {
-        let path = &self.target.target;
+        let path = self.target.target();
         let encoder = h264::H264Encoder::new(width, height, self.fps)
             .map_err(|e| ReadError::io(path, std::io::Error::other(e)))?;
-        let file = File::create(&self.target.temporary).map_err(|e| ReadError::io(path, e))?;
+        let file = self
+            .file
+            .take()
+            .ok_or_else(|| ReadError::format(path, "the H.264 encoder failed before"))?;
         let (w, h) = encoder.padded_size();
         // Both edges are at most MP4_MAX_EDGE (even), checked by the caller.
         let muxer = mp4::Mp4Muxer::new(BufWriter::new(file), w as u16, h as u16, self.fps)
@@ -411,7 +402,7 @@ const MP4_MAX_EDGE: usize = 16384;
 
 impl FrameSink for H264Sink {
     fn push(&mut self, rgb: &[u8], width: usize, height: usize) -> Result<()> {
-        let path = self.target.target.clone();
+        let path = self.target.target().to_path_buf();
         self.size.check(&path, rgb, (width, height), MP4_MAX_EDGE)?;
         if self.coder.is_none() {
             self.coder = Some(self.start(width, height)?);
@@ -430,14 +421,15 @@ impl FrameSink for H264Sink {
     }
 
     fn finish(mut self: Box<Self>) -> Result<PathBuf> {
-        let path = self.target.target.clone();
+        let path = self.target.target().to_path_buf();
         let (_, muxer) = self.coder.take().ok_or_else(|| no_frames(&path))?;
         let io = |e| ReadError::io(&path, e);
         let writer = muxer.finish().map_err(io)?;
         let file = writer.into_inner().map_err(|e| io(e.into_error()))?;
         file.sync_all().map_err(io)?;
         drop(file);
-        self.target.commit()
+        self.target.commit()?;
+        Ok(path)
     }
 }
 
@@ -446,7 +438,7 @@ const STDERR_KEPT: usize = 4000;
 
 /// H.264 in MP4 by an `ffmpeg` child process reading raw RGB frames on its standard input.
 struct FfmpegSink {
-    target: TempTarget,
+    target: Temporary,
     program: PathBuf,
     fps: f64,
     child: Option<Child>,
@@ -460,7 +452,7 @@ impl FfmpegSink {
     fn create(path: &Path, program: &Path, options: &VideoOptions) -> Result<Self> {
         check_ffmpeg(path, program)?;
         Ok(Self {
-            target: TempTarget::new(path)?,
+            target: Temporary::create(path)?.0,
             program: program.to_path_buf(),
             fps: options.fps,
             child: None,
@@ -485,12 +477,12 @@ impl FfmpegSink {
             ])
             .args(["-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2"])
             .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-f", "mp4"])
-            .arg(&self.target.temporary)
+            .arg(self.target.path())
             .stdin(Stdio::piped())
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
             .spawn()
-            .map_err(|e| ffmpeg_missing(&self.target.target, &self.program, &e))?;
+            .map_err(|e| ffmpeg_missing(self.target.target(), &self.program, &e))?;
         self.stdin = child.stdin.take();
         // Drained on a thread so that a chatty ffmpeg never blocks on a full pipe.
         self.stderr = child.stderr.take().map(|mut err| {
@@ -508,7 +500,7 @@ impl FfmpegSink {
     /// Waits for `ffmpeg` to exit; an error carries what it printed.
     fn wait(&mut self) -> Result<()> {
         drop(self.stdin.take());
-        let path = self.target.target.clone();
+        let path = self.target.target().to_path_buf();
         let Some(mut child) = self.child.take() else {
             return Err(no_frames(&path));
         };
@@ -557,7 +549,7 @@ fn ffmpeg_missing(path: &Path, program: &Path, e: &std::io::Error) -> ReadError 
 
 impl FrameSink for FfmpegSink {
     fn push(&mut self, rgb: &[u8], width: usize, height: usize) -> Result<()> {
-        let path = self.target.target.clone();
+        let path = self.target.target().to_path_buf();
         self.size.check(&path, rgb, (width, height), MP4_MAX_EDGE)?;
         if self.child.is_none() {
             self.spawn(width, height)?;
@@ -580,8 +572,10 @@ impl FrameSink for FfmpegSink {
     }
 
     fn finish(mut self: Box<Self>) -> Result<PathBuf> {
+        let path = self.target.target().to_path_buf();
         self.wait()?;
-        self.target.commit()
+        self.target.commit()?;
+        Ok(path)
     }
 }
 

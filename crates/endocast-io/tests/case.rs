@@ -1,9 +1,10 @@
 //! Case files: annotations and the scan's fingerprint round-trip, bad files are refused with
-//! the file and the problem, and a kill during a save leaves a whole file.
+//! the file and the problem, a kill during a save leaves a whole file, changes made at once
+//! are all kept, and a large case opens at once.
 
 use endocast_core::annotate::{Annotation, Annotations, ScanIdentity, Shape};
 use endocast_core::phantom::{Phantom, PhantomOptions};
-use endocast_io::case::{Case, ScanSource};
+use endocast_io::case::{AnnotationRecord, Case, CaseError, ScanSource};
 use glam::DVec3;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
@@ -211,4 +212,67 @@ fn a_kill_during_a_save_leaves_the_old_or_the_new_case_whole() {
         );
         assert_eq!(case.annotations.len(), 300);
     }
+}
+
+#[test]
+fn changes_made_at_once_are_all_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.json");
+    let (source, identity) = tube();
+    let add = |n: usize| {
+        Case::update(
+            &path,
+            || Ok::<_, CaseError>(Case::new(source.clone(), Some(&identity))),
+            |case| {
+                let mut marks = case.annotations(&path)?;
+                marks.add(Annotation::new(Shape::Point(DVec3::splat(n as f64))));
+                case.set_annotations(&marks);
+                Ok(())
+            },
+        )
+    };
+    std::thread::scope(|scope| {
+        for writer in 0..8 {
+            scope.spawn(move || (0..10).for_each(|k| add(writer * 10 + k).unwrap()));
+        }
+    });
+    let case = Case::read(&path).unwrap();
+    assert_eq!(case.annotations.len(), 80);
+    assert_eq!(case.revision, 80);
+    // A failed change writes nothing.
+    let failed: Result<(), _> = Case::update(
+        &path,
+        || unreachable!(),
+        |_| Err(CaseError::new(&path, "no")),
+    );
+    assert!(failed.is_err());
+    assert_eq!(Case::read(&path).unwrap(), case);
+}
+
+#[test]
+fn a_case_of_300_000_annotations_opens_in_linear_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("big.json");
+    let (source, identity) = tube();
+    let mut case = Case::new(source, Some(&identity));
+    case.annotations = (1..=300_000)
+        .map(|id| AnnotationRecord {
+            id,
+            kind: "point".into(),
+            label: String::new(),
+            points: vec![[f64::from(id % 97), 1.0, 2.0]],
+            point: None,
+            color: None,
+            distance_mm: None,
+        })
+        .collect();
+    // Compact, as the size limit of case files allows.
+    std::fs::write(&path, serde_json::to_vec(&case).unwrap()).unwrap();
+    let start = std::time::Instant::now();
+    let read = Case::read(&path).unwrap();
+    let marks = read.annotations(&path).unwrap();
+    let seconds = start.elapsed().as_secs_f64();
+    assert_eq!(marks.len(), 300_000);
+    assert_eq!(marks.items()[299_999].id, 300_000);
+    assert!(seconds <= 2.0, "{seconds:.1} s to open 300 000 annotations");
 }

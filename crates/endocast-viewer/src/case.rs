@@ -203,25 +203,27 @@ fn key_from_case(k: &CaseKeyFrame) -> Result<KeyFrame, String> {
     .map_err(|e| e.to_string())
 }
 
-/// Saves the case every so often when it changed, atomically.
+/// Saves the case every so often when it changed, atomically, and never over what another
+/// program saved to the same file meanwhile (see [`Case::write_over`]).
 #[derive(Debug)]
 pub struct Autosave {
     path: PathBuf,
     interval: Duration,
     last_saved: Option<Case>,
     last_time: Option<Instant>,
-    revision: u64,
+    /// The revision of the file as last read or written (`None`: there was none).
+    revision: Option<u64>,
 }
 
 impl Autosave {
-    /// Autosaves to `path` at most once per `interval`.
+    /// Autosaves to `path` at most once per `interval`, over the file as it is now.
     pub fn new(path: PathBuf, interval: Duration) -> Self {
         Self {
+            revision: Case::revision_at(&path).ok().flatten(),
             path,
             interval,
             last_saved: None,
             last_time: None,
-            revision: 0,
         }
     }
 
@@ -232,12 +234,14 @@ impl Autosave {
 
     /// Saves to another file from now on (after "Save as").
     pub fn set_path(&mut self, path: PathBuf) {
+        self.revision = Case::revision_at(&path).ok().flatten();
         self.path = path;
         self.last_saved = None;
     }
 
     /// Saves `session` when it changed since the last save and the interval has passed (or
-    /// `force`); returns whether it wrote.
+    /// `force`); returns whether it wrote. Refused when another program saved the file since
+    /// it was opened or last saved here.
     pub fn tick(&mut self, session: &Session, force: bool) -> Result<bool, CaseError> {
         let due = self.last_time.is_none_or(|t| t.elapsed() >= self.interval);
         if !(force || due) {
@@ -248,12 +252,7 @@ impl Autosave {
         if self.last_saved.as_ref() == Some(&case) {
             return Ok(false);
         }
-        let written = Case {
-            revision: self.revision + 1,
-            ..case.clone()
-        };
-        written.write(&self.path)?;
-        self.revision += 1;
+        self.revision = Some(case.write_over(&self.path, self.revision)?);
         self.last_saved = Some(case);
         self.last_time = Some(Instant::now());
         Ok(true)

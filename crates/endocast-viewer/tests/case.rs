@@ -1,4 +1,5 @@
-//! Case files: reopened exactly, strict on reading, and never lost to a kill during a save.
+//! Case files: reopened exactly, strict on reading, never lost to a kill during a save, and
+//! never saved over another program's changes.
 
 use crate::common::{settled, tube_session};
 use endocast_core::annotate::STROKE_COLOR;
@@ -314,4 +315,38 @@ fn a_case_reads_its_meshes_again_and_opens_without_one_that_is_gone() {
     assert!(problems[0].contains("t.stl"), "{problems:?}");
     assert!(reopened.geometry().mesh_files().is_empty());
     assert_eq!(reopened.controls, session.controls);
+}
+
+#[test]
+fn an_autosave_never_overwrites_what_another_program_saved_meanwhile() {
+    use endocast_core::annotate::{Annotation, Shape};
+    use endocast_viewer::case::CaseError;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("shared.json");
+    let (mut session, _) = tube_session();
+    let mut autosave = Autosave::new(path.clone(), Duration::ZERO);
+    assert!(autosave.tick(&session, true).unwrap());
+    // `endocast annotate` adds a mark to the same case.
+    Case::update(
+        &path,
+        || unreachable!(),
+        |case| {
+            let mut marks = case.annotations(&path)?;
+            marks.add(Annotation::new(Shape::Point(glam::DVec3::ZERO)));
+            case.set_annotations(&marks);
+            Ok::<_, CaseError>(())
+        },
+    )
+    .unwrap();
+    session.turn(0.01, 0.0);
+    let refused = autosave.tick(&session, true).unwrap_err().to_string();
+    assert!(
+        refused.contains("shared.json") && refused.contains("another program"),
+        "{refused}"
+    );
+    assert_eq!(Case::read(&path).unwrap().annotations.len(), 1);
+    // Opened again, it saves over the file as it is now.
+    let mut reopened = Autosave::new(path.clone(), Duration::ZERO);
+    assert!(reopened.tick(&session, true).unwrap());
+    assert_eq!(Case::read(&path).unwrap().revision, 3);
 }

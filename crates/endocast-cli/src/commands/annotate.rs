@@ -116,14 +116,15 @@ pub fn run(args: &AnnotateArgs) -> Result<()> {
     match &args.action {
         Action::List { json } => list(&opened.case.annotations(&args.case)?, *json)?,
         Action::Remove { ids } => {
-            let mut marks = opened.case.annotations(&args.case)?;
-            for id in ids {
-                marks
-                    .remove(*id)
-                    .with_context(|| format!("{}: no annotation {id}", args.case.display()))?;
-            }
-            opened.save(&args.case, &marks)?;
-            println!("removed {} annotation(s); {} left", ids.len(), marks.len());
+            let left = opened.save(&args.case, |marks| {
+                for id in ids {
+                    marks
+                        .remove(*id)
+                        .with_context(|| format!("{}: no annotation {id}", args.case.display()))?;
+                }
+                Ok(marks.len())
+            })?;
+            println!("removed {} annotation(s); {left} left", ids.len());
         }
         Action::Add(add) => {
             let points = if add.pixel.is_empty() {
@@ -131,12 +132,12 @@ pub fn run(args: &AnnotateArgs) -> Result<()> {
             } else {
                 pick(&add.pixel, &add.view, opened.volume(&args.case)?)?
             };
-            let mut marks = opened.case.annotations(&args.case)?;
             let annotation = annotation(add, &points)?;
-            let id = marks.add(annotation);
-            opened.save(&args.case, &marks)?;
-            let added = marks.get(id).context("the annotation just added")?;
-            println!("added {}", line(added));
+            let added = opened.save(&args.case, |marks| {
+                let id = marks.add(annotation);
+                marks.get(id).cloned().context("the annotation just added")
+            })?;
+            println!("added {}", line(&added));
         }
     }
     Ok(())
@@ -187,11 +188,30 @@ impl Opened {
         self.volume.as_ref().context("the case's scan")
     }
 
-    /// Writes the case with `marks`, atomically.
-    fn save(&mut self, path: &Path, marks: &Annotations) -> Result<()> {
-        self.case.set_annotations(marks);
-        self.case.revision += 1;
-        Ok(self.case.write(path)?)
+    /// Makes `change` to the case's annotations and writes it, atomically. The case is read
+    /// again under its lock first (see [`Case::update`]), so that what other programs saved
+    /// since it was opened is kept; returns what `change` returns.
+    fn save<T>(
+        &self,
+        path: &Path,
+        change: impl FnOnce(&mut Annotations) -> Result<T>,
+    ) -> Result<T> {
+        Case::update(
+            path,
+            || Ok(self.case.clone()),
+            |case| {
+                if case.identity != self.case.identity {
+                    bail!(
+                        "{}: the case was changed to another scan meanwhile",
+                        path.display()
+                    );
+                }
+                let mut marks = case.annotations(path)?;
+                let changed = change(&mut marks)?;
+                case.set_annotations(&marks);
+                Ok(changed)
+            },
+        )
     }
 }
 

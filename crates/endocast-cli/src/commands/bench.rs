@@ -23,7 +23,7 @@ use endocast_core::render::{
 };
 use endocast_core::Volume;
 use endocast_io::route_file::{read_camera_path, CameraPath};
-use endocast_io::OpenOptions;
+use endocast_io::{Limits, OpenOptions};
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -338,6 +338,7 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
             args.phantom_size
         );
     }
+    let frames = frame_count(args.frames)?;
     let (volume, colon) = phantom::colon(&PhantomOptions {
         size: args.phantom_size,
         ..PhantomOptions::default()
@@ -347,10 +348,10 @@ fn paper_protocol(args: &BenchArgs) -> Result<(Renderer, Vec<Pose>, Vec<Cell>)> 
         volume.geometry(),
         |s| line.point_at(s),
         line.length_vox(),
-        args.frames,
+        frames,
         10.0,
     )
-    .with_context(|| format!("no fly path of {} frames fits the colon", args.frames))?;
+    .with_context(|| format!("no fly path of {frames} frames fits the colon"))?;
     let ScanLook {
         settings: base,
         look,
@@ -449,9 +450,15 @@ fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
     match read_camera_path(path).context("cannot read the path")? {
         CameraPath::Cameras(poses) => Ok(poses),
         CameraPath::Route(route) => route
-            .spread_poses(frames, LOOK_AHEAD_MM)
+            .spread_poses(frame_count(frames)?, LOOK_AHEAD_MM)
             .context("cannot sample the path"),
     }
+}
+
+/// `--frames`, refused above the limit ([`Limits::check_frame_count`]) before a pose is made.
+fn frame_count(frames: usize) -> Result<usize> {
+    Limits::default().check_frame_count("--frames", frames as u64)?;
+    Ok(frames)
 }
 
 /// Prints `text` when the table is printed (not under `--json`).

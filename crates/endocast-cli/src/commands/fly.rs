@@ -27,6 +27,7 @@ use endocast_core::views::stereo::StereoOutput;
 use endocast_core::Volume;
 use endocast_io::route_file::read_route;
 use endocast_io::video::{open_sink, FrameSink, VideoOptions};
+use endocast_io::Limits;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -118,9 +119,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     args.input
         .check_frames(&args.output, args.size, eyes + dashboard)?;
     let route = read_route(&args.route).context("cannot read the path")?;
-    let shots = route
-        .shots(args.frame_step, args.look_ahead)
-        .context("cannot sample the route")?;
+    let shots = shots(&route, args)?;
     let mut sinks = Sinks::open(&args.output, &video_options(args), stereo.map(|s| s.output))?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
@@ -257,6 +256,17 @@ fn fly_back(
     let backward = back.fly(settings, || progress.step())?;
     progress.finish();
     Ok(WallSeen::with_backward(forward, &backward)?)
+}
+
+/// The route's shots every `--frame-step`, refused above the frame limit
+/// ([`Limits::check_frame_count`]) before any is made.
+fn shots(route: &Route, args: &FlyArgs) -> Result<Vec<Shot>> {
+    let frames = (route.len_mm() / args.frame_step).ceil() + 1.0;
+    // A float count converts saturating: no overflow.
+    Limits::default().check_frame_count("--frame-step", frames as u64)?;
+    route
+        .shots(args.frame_step, args.look_ahead)
+        .context("cannot sample the route")
 }
 
 /// The stereo options as the flight takes them; side-by-side and top-bottom frames are twice

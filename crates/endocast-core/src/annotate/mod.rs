@@ -36,6 +36,7 @@ pub use pick::{SurfaceView, Visibility};
 
 use crate::views::Rgb;
 use glam::DVec3;
+use std::collections::HashSet;
 
 /// Default colour of points and labels.
 pub const POINT_COLOR: Rgb = [255, 220, 0];
@@ -173,15 +174,25 @@ pub struct Annotations {
 
 impl Annotations {
     /// A set holding `items` as they are (ids kept; a case file's). Duplicate ids are renumbered
-    /// after the largest.
+    /// after the largest. Linear in the count (the ids seen so far are hashed, not searched),
+    /// so that a case of hundreds of thousands of annotations opens at once.
     pub fn from_items(items: Vec<Annotation>) -> Self {
-        let mut set = Self::default();
-        for item in items {
-            let taken = set.get(item.id).is_some() || item.id == 0;
-            let id = if taken { set.next_id() } else { item.id };
-            set.items.push(Annotation { id, ..item });
-        }
-        set
+        let mut taken = HashSet::with_capacity(items.len());
+        let mut largest = 0;
+        let items = items
+            .into_iter()
+            .map(|item| {
+                let id = if item.id == 0 || taken.contains(&item.id) {
+                    largest + 1
+                } else {
+                    item.id
+                };
+                taken.insert(id);
+                largest = largest.max(id);
+                Annotation { id, ..item }
+            })
+            .collect();
+        Self { items }
     }
 
     /// Adds `annotation` with a new id (one more than the largest) and returns the id.

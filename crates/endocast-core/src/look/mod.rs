@@ -73,7 +73,7 @@ pub use reduced::shade_reduced;
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;
 pub use still::still;
-pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES};
+pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, MAX_TEXELS};
 
 use thiserror::Error;
 

@@ -14,7 +14,7 @@ pub const BUILT_IN_TEXTURES: [&str; 3] = ["mucosa", "grid", "none"];
 const BUILT_IN_TEXELS: usize = 256;
 
 /// The largest edge accepted, texels.
-const MAX_TEXELS: usize = 8192;
+pub const MAX_TEXELS: usize = 8192;
 
 /// A texture that cannot be used.
 #[derive(Debug, Error, Clone, PartialEq)]

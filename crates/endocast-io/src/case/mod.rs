@@ -1,7 +1,8 @@
 //! Case files: one scan and what was done to it — the scan's reference and fingerprint, the
 //! viewer's controls and camera, key frames, and the annotations drawn and measured on the
 //! tissue — as JSON, written atomically (a temporary file renamed over the old one, so a crash
-//! or a kill during a save leaves the previous case whole). The viewer (`endocast view`) and
+//! or a kill during a save leaves the previous case whole) and under a lock, so that programs
+//! changing one case at once ([`Case::update`]) lose none of each other's changes. The viewer (`endocast view`) and
 //! the CLI (`endocast annotate`, `render --case`, `fly --case`) read and write the same files.
 //!
 //! ```json
@@ -35,6 +36,7 @@ pub use scan::{IdentityRecord, ScanSource};
 
 use endocast_core::annotate::{Annotations, ScanIdentity};
 use serde::{Deserialize, Serialize};
+use std::fs::File;
 use std::path::{Path, PathBuf};
 
 /// The `"format"` value of case files.
@@ -133,8 +135,72 @@ impl Case {
         Ok(case)
     }
 
-    /// Writes the case to `path` atomically, as the current [`VERSION`].
+    /// Writes the case to `path` atomically, as the current [`VERSION`], under the case's
+    /// lock (so never in the middle of another program's [`Case::update`]).
     pub fn write(&self, path: &Path) -> Result<(), CaseError> {
+        let _lock = CaseLock::acquire(path)?;
+        self.write_locked(path)
+    }
+
+    /// Changes the case at `path` under its lock: reads it (or takes `new()` when there is
+    /// none), lets `change` change it, and writes it back as the next revision. Programs
+    /// changing one case at once take turns, each changing what the one before wrote, so that
+    /// no change is lost. Returns what `change` returns; nothing is written when it fails.
+    pub fn update<T, E: From<CaseError>>(
+        path: &Path,
+        new: impl FnOnce() -> Result<Self, E>,
+        change: impl FnOnce(&mut Self) -> Result<T, E>,
+    ) -> Result<T, E> {
+        let _lock = CaseLock::acquire(path)?;
+        let mut case = if path.exists() {
+            Self::read(path)?
+        } else {
+            new()?
+        };
+        let changed = change(&mut case)?;
+        case.revision += 1;
+        case.write_locked(path)?;
+        Ok(changed)
+    }
+
+    /// Writes the case over the file at `path` as it was read, at revision `base` (`None`:
+    /// there was no file), as the next revision, under the case's lock. Refused, writing
+    /// nothing, when another program saved the case since (the file's revision is not `base`),
+    /// so that its changes are not overwritten unseen. Returns the revision written.
+    pub fn write_over(&self, path: &Path, base: Option<u64>) -> Result<u64, CaseError> {
+        let _lock = CaseLock::acquire(path)?;
+        let now = Self::revision_at(path)?;
+        if now != base {
+            let said = |r: Option<u64>| r.map_or_else(|| "none".to_owned(), |r| r.to_string());
+            return Err(CaseError::new(
+                path,
+                format!(
+                    "saved by another program since it was opened (revision {}, opened at {}): \
+                     not overwritten; save the case under another name",
+                    said(now),
+                    said(base)
+                ),
+            ));
+        }
+        let revision = base.map_or(1, |r| r + 1);
+        Self {
+            revision,
+            ..self.clone()
+        }
+        .write_locked(path)?;
+        Ok(revision)
+    }
+
+    /// The revision of the case at `path`, `None` when there is no file.
+    pub fn revision_at(path: &Path) -> Result<Option<u64>, CaseError> {
+        if !path.exists() {
+            return Ok(None);
+        }
+        Self::read(path).map(|case| Some(case.revision))
+    }
+
+    /// [`Case::write`] with the case's lock held by the caller.
+    fn write_locked(&self, path: &Path) -> Result<(), CaseError> {
         let current = Self {
             version: VERSION,
             ..self.clone()
@@ -175,5 +241,32 @@ impl Case {
                 format!("made on another scan than {}: {e}", self.scan.label()),
             )
         })
+    }
+}
+
+/// A case file's lock, held while the case is written or changed: an advisory lock (`flock`)
+/// on `.NAME.lock` beside it, released when dropped. The lock file stays, empty: removing it
+/// would let two programs lock two different files of one name.
+#[derive(Debug)]
+struct CaseLock {
+    _file: File,
+}
+
+impl CaseLock {
+    /// Waits until the lock of the case at `path` is this process's alone.
+    fn acquire(path: &Path) -> Result<Self, CaseError> {
+        let name = path
+            .file_name()
+            .ok_or_else(|| CaseError::new(path, "the path names no file"))?;
+        let lock = path.with_file_name(format!(".{}.lock", name.to_string_lossy()));
+        // Made exclusively (never through a symbolic link), else opened to read only.
+        let file = match File::create_new(&lock) {
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => File::open(&lock),
+            opened => opened,
+        };
+        let cannot = |e| CaseError::new(path, format!("cannot lock {}: {e}", lock.display()));
+        let file = file.map_err(cannot)?;
+        file.lock().map_err(cannot)?;
+        Ok(Self { _file: file })
     }
 }
