@@ -71,13 +71,7 @@ fn render(scan: &Path, preset: Option<&str>, dir: &Path) -> (Value, f64, String)
     ];
     args.extend(preset.iter().flat_map(|p| ["--preset", p]));
     let (json, stderr) = json_of(&args);
-    let (_, values) = read_npy(&depth);
-    let hits = values.iter().filter(|d| d.is_finite()).count();
-    (
-        json["study"].clone(),
-        hits as f64 / values.len() as f64,
-        stderr,
-    )
+    (json["study"].clone(), hit_share(&depth), stderr)
 }
 
 /// The viewer's session on `scan` for `preset`, as `endocast view` opens it (no window): its
