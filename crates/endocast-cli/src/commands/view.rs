@@ -26,7 +26,8 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 256)]
     size: usize,
     /// Clinical defaults: colonoscopy, bronchoscopy, angioscopy, sinus, ventricles,
-    /// arthroscopy (default: none, the whole object framed, as `render` does).
+    /// arthroscopy (default: none, the whole object framed, as `render` does; for a phantom,
+    /// which is tissue to its border, colonoscopy).
     #[arg(long)]
     preset: Option<String>,
     /// Reopen a case file (its scan, view, key frames and marks); it is autosaved there.
@@ -45,7 +46,12 @@ pub struct ViewArgs {
 
 /// Runs `endocast view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
-    let preset = args.preset.as_deref().map(find_preset).transpose()?;
+    let name = match (&args.preset, &args.phantom) {
+        (Some(name), _) => Some(name.as_str()),
+        (None, Some(_)) => Some("colonoscopy"),
+        (None, None) => None,
+    };
+    let preset = name.map(find_preset).transpose()?;
     let source = match (&args.scan, &args.phantom, &args.case) {
         (Some(path), _, _) => ScanSource::File {
             path: path.clone(),
