@@ -79,12 +79,24 @@ fn view_opens_a_window_under_xvfb_and_writes_its_screenshot() {
     };
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("window.png");
+    let colon = dir.path().join("colon.nii.gz");
+    let scan = colon.to_str().unwrap();
+    let made = endocast(&["phantom", "colon", "--size", "96", "-o", scan]);
+    assert!(made.status.success());
     let mut child = Command::new(env!("CARGO_BIN_EXE_endocast"))
-        .args(["view", "--phantom", "colon", "--size", "96", "--screenshot"])
+        .args([
+            "view",
+            scan,
+            "--preset",
+            "colonoscopy",
+            "--json",
+            "--screenshot",
+        ])
         .arg(&png)
         .env("DISPLAY", &x.1)
         .env("LIBGL_ALWAYS_SOFTWARE", "1")
         .env("TMPDIR", dir.path())
+        .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
@@ -102,6 +114,24 @@ fn view_opens_a_window_under_xvfb_and_writes_its_screenshot() {
     let output = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(status.success(), "{stderr}");
+    // --json: the session resolved the scan as `render --json` does, and its camera is there.
+    let session: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let render = endocast(&[
+        "render",
+        scan,
+        "--preset",
+        "colonoscopy",
+        "--size",
+        "16x16",
+        "--json",
+        "-o",
+        dir.path().join("r.png").to_str().unwrap(),
+    ]);
+    let render: serde_json::Value = serde_json::from_slice(&render.stdout).unwrap();
+    for key in ["preset", "iso", "lumen", "window", "structure", "start"] {
+        assert_eq!(session["study"][key], render["study"][key], "{key}");
+    }
+    assert_eq!(session["camera"]["eye"], render["study"]["start"]["eye"]);
     let decoder = png::Decoder::new(BufReader::new(std::fs::File::open(&png).unwrap()));
     let mut reader = decoder.read_info().unwrap();
     let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
