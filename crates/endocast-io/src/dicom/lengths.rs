@@ -193,7 +193,14 @@ impl<R: Read + Seek> Walker<R> {
             let start = self.pos;
             let Some(head) = self.take::<8>() else { break };
             let group_le = u16::from_le_bytes([head[0], head[1]]);
-            in_meta &= group_le == 0x0002 && start < meta_end;
+            // dicom-rs reads every element within the group length as meta, whatever its group
+            // (a corrupt tag inside it does not end it); without a group length, the meta
+            // group ends at the first element of another group.
+            in_meta = if meta_end == u64::MAX {
+                in_meta && group_le == 0x0002
+            } else {
+                start < meta_end
+            };
             let current = match (in_meta, encoding) {
                 (true, _) => Encoding::ExplicitLittle,
                 (false, Some(encoding)) => encoding,
