@@ -9,8 +9,9 @@
 //! joined to its border, holes filled): the CSF at the brain's surface, where the ventricles
 //! open to the outside, is cut, the ventricles deep inside are not.
 
+use super::bit_grid::BitGrid;
 use super::distance::DistanceField;
-use super::lumen::{BitGrid, Lumen, LumenSide};
+use super::lumen::{Lumen, LumenSide};
 use super::preset::Central;
 use crate::Volume;
 

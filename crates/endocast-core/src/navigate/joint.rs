@@ -10,8 +10,10 @@
 //! the dark voxels joined to it within a lens around the two closest points
 //! ([`JOINT_REACH_MM`]) are the space an arthroscope looks around in.
 
+use super::bit_grid::BitGrid;
 use super::distance::DistanceField;
-use super::lumen::{largest_components, BitGrid, Lumen, LumenSide};
+use super::lumen::{largest_components, Lumen, LumenSide};
+use super::plan::seed_voxel;
 use crate::Volume;
 use glam::DVec3;
 
@@ -59,7 +61,7 @@ pub fn find_joint(volume: &Volume, threshold: f64) -> Option<Joint> {
     };
     let (a, b) = closest_points(&surface(first, volume), &surface(second, volume))?;
     let (gap_mm, width_mm) = darkest_between(volume, a, b, threshold);
-    let seed = nearest_voxel(volume, gap_mm);
+    let seed = seed_voxel(volume, gap_mm).ok()?;
     let lens = lens_between(volume, a, b);
     let space = Lumen::within(volume, seed, threshold, LumenSide::Below, &lens).ok()?;
     Some(Joint {
@@ -144,15 +146,4 @@ fn darkest_between(volume: &Volume, a: DVec3, b: DVec3, threshold: f64) -> (DVec
         _ => 0.0,
     };
     (a.lerp(b, darkest as f64 / samples as f64), run)
-}
-
-/// The voxel nearest world point `p_mm` (which lies inside the volume).
-fn nearest_voxel(volume: &Volume, p_mm: DVec3) -> [usize; 3] {
-    let v = volume
-        .geometry()
-        .voxel_from_world()
-        .transform_point3(p_mm)
-        .round();
-    let dims = volume.dims();
-    [0, 1, 2].map(|a| (v[a].max(0.0) as usize).min(dims[a] - 1))
 }

@@ -6,6 +6,7 @@
 //! (one stack entry per run of voxels along `i`, not per voxel) with a one-bit-per-voxel visited
 //! set over the volume, so its memory is bounded by `voxels / 8` bytes plus the stack of runs.
 
+use super::bit_grid::BitGrid;
 use super::error::{check_finite, NavError};
 pub use super::side::LumenSide;
 use crate::{ValueMap, Volume};
@@ -14,61 +15,6 @@ use crate::{ValueMap, Volume};
 pub const LEAK_FACES: usize = 3;
 /// A lumen holding more than this fraction of the volume leaks (see [`Lumen::leak`]).
 pub const LEAK_FRACTION: f64 = 0.25;
-
-/// One bit per voxel of a box, `i` fastest.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct BitGrid {
-    dims: [usize; 3],
-    words: Vec<u64>,
-}
-
-impl BitGrid {
-    pub(crate) fn new(dims: [usize; 3]) -> Self {
-        let n = dims[0] * dims[1] * dims[2];
-        Self {
-            dims,
-            words: vec![0; n.div_ceil(64)],
-        }
-    }
-
-    #[inline]
-    fn index(&self, [i, j, k]: [usize; 3]) -> usize {
-        i + self.dims[0] * (j + self.dims[1] * k)
-    }
-
-    /// The bit of voxel `v` (which must lie in the box).
-    #[inline]
-    pub(crate) fn get(&self, v: [usize; 3]) -> bool {
-        let n = self.index(v);
-        self.words[n >> 6] >> (n & 63) & 1 == 1
-    }
-
-    /// The bit of the voxel at linear index `n` (`i` fastest).
-    #[inline]
-    pub(crate) fn get_linear(&self, n: usize) -> bool {
-        self.words[n >> 6] >> (n & 63) & 1 == 1
-    }
-
-    /// Sets the bit of voxel `v` (which must lie in the box).
-    #[inline]
-    pub(crate) fn set(&mut self, v: [usize; 3]) {
-        let n = self.index(v);
-        self.words[n >> 6] |= 1 << (n & 63);
-    }
-}
-
-impl BitGrid {
-    /// Clears every bit whose index along `axis` (0 `i`, 1 `j`, 2 `k`) lies outside `range`.
-    pub(crate) fn keep_along(&mut self, axis: usize, range: std::ops::RangeInclusive<usize>) {
-        let [nx, ny, nz] = self.dims;
-        for n in 0..nx * ny * nz {
-            let at = [n % nx, n / nx % ny, n / (nx * ny)];
-            if !range.contains(&at[axis]) {
-                self.words[n >> 6] &= !(1 << (n & 63));
-            }
-        }
-    }
-}
 
 /// Which stored values lie on the lumen side: a table over all 65 536 `u16` values, so the fill
 /// compares nothing and any value map (even a negative scale) is handled alike.

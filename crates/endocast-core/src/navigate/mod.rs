@@ -20,6 +20,7 @@
 
 mod aorta;
 mod axial;
+mod bit_grid;
 mod central;
 mod centreline;
 mod collision;

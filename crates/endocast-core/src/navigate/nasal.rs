@@ -10,9 +10,10 @@
 //! flipped, is read the same way.
 
 use super::axial::BodyAxes;
+use super::bit_grid::BitGrid;
 use super::distance::DistanceField;
 use super::faces::Faces;
-use super::lumen::{BitGrid, Lumen, LumenSide};
+use super::lumen::{Lumen, LumenSide};
 use super::section::neighbours4;
 use crate::Volume;
 use glam::DVec3;

@@ -12,7 +12,8 @@ mod chain;
 mod follow;
 
 use super::axial::AxialCopy;
-use super::lumen::{BitGrid, Lumen, LumenSide};
+use super::bit_grid::BitGrid;
+use super::lumen::{Lumen, LumenSide};
 use crate::Volume;
 use chain::{candidates, longest_chain, Candidate};
 use follow::follow;
