@@ -6,6 +6,7 @@ use crate::kwargs::Kwargs;
 use crate::look::{optics, LookOptions};
 use crate::volume::Volume;
 use endocast_core::flight::{Flight, FlightOptions, Layout, Route, ShotSettings};
+use endocast_core::study::LOOK_AHEAD_MM;
 use endocast_io::route_file::read_route;
 use endocast_io::transfer_json::transfer_function;
 use endocast_io::video::{open_sink, VideoOptions};
@@ -36,7 +37,7 @@ pub fn fly<'py>(
     let fov = kw.take::<f64>("fov")?;
     let size = kw.take::<[usize; 2]>("size")?.unwrap_or([384, 384]);
     let frame_step = kw.take::<f64>("frame_step")?.unwrap_or(1.0);
-    let look_ahead = kw.take::<f64>("look_ahead")?.unwrap_or(10.0);
+    let look_ahead = kw.take::<f64>("look_ahead")?.unwrap_or(LOOK_AHEAD_MM);
     let fps = kw.take::<f64>("fps")?.unwrap_or(25.0);
     let route = read(py, route)?;
     let shots = route.shots(frame_step, look_ahead).map_err(to_py)?;

@@ -21,7 +21,7 @@ use endocast_core::flight::{
 };
 use endocast_core::navigate::{seed_voxel, Lumen};
 use endocast_core::render::{RenderSettings, Renderer};
-use endocast_core::study::Study;
+use endocast_core::study::{Study, LOOK_AHEAD_MM};
 use endocast_core::views::slices::Window;
 use endocast_core::views::stereo::StereoOutput;
 use endocast_core::Volume;
@@ -55,7 +55,7 @@ pub struct FlyArgs {
     #[arg(long, value_name = "MM", default_value_t = 1.0)]
     pub(crate) frame_step: f64,
     /// How far ahead on the path the camera looks, mm.
-    #[arg(long, value_name = "MM", default_value_t = 10.0)]
+    #[arg(long, value_name = "MM", default_value_t = LOOK_AHEAD_MM)]
     pub(crate) look_ahead: f64,
     /// Vertical field of view, degrees (default: the preset's, else 90; fisheye 170; key frames
     /// carry their own); view height in mm for an orthographic lens.
