@@ -5,11 +5,11 @@ use crate::lumen::LumenArgs;
 use crate::peel::PeelArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::look::{Look, LookKind, PresetLook, SecretionMode, Texture, BUILT_IN_TEXTURES};
+use endocast_core::look::{Look, PresetLook};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
-use endocast_core::render::{Mode, RenderSettings, TransferFunction};
-use endocast_core::study::{Study, StudyRequest};
+use endocast_core::render::{RenderSettings, TransferFunction};
+use endocast_core::study::{named, LookOptions, OptionError, Study, StudyRequest, ViewOptions};
 use endocast_core::Volume;
 use endocast_io::Limits;
 
@@ -103,40 +103,20 @@ impl LookArgs {
             .map_or_else(|| "plain".to_owned(), |n| n.trim().to_ascii_lowercase())
     }
 
-    fn overridden(&self, mut s: RenderSettings) -> Result<RenderSettings> {
-        if let Some(mode) = &self.mode {
-            s.mode = Mode::from_name(mode).with_context(|| {
-                format!(
-                    "unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip, minip or peel"
-                )
-            })?;
-        }
-        if let Some(iso) = self.iso {
-            s.iso_hu = finite("--iso", iso)?;
-        }
-        if let Some(iso2) = self.iso2 {
-            s.iso2_hu = finite("--iso2", iso2)?;
-        }
-        if let Some(alpha) = self.iso_opacity {
-            if !(0.0..=1.0).contains(&alpha) {
-                bail!("--iso-opacity must be between 0 and 1, not {alpha}");
-            }
-            s.iso_opacity = alpha;
-        }
-        if let Some(tf) = &self.tf {
-            s.tf = transfer_function(tf)?;
-        }
-        if let Some(step) = self.step {
-            s.step_vox = finite("--step", step)?;
-        }
-        s.jitter = self.jitter;
-        s.shade_dvr |= self.shade_dvr;
-        s.skip_empty = self.skip_empty;
-        self.peel.apply(&mut s)?;
-        if let Some(spec) = self.peel.tf_after() {
-            s.peel.tf_after = Some(transfer_function(spec)?);
-        }
-        Ok(s)
+    fn overridden(&self, s: RenderSettings) -> Result<RenderSettings> {
+        let options = ViewOptions {
+            mode: parsed(self.mode.as_deref(), named::mode)?,
+            iso2: self.iso2,
+            iso_opacity: self.iso_opacity,
+            tf: self.tf.as_deref().map(transfer_function).transpose()?,
+            step: self.step,
+            jitter: Some(self.jitter),
+            shade_dvr: self.shade_dvr.then_some(true),
+            skip_empty: Some(self.skip_empty),
+            background: None,
+            peel: self.peel.options()?,
+        };
+        options.apply(s).map_err(flag_error)
     }
 }
 
@@ -170,98 +150,38 @@ pub struct RealismArgs {
 }
 
 impl RealismArgs {
-    /// The options that only a clinical or realistic look uses, as given.
-    fn given(&self) -> Vec<&'static str> {
-        let flags = [
-            ("--secretion", self.secretion.is_some()),
-            ("--secretion-iso", self.secretion_iso.is_some()),
-            ("--wetness", self.wetness.is_some()),
-            ("--texture", self.texture.is_some()),
-            ("--texture-scale", self.texture_scale.is_some()),
-            ("--attenuation", self.attenuation.is_some()),
-        ];
-        flags
-            .iter()
-            .filter(|(_, on)| *on)
-            .map(|(f, _)| *f)
-            .collect()
-    }
-
     /// The look asked for over `base` (a preset's look in the scan's units), `tissue_iso` the
     /// `--iso` given; `None` for plain.
     fn look(&self, base: &PresetLook, tissue_iso: Option<f64>) -> Result<Option<Look>> {
-        let kind = match &self.look {
-            Some(name) => LookKind::from_name(name).with_context(|| {
-                format!("unknown look {name:?}; choose plain, clinical or realistic")
-            })?,
-            None => base.kind,
+        let options = LookOptions {
+            kind: parsed(self.look.as_deref(), named::look)?,
+            secretion: parsed(self.secretion.as_deref(), named::secretion)?,
+            secretion_iso: self.secretion_iso,
+            wetness: self.wetness,
+            texture: self
+                .texture
+                .as_deref()
+                .map(|spec| {
+                    endocast_io::texture::named_or_file(spec)
+                        .map(|t| t.map(std::sync::Arc::new))
+                        .context("cannot use the texture")
+                })
+                .transpose()?,
+            texture_scale: self.texture_scale,
+            attenuation: self.attenuation,
         };
-        let Some(mut look) = Look::of_kind(kind, base) else {
-            let given = self.given();
-            if !given.is_empty() {
-                bail!(
-                    "{} only apply to --look clinical or realistic (the plain look has no deferred stage)",
-                    given.join(", ")
-                );
-            }
-            return Ok(None);
-        };
-        if let Some(iso) = tissue_iso {
-            look.ray.tissue_hu = finite("--iso", iso)?;
-        }
-        if let Some(iso) = self.secretion_iso {
-            look.ray.secretion_hu = finite("--secretion-iso", iso)?;
-        }
-        if let Some(mode) = &self.secretion {
-            look.ray.secretion = SecretionMode::from_name(mode).with_context(|| {
-                format!("unknown secretion mode {mode:?}; choose off, on or accumulate")
-            })?;
-        }
-        if let Some(w) = self.wetness {
-            if !(0.0..=1.0).contains(&w) {
-                bail!("--wetness must be between 0 and 1, not {w}");
-            }
-            look.shading.wetness = w;
-        }
-        if let Some(spec) = &self.texture {
-            look.shading.texture = texture(spec)?.map(std::sync::Arc::new);
-        }
-        if let Some(mm) = self.texture_scale {
-            if !(mm.is_finite() && mm > 0.0) {
-                bail!("--texture-scale must be a positive number of mm, not {mm}");
-            }
-            look.shading.texture_mm = mm;
-        }
-        if let Some(mm) = self.attenuation {
-            if !(mm.is_finite() && mm >= 0.0) {
-                bail!("--attenuation must be a distance in mm (0 for none), not {mm}");
-            }
-            look.shading.attenuation_mm = (mm > 0.0).then_some(mm);
-        }
-        look.ray.validate().context("invalid look")?;
-        look.shading.validate().context("invalid look")?;
-        Ok(Some(look))
+        options.resolve(base, tissue_iso).map_err(flag_error)
     }
 }
 
-/// A detail texture by built-in name (`none`: no texture) or from a PNG file.
-fn texture(spec: &str) -> Result<Option<Texture>> {
-    let name = spec.trim();
-    if BUILT_IN_TEXTURES.contains(&name.to_ascii_lowercase().as_str()) {
-        return Ok(Texture::built_in(name));
-    }
-    let path = std::path::Path::new(spec);
-    let is_png = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !is_png && !path.exists() {
-        bail!(
-            "unknown texture {spec:?}; choose {} or a .png file",
-            BUILT_IN_TEXTURES.join(", ")
-        );
-    }
-    let texture = endocast_io::texture::read_texture(path).context("cannot use the texture")?;
-    Ok(Some(texture))
+/// `name` parsed by `parse`, if given.
+fn parsed<T>(name: Option<&str>, parse: fn(&str) -> Result<T, OptionError>) -> Result<Option<T>> {
+    name.map(parse).transpose().map_err(flag_error)
+}
+
+/// An option's error with the option spelled as its flag (`--iso-opacity`).
+pub fn flag_error(e: OptionError) -> anyhow::Error {
+    anyhow::anyhow!(e.message(|key| format!("--{}", key.replace('_', "-"))))
 }
 
 /// How a scan looks, its values understood.

@@ -1,8 +1,9 @@
 //! The depth-peeling options (`--mode peel`), shared by every command that renders.
 
-use anyhow::{bail, Result};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use endocast_core::render::{PeelLayer, RenderSettings, Unpeeled};
+use endocast_core::render::{PeelLayer, Unpeeled};
+use endocast_core::study::PeelOptions;
 
 /// How `--mode peel` peels (Borland et al.'s volumetric depth peeling).
 #[derive(Args, Debug, Clone)]
@@ -38,37 +39,24 @@ enum UnpeeledArg {
 }
 
 impl PeelArgs {
-    /// The `--tf-after` given, a file or a preset name, for the caller to read.
-    pub fn tf_after(&self) -> Option<&str> {
-        self.tf_after.as_deref()
-    }
-
-    /// Applies the options given to `settings`, all but [`Self::tf_after`].
-    pub fn apply(&self, settings: &mut RenderSettings) -> Result<()> {
-        let peel = &mut settings.peel;
-        if let Some(layer) = self.peel {
-            peel.layer = layer;
-        }
-        if let Some(threshold) = self.peel_threshold {
-            if !threshold.is_finite() {
-                bail!("--peel-threshold must be a finite number, not {threshold}");
-            }
-            peel.threshold_hu = Some(threshold);
-        }
-        peel.falling |= self.peel_falling;
-        if let Some(keep) = self.peel_keep {
-            if !(0.0..=1.0).contains(&keep) {
-                bail!("--peel-keep must be between 0 and 1, not {keep}");
-            }
-            peel.keep = keep;
-        }
-        if let Some(unpeeled) = self.unpeeled {
-            peel.unpeeled = match unpeeled {
+    /// The options given, transfer function behind the peel read.
+    pub fn options(&self) -> Result<PeelOptions> {
+        Ok(PeelOptions {
+            layer: self.peel,
+            threshold: self.peel_threshold,
+            falling: self.peel_falling.then_some(true),
+            keep: self.peel_keep,
+            unpeeled: self.unpeeled.map(|u| match u {
                 UnpeeledArg::Discard => Unpeeled::Discard,
                 UnpeeledArg::Context => Unpeeled::Context,
-            };
-        }
-        Ok(())
+            }),
+            tf_after: self
+                .tf_after
+                .as_deref()
+                .map(endocast_io::transfer_json::transfer_function)
+                .transpose()
+                .context("cannot use the transfer function behind the peel")?,
+        })
     }
 }
 

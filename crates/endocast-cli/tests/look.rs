@@ -125,7 +125,7 @@ fn bad_look_values_are_refused_with_a_clear_message() {
     let png = png.to_str().unwrap();
     let base = ["render", volume, "-o", png, "--size", "16x16"];
     let cases: [(&[&str], &str); 10] = [
-        (&["--look", "photo"], "unknown look"),
+        (&["--look", "photo"], "--look \"photo\" is unknown"),
         (
             &["--look", "realistic", "--secretion", "some"],
             "unknown secretion mode",
@@ -150,7 +150,7 @@ fn bad_look_values_are_refused_with_a_clear_message() {
         ),
         (
             &["--secretion", "on"],
-            "only apply to --look clinical or realistic",
+            "--secretion only applies to the clinical or realistic look",
         ),
         (&["--look", "realistic", "--still", "0"], "--still"),
     ];

@@ -2,7 +2,7 @@
 //! with or without alpha, 8 or 16 bits) read as its luminance, 0–1.
 
 use crate::error::{ReadError, Result};
-use endocast_core::look::{Texture, MAX_TEXELS};
+use endocast_core::look::{Texture, BUILT_IN_TEXTURES, MAX_TEXELS};
 use std::io::BufReader;
 use std::path::Path;
 
@@ -35,6 +35,29 @@ pub fn read_texture(path: &Path) -> Result<Texture> {
         })
         .collect();
     Texture::from_luma(width, height, luma).map_err(|e| ReadError::format(path, e.to_string()))
+}
+
+/// A detail texture by built-in name (`none`: no texture) or from a PNG file, as `--texture`
+/// and Python's `texture=` take it.
+pub fn named_or_file(spec: &str) -> Result<Option<Texture>> {
+    let name = spec.trim();
+    if BUILT_IN_TEXTURES.contains(&name.to_ascii_lowercase().as_str()) {
+        return Ok(Texture::built_in(name));
+    }
+    let path = Path::new(spec);
+    let is_png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png && !path.exists() {
+        return Err(ReadError::format(
+            path,
+            format!(
+                "unknown texture; choose {} or a .png file",
+                BUILT_IN_TEXTURES.join(", ")
+            ),
+        ));
+    }
+    read_texture(path).map(Some)
 }
 
 /// Refuses a texture of more than [`MAX_TEXELS`] pixels along an edge, from its header, before

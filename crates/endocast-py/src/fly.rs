@@ -20,8 +20,16 @@ use std::path::PathBuf;
 /// Flies along `route` — an (N, 3) array of points (LPS mm), or a path file as `endocast path`
 /// or 3D Slicer writes it (points or key frames) — one frame every `frame_step` mm (default
 /// 1) looking `look_ahead` mm ahead (default 10). With `out` (a `.gif`, an `.mp4` or a folder
-/// of PNGs) writes the film and returns its path (a `pathlib.Path`); without, returns the frames as an RGB uint8
-/// array (frames, height, width, 3).
+/// of PNGs) writes the film and returns its path (a `pathlib.Path`); without, returns the
+/// frames as an RGB uint8 array (frames, height, width, 3).
+///
+/// Options: `size` (width, height; default 384 × 384), `frame_step`, `look_ahead` (mm), `fps`,
+/// and `render`'s look, peel, lens and lumen options: `preset`, `mode`, `iso`, `iso2`,
+/// `iso_opacity`, `tf`, `step`, `jitter`, `skip_empty`, `shade_dvr`, `background`, `peel`,
+/// `peel_threshold`, `peel_falling`, `peel_keep`, `unpeeled`, `tf_after`, `look`,
+/// `secretion`, `secretion_iso`, `wetness`, `texture`, `texture_scale`, `attenuation`, `fov`,
+/// `near`, `lens`, `distortion`, `vignetting`, `lumen_threshold`, `bright_lumen`, `threads`
+/// (see `help(endocast.render)`). The volume may be a nibabel or SimpleITK image.
 #[pyfunction]
 #[pyo3(signature = (volume, route, out = None, **options))]
 pub fn fly<'py>(
@@ -56,6 +64,7 @@ pub fn fly<'py>(
         window: look.study.window(),
     };
     let mut flight = Flight::new(volume.renderer().clone(), options);
+    flight.set_look(look.look.clone());
     let mut looks = ShotSettings::new(look.settings.clone(), transfer_function);
     let mut frame = |n: usize| {
         py.detach(|| {

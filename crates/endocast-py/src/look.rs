@@ -7,75 +7,92 @@ use crate::kwargs::Kwargs;
 use endocast_core::camera::{default_up, Lens, Optics, Projection};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
-use endocast_core::render::{Camera, Mode, RenderSettings, TransferFunction};
-use endocast_core::study::{Study, StudyRequest};
+use endocast_core::render::{Camera, PeelLayer, RenderSettings, TransferFunction};
+use endocast_core::study::{
+    self, named, OptionError, PeelOptions, Study, StudyRequest, ViewOptions,
+};
 use endocast_core::Volume;
 use glam::DVec3;
 use pyo3::prelude::*;
+use std::sync::Arc;
 
 /// The look options as given (the keywords `render`, `fly` and `default_view` share), before
 /// a volume resolves them ([`LookOptions::resolve`]).
 pub struct LookOptions {
     preset: Option<&'static Preset>,
-    mode: Option<Mode>,
     iso: Option<f64>,
-    iso2: Option<f64>,
-    iso_opacity: Option<f32>,
-    tf: Option<TransferFunction>,
-    step: Option<f64>,
-    jitter: bool,
-    skip_empty: bool,
-    shade_dvr: Option<bool>,
-    background: Option<[f32; 3]>,
     lumen_threshold: Option<f64>,
     bright_lumen: bool,
     threads: Option<usize>,
+    view: ViewOptions,
+    realism: study::LookOptions,
 }
 
 impl LookOptions {
-    /// Takes `preset`, `mode`, `iso`, `iso2`, `iso_opacity`, `tf`, `step`, `jitter`,
-    /// `skip_empty`, `shade_dvr`, `background`, `lumen_threshold`, `bright_lumen` and
-    /// `threads`.
+    /// Takes `preset`, `iso`, `lumen_threshold`, `bright_lumen`, `threads`, the render
+    /// options (`mode`, `iso2`, `iso_opacity`, `tf`, `step`, `jitter`, `skip_empty`,
+    /// `shade_dvr`, `background`), the peel's (`peel`, `peel_threshold`, `peel_falling`,
+    /// `peel_keep`, `unpeeled`, `tf_after`) and the look's (`look`, `secretion`,
+    /// `secretion_iso`, `wetness`, `texture`, `texture_scale`, `attenuation`).
     pub fn take(kw: &Kwargs<'_>) -> PyResult<Self> {
-        let mode = kw
-            .take::<String>("mode")?
-            .map(|mode| {
-                Mode::from_name(&mode).ok_or_else(|| {
-                    error(format!(
-                        "unknown mode {mode:?}; choose iso, dvr, hybrid, two-iso, mip, minip or \
-                         peel"
-                    ))
+        let tf = |key| -> PyResult<Option<TransferFunction>> {
+            kw.take::<String>(key)?
+                .map(|tf| endocast_io::transfer_json::transfer_function(&tf).map_err(to_py))
+                .transpose()
+        };
+        let view = ViewOptions {
+            mode: named_option(kw, "mode", named::mode)?,
+            iso2: kw.take("iso2")?,
+            iso_opacity: kw.take("iso_opacity")?,
+            tf: tf("tf")?,
+            step: kw.take("step")?,
+            jitter: kw.take("jitter")?,
+            shade_dvr: kw.take("shade_dvr")?,
+            skip_empty: kw.take("skip_empty")?,
+            background: kw.take("background")?,
+            peel: PeelOptions {
+                layer: peel_layer(kw)?,
+                threshold: kw.take("peel_threshold")?,
+                falling: kw.take("peel_falling")?,
+                keep: kw.take("peel_keep")?,
+                unpeeled: named_option(kw, "unpeeled", named::unpeeled)?,
+                tf_after: tf("tf_after")?,
+            },
+        };
+        let realism = study::LookOptions {
+            kind: named_option(kw, "look", named::look)?,
+            secretion: named_option(kw, "secretion", named::secretion)?,
+            secretion_iso: kw.take("secretion_iso")?,
+            wetness: kw.take("wetness")?,
+            texture: kw
+                .take::<String>("texture")?
+                .map(|spec| {
+                    endocast_io::texture::named_or_file(&spec)
+                        .map(|t| t.map(Arc::new))
+                        .map_err(to_py)
                 })
-            })
-            .transpose()?;
-        let tf = kw
-            .take::<String>("tf")?
-            .map(|tf| endocast_io::transfer_json::transfer_function(&tf).map_err(to_py))
-            .transpose()?;
+                .transpose()?,
+            texture_scale: kw.take("texture_scale")?,
+            attenuation: kw.take("attenuation")?,
+        };
         Ok(Self {
             preset: kw
                 .take::<String>("preset")?
                 .map(|name| find_preset(&name))
                 .transpose()?,
-            mode,
             iso: finite("iso", kw.take("iso")?)?,
-            iso2: kw.take("iso2")?,
-            iso_opacity: kw.take("iso_opacity")?,
-            tf,
-            step: kw.take("step")?,
-            jitter: kw.take("jitter")?.unwrap_or(false),
-            skip_empty: kw.take("skip_empty")?.unwrap_or(true),
-            shade_dvr: kw.take("shade_dvr")?,
-            background: kw.take("background")?,
             lumen_threshold: finite("lumen_threshold", kw.take("lumen_threshold")?)?,
             bright_lumen: kw.take("bright_lumen")?.unwrap_or(false),
             threads: kw.take("threads")?,
+            view,
+            realism,
         })
     }
 
     /// The study of `volume` these options ask for (the same as `endocast render`'s: the preset
     /// in the scan's units, the lumen, the structure and the start, or `pose` when the caller
-    /// placed the camera; resolved without the GIL), and the settings with every option on top.
+    /// placed the camera; resolved without the GIL), and the settings and look with every
+    /// option on top.
     pub fn resolve(
         &self,
         py: Python<'_>,
@@ -92,7 +109,15 @@ impl LookOptions {
             pose,
         };
         let study = py.detach(|| Study::resolve(volume, &request));
-        let settings = self.overridden(study.settings().clone())?;
+        let settings = self
+            .view
+            .apply(study.settings().clone())
+            .map_err(option_error)?;
+        settings.validate().map_err(to_py)?;
+        let look = self
+            .realism
+            .resolve(&study.look(), self.iso)
+            .map_err(option_error)?;
         let pool = match self.threads {
             None => None,
             Some(0) => return Err(error("threads must be at least 1")),
@@ -106,37 +131,33 @@ impl LookOptions {
         Ok(Look {
             study,
             settings,
+            look,
             pool,
         })
     }
+}
 
-    fn overridden(&self, mut s: RenderSettings) -> PyResult<RenderSettings> {
-        if let Some(mode) = self.mode {
-            s.mode = mode;
-        }
-        if let Some(iso2) = self.iso2 {
-            s.iso2_hu = iso2;
-        }
-        if let Some(alpha) = self.iso_opacity {
-            s.iso_opacity = alpha;
-        }
-        if let Some(tf) = &self.tf {
-            s.tf.clone_from(tf);
-        }
-        if let Some(step) = self.step {
-            s.step_vox = step;
-        }
-        s.jitter = self.jitter;
-        s.skip_empty = self.skip_empty;
-        if let Some(shade) = self.shade_dvr {
-            s.shade_dvr = shade;
-        }
-        if let Some(background) = self.background {
-            s.background = background;
-        }
-        s.validate().map_err(to_py)?;
-        Ok(s)
-    }
+/// The option `key`, a name parsed by `parse`, if given.
+fn named_option<T>(
+    kw: &Kwargs<'_>,
+    key: &str,
+    parse: fn(&str) -> Result<T, OptionError>,
+) -> PyResult<Option<T>> {
+    kw.take::<String>(key)?
+        .map(|name| parse(&name).map_err(option_error))
+        .transpose()
+}
+
+/// `peel`: a number (1, 2, 3 …) or "last".
+fn peel_layer(kw: &Kwargs<'_>) -> PyResult<Option<PeelLayer>> {
+    kw.take::<Bound<'_, PyAny>>("peel")?
+        .map(|v| named::peel_layer(&v.str()?.to_string()).map_err(option_error))
+        .transpose()
+}
+
+/// An option's error as Python's exception, the option named by its keyword.
+fn option_error(e: OptionError) -> PyErr {
+    error(e.message(str::to_owned))
 }
 
 /// `value` when it is finite (or absent), else an error naming the option.
@@ -153,6 +174,8 @@ pub struct Look {
     pub study: Study,
     /// The settings in force.
     pub settings: RenderSettings,
+    /// The clinical or realistic look's stages; `None` for the plain look.
+    pub look: Option<endocast_core::look::Look>,
     /// The workers of the `threads` option (`None`: rayon's global pool, all cores); made
     /// once, so that a flight's frames share it.
     pool: Option<rayon::ThreadPool>,

@@ -5,6 +5,7 @@ use crate::kwargs::Kwargs;
 use crate::look::{camera, LookOptions, Placed};
 use crate::volume::Volume;
 use endocast_core::camera::StereoRig;
+use endocast_core::look::{still_view, MAX_STILL_FRAMES};
 use endocast_core::render::{Camera, Frame, Prepared};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
@@ -52,6 +53,12 @@ struct View {
 ///   orthographic), `distortion` (k1, k2), `vignetting`;
 /// - stereo: `stereo` (anaglyph, red-cyan, dubois, side-by-side, top-bottom, pair),
 ///   `eye_separation`, `focus` (mm);
+/// - depth peeling (`mode="peel"`): `peel` (1, 2, 3 … or "last"), `peel_threshold`,
+///   `peel_falling`, `peel_keep` (0–1), `unpeeled` (discard, context), `tf_after`;
+/// - the endoscope's look: `look` (plain, clinical, realistic; default the preset's),
+///   `secretion` (off, on, accumulate), `secretion_iso`, `wetness` (0–1), `texture`
+///   (mucosa, grid, none or a PNG file), `texture_scale` (mm), `attenuation` (mm, 0: none),
+///   `still` (average this many jittered frames, 1–256);
 /// - lumen: `lumen_threshold`, `bright_lumen`.
 #[pyfunction]
 #[pyo3(signature = (volume, **options))]
@@ -67,13 +74,26 @@ pub fn render<'py>(
     let look = options.resolve(py, volume.volume(), placed.pose, placed.fov)?;
     let camera = camera(&kw, &look, volume.volume(), &placed)?;
     let stereo = stereo_options(&kw)?;
+    let still = kw.take::<usize>("still")?.unwrap_or(1);
     kw.finish()?;
+    if !(1..=MAX_STILL_FRAMES).contains(&still) {
+        return Err(error(format!(
+            "still must be between 1 and {MAX_STILL_FRAMES} frames, not {still}"
+        )));
+    }
+    if look.look.is_some() && stereo.is_some() {
+        return Err(error(
+            "the clinical and realistic looks draw no stereo pair yet; use look=\"plain\"",
+        ));
+    }
     let renderer = volume.renderer().clone();
     let view = py.detach(|| -> PyResult<View> {
         let prepared = renderer.prepare(&look.settings).map_err(to_py)?;
         match &stereo {
             None => {
-                let frame = look.in_pool(|| prepared.render(&camera));
+                let frame = look
+                    .in_pool(|| still_view(&prepared, look.look.as_ref(), &camera, still))
+                    .map_err(to_py)?;
                 Ok(single(&frame, look.settings.background))
             }
             Some(stereo) => look.in_pool(|| render_stereo(&prepared, &camera, stereo)),

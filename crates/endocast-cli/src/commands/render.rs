@@ -12,11 +12,9 @@ use crate::structure;
 use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::look::{self, RayPass};
+use endocast_core::look::{self, MAX_STILL_FRAMES};
 use endocast_core::presets::Preset;
-use endocast_core::render::{
-    Camera, Frame, Prepared, RenderOptions, RenderSettings, Renderer, Still,
-};
+use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
 use endocast_core::study::Study;
 use endocast_core::tissue::short;
 use endocast_core::views::stereo::{self, StereoOutput};
@@ -136,16 +134,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             both
         }
         None => {
-            let frame = match &look.look {
-                Some(l) => {
-                    let pass = RayPass::new(&renderer, settings, &l.ray).context("invalid look")?;
-                    in_pool(args.look.threads, || {
-                        look::still(&pass, &camera, &l.shading, args.still)
-                    })?
-                    .context("invalid look")?
-                }
-                None => in_pool(args.look.threads, || still(&prepared, &camera, args.still))??,
-            };
+            let frame = in_pool(args.look.threads, || {
+                look::still_view(&prepared, look.look.as_ref(), &camera, args.still)
+            })?
+            .context("invalid look")?;
             let [w, h] = [frame.width as u32, frame.height as u32];
             let mut image = Image::from_frame(&frame, settings.background)?;
             if let Some(marks) = &marks {
@@ -179,19 +171,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The most frames `--still` averages.
-const MAX_STILL_FRAMES: usize = 256;
-
-/// The average of `frames` jittered frames of `camera` (one: the plain frame).
-fn still(prepared: &Prepared, camera: &Camera, frames: usize) -> Result<Frame> {
-    let mut still = Still::new();
-    for _ in 0..frames {
-        // Nothing cancels it.
-        let _ = still.render_next(prepared, camera, &RenderOptions::new());
-    }
-    Ok(still.frame().clone())
 }
 
 /// The camera of the study's start (the user's pose, or inside the structure the preset

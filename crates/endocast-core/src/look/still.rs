@@ -5,9 +5,9 @@
 use super::deferred::shade;
 use super::gbuffer::RayPass;
 use super::shading::Shading;
-use super::LookError;
+use super::{Look, LookError};
 use crate::camera::Camera;
-use crate::render::{Frame, Jitter, Quality, Still};
+use crate::render::{Frame, Jitter, Prepared, Quality, RenderOptions, Still};
 
 /// The average of `frames` (at least one) shaded ray passes of `camera` by `pass`, frame `k`
 /// jittered as [`Jitter::of_frame`]`(k)` says (frame 0 is the plain pass).
@@ -24,6 +24,30 @@ pub fn still(
         let jittered = camera.with_pixel_offset(dx, dy);
         let gbuffer = pass.trace_shifted(&jittered, Quality::Full, jitter.grid_shift);
         still.add(&shade(&gbuffer, &jittered, shading)?);
+    }
+    Ok(still.frame().clone())
+}
+
+/// The most frames a still averages on request (`--still`, `still=`).
+pub const MAX_STILL_FRAMES: usize = 256;
+
+/// A converged still of `camera`: the average of `frames` (at least one) jittered frames, drawn
+/// as `look` says over `prepared`'s settings, or `prepared`'s own image without a look (the
+/// plain look, its geometry included).
+pub fn still_view(
+    prepared: &Prepared,
+    look: Option<&Look>,
+    camera: &Camera,
+    frames: usize,
+) -> Result<Frame, LookError> {
+    if let Some(look) = look {
+        let pass = RayPass::new(prepared.renderer(), prepared.settings(), &look.ray)?;
+        return still(&pass, camera, &look.shading, frames);
+    }
+    let mut still = Still::new();
+    for _ in 0..frames.max(1) {
+        // Nothing cancels it.
+        let _ = still.render_next(prepared, camera, &RenderOptions::new());
     }
     Ok(still.frame().clone())
 }

@@ -29,10 +29,12 @@
 //! ```
 
 mod framing;
+mod options;
 mod route;
 mod start;
 
 pub use framing::{object_bounds, object_framing};
+pub use options::{named, LookOptions, OptionError, PeelOptions, ViewOptions};
 pub use route::{StudyPath, StudyPathError};
 pub use start::LOOK_AHEAD_MM;
 

@@ -123,14 +123,7 @@ impl CasePeel {
 
 /// A peel layer by name: `N` (1, 2, 3 …) or `last`.
 pub fn peel_layer(text: &str) -> Result<PeelLayer, String> {
-    let text = text.trim();
-    if text.eq_ignore_ascii_case("last") {
-        return Ok(PeelLayer::Last);
-    }
-    match text.parse::<u32>() {
-        Ok(n) if n >= 1 => Ok(PeelLayer::Nth(n)),
-        _ => Err(format!("expected 1, 2, 3 … or last, found {text:?}")),
-    }
+    endocast_core::study::named::peel_layer(text).map_err(|e| e.problem)
 }
 
 /// Which geometry the viewer shows with the scan, and the mesh files it read (read again when

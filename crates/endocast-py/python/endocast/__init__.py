@@ -1,6 +1,7 @@
 """endocast: virtual endoscopy of CT and MRI scans from Python.
 
-Read a scan (``open``) or wrap a numpy array (``Volume.from_array``), render the endoscope's
+Read a scan (``open``), wrap a numpy array (``Volume.from_array``) or pass a nibabel or
+SimpleITK image as it is (``as_volume`` converts it), render the endoscope's
 view (``render``), plan a centred path through a lumen (``path``) and fly along it (``fly``).
 The options are those of the ``endocast`` command (``--look-at`` is ``look_at=``), with the
 same defaults and presets; positions are in the patient frame, LPS millimetres, as DICOM has
@@ -11,21 +12,19 @@ them (``Volume.affine_ras`` converts to nibabel's RAS).
     >>> rgba, depth = endocast.render(vol, preset="colonoscopy", size=(256, 256))
 """
 
-from ._endocast import (
-    EndocastError,
-    Volume,
-    default_view,
-    fly,
-    open,
-    path,
-    presets,
-    render,
-    save_png,
-)
+from . import _endocast
+from ._endocast import EndocastError, Volume, open, presets, save_png
+from ._images import accepting_images, as_volume
+
+render = accepting_images(_endocast.render)
+default_view = accepting_images(_endocast.default_view)
+path = accepting_images(_endocast.path)
+fly = accepting_images(_endocast.fly)
 
 __all__ = [
     "EndocastError",
     "Volume",
+    "as_volume",
     "default_view",
     "fly",
     "open",

@@ -2,7 +2,7 @@
 
 import os
 import pathlib
-from typing import Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -13,6 +13,11 @@ _Path = Union[str, "os.PathLike[str]"]
 _Mode = Literal["iso", "dvr", "hybrid", "two-iso", "mip", "minip", "peel"]
 _Lens = Literal["pinhole", "equidistant", "equisolid", "orthographic"]
 _Stereo = Literal["anaglyph", "red-cyan", "dubois", "side-by-side", "top-bottom", "pair"]
+_Look = Literal["plain", "clinical", "realistic"]
+_Secretion = Literal["off", "on", "accumulate"]
+_Unpeeled = Literal["discard", "context"]
+# A volume: endocast's own, or a nibabel image or SimpleITK Image (``as_volume`` converts them).
+_VolumeLike = Union["Volume", Any]
 
 class EndocastError(ValueError):
     """An error from endocast; the message is the library's, naming the file and the problem."""
@@ -74,7 +79,7 @@ def open(
     """Read a DICOM directory or file, NIfTI, NRRD or MetaImage scan."""
 
 def render(
-    volume: Volume,
+    volume: _VolumeLike,
     *,
     preset: Optional[str] = None,
     mode: Optional[_Mode] = None,
@@ -83,8 +88,8 @@ def render(
     iso_opacity: Optional[float] = None,
     tf: Optional[str] = None,
     step: Optional[float] = None,
-    jitter: bool = False,
-    skip_empty: bool = True,
+    jitter: Optional[bool] = None,
+    skip_empty: Optional[bool] = None,
     shade_dvr: Optional[bool] = None,
     background: Optional[_Vec3] = None,
     eye: Optional[_Point] = None,
@@ -99,6 +104,20 @@ def render(
     stereo: Optional[_Stereo] = None,
     eye_separation: Optional[float] = None,
     focus: Optional[float] = None,
+    peel: Optional[Union[int, Literal["last"]]] = None,
+    peel_threshold: Optional[float] = None,
+    peel_falling: Optional[bool] = None,
+    peel_keep: Optional[float] = None,
+    unpeeled: Optional[_Unpeeled] = None,
+    tf_after: Optional[str] = None,
+    look: Optional[_Look] = None,
+    secretion: Optional[_Secretion] = None,
+    secretion_iso: Optional[float] = None,
+    wetness: Optional[float] = None,
+    texture: Optional[str] = None,
+    texture_scale: Optional[float] = None,
+    attenuation: Optional[float] = None,
+    still: int = 1,
     lumen_threshold: Optional[float] = None,
     bright_lumen: bool = False,
     threads: Optional[int] = None,
@@ -108,10 +127,13 @@ def render(
     rgba is uint8 (height, width, 4), the colour over the background with alpha 255; depth is
     float32 (height, width), mm from the eye to the first isosurface hit, NaN where none.
     ``size`` is (width, height). ``stereo="pair"`` gives (2, height, width, 4) and
-    (2, height, width). Without ``eye``/``look_at`` the camera is ``default_view``'s."""
+    (2, height, width). Without ``eye``/``look_at`` the camera is ``default_view``'s.
+    ``mode="peel"`` with the ``peel*`` options peels (Borland et al.); ``look`` "clinical" or
+    "realistic" draws the endoscope's look (Krüger et al.) with ``secretion``, ``wetness``,
+    ``texture``, ``attenuation``; ``still`` averages that many jittered frames."""
 
 def default_view(
-    volume: Volume,
+    volume: _VolumeLike,
     *,
     preset: Optional[str] = None,
     iso: Optional[float] = None,
@@ -126,7 +148,7 @@ def default_view(
     without one, the whole object framed from the front. Takes ``render``'s look options."""
 
 def path(
-    volume: Volume,
+    volume: _VolumeLike,
     start: Optional[_Point] = None,
     end: Optional[_Point] = None,
     *,
@@ -148,7 +170,7 @@ def path(
 
 @overload
 def fly(
-    volume: Volume,
+    volume: _VolumeLike,
     route: Union[_Path, npt.ArrayLike],
     out: None = None,
     *,
@@ -159,8 +181,8 @@ def fly(
     iso_opacity: Optional[float] = None,
     tf: Optional[str] = None,
     step: Optional[float] = None,
-    jitter: bool = False,
-    skip_empty: bool = True,
+    jitter: Optional[bool] = None,
+    skip_empty: Optional[bool] = None,
     shade_dvr: Optional[bool] = None,
     background: Optional[_Vec3] = None,
     fov: Optional[float] = None,
@@ -168,6 +190,19 @@ def fly(
     lens: Optional[_Lens] = None,
     distortion: Optional[Tuple[float, float]] = None,
     vignetting: float = 0.0,
+    peel: Optional[Union[int, Literal["last"]]] = None,
+    peel_threshold: Optional[float] = None,
+    peel_falling: Optional[bool] = None,
+    peel_keep: Optional[float] = None,
+    unpeeled: Optional[_Unpeeled] = None,
+    tf_after: Optional[str] = None,
+    look: Optional[_Look] = None,
+    secretion: Optional[_Secretion] = None,
+    secretion_iso: Optional[float] = None,
+    wetness: Optional[float] = None,
+    texture: Optional[str] = None,
+    texture_scale: Optional[float] = None,
+    attenuation: Optional[float] = None,
     size: Tuple[int, int] = (384, 384),
     frame_step: float = 1.0,
     look_ahead: float = 10.0,
@@ -178,7 +213,7 @@ def fly(
     films the endoscopic view: without ``out`` the frames, RGB uint8 (frames, height, width, 3)."""
 @overload
 def fly(
-    volume: Volume,
+    volume: _VolumeLike,
     route: Union[_Path, npt.ArrayLike],
     out: _Path,
     **options: object,
