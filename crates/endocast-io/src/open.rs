@@ -5,6 +5,7 @@ use crate::error::{ReadError, Result};
 use crate::escape::escape;
 use crate::loaded::{Format, Loaded, OpenOptions};
 use crate::{dicom, metaimage, nifti, nrrd, raw};
+use endocast_core::navigate::guess_head_orientation;
 use endocast_core::{Geometry, Volume};
 use std::io::Read;
 use std::path::Path;
@@ -42,9 +43,9 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
 }
 
 /// Gives an undeclared orientation the code the user named (see [`OpenOptions::orientation`]).
-fn apply_orientation(path: &Path, mut loaded: Loaded, code: Option<&str>) -> Result<Loaded> {
+fn apply_orientation(path: &Path, loaded: Loaded, code: Option<&str>) -> Result<Loaded> {
     let Some(code) = code else {
-        return Ok(loaded);
+        return guess_orientation(path, loaded);
     };
     if loaded.source.orientation_declared {
         return Err(ReadError::inconsistent(
@@ -56,6 +57,36 @@ fn apply_orientation(path: &Path, mut loaded: Loaded, code: Option<&str>) -> Res
             ),
         ));
     }
+    let mut loaded = oriented(path, loaded, code)?;
+    loaded.warnings.push(format!(
+        "{}: orientation {code} assumed, as asked",
+        path.display()
+    ));
+    Ok(loaded)
+}
+
+/// A head CT that declares no orientation turned upright: its orientation guessed from the
+/// anatomy ([`guess_head_orientation`]), with a warning that says so.
+fn guess_orientation(path: &Path, loaded: Loaded) -> Result<Loaded> {
+    if loaded.source.orientation_declared {
+        return Ok(loaded);
+    }
+    let Some(guess) = guess_head_orientation(&loaded.volume) else {
+        return Ok(loaded);
+    };
+    let mut loaded = oriented(path, loaded, &guess.code)?;
+    loaded.warnings.push(format!(
+        "{}: read as {} instead, guessed from the anatomy ({}); --orientation \
+         overrides",
+        path.display(),
+        guess.code,
+        guess.reason
+    ));
+    Ok(loaded)
+}
+
+/// `loaded` with its index axes pointing as `code` says.
+fn oriented(path: &Path, mut loaded: Loaded, code: &str) -> Result<Loaded> {
     let direction = Geometry::direction_from_code(code).ok_or_else(|| {
         ReadError::format(
             path,
@@ -71,10 +102,6 @@ fn apply_orientation(path: &Path, mut loaded: Loaded, code: Option<&str>) -> Res
     let (map, modality) = (volume.value_map(), volume.modality().clone());
     loaded.volume = Volume::new(geometry, volume.into_voxels(), map, modality)
         .map_err(|e| ReadError::format(path, e.to_string()))?;
-    loaded.warnings.push(format!(
-        "{}: orientation {code} assumed, as asked",
-        path.display()
-    ));
     Ok(loaded)
 }
 

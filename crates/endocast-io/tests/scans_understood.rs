@@ -155,3 +155,39 @@ fn the_airway_tree_is_found_on_the_chest_ct_without_the_lung() {
     );
     assert!(tree_s.voxels().all(|[a, b, c]| tree.contains([b, c, a])));
 }
+
+#[test]
+fn head_cts_without_an_orientation_are_read_upright() {
+    // CThead and headsq store their slices from the top of the head down (bench/scenes.json
+    // gave them --orientation LPI); the guess from the anatomy finds it and says so.
+    for name in [
+        "head-ct-stanford-cthead/CThead.nhdr",
+        "classic-vtk-headsq/quarter.nhdr",
+    ] {
+        let Some(path) = shared_data(name) else {
+            return;
+        };
+        let loaded = endocast_io::open(&path, &OpenOptions::default()).unwrap();
+        assert_eq!(loaded.volume.geometry().orientation_code(), "LPI", "{name}");
+        assert!(
+            loaded
+                .warnings
+                .iter()
+                .any(|w| w.contains("guessed from the anatomy")),
+            "{name}: {:?}",
+            loaded.warnings
+        );
+        // Given, the orientation wins over the guess.
+        let mut options = OpenOptions::default();
+        options.orientation = Some("LPS".into());
+        let given = endocast_io::open(&path, &options).unwrap();
+        assert_eq!(given.volume.geometry().orientation_code(), "LPS", "{name}");
+    }
+    // The GE head declares its orientation: the guess agrees with it.
+    let Some(ge) = load("head-ct-ge-gantry-tilt/GE") else {
+        return;
+    };
+    let guess = endocast_core::navigate::guess_head_orientation(&ge).unwrap();
+    let declared = ge.geometry().orientation_code();
+    assert_eq!(guess.code[2..], declared[2..], "{}", guess.reason);
+}

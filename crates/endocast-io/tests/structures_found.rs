@@ -230,16 +230,16 @@ fn sinus_on_cthead_starts_in_the_nasal_cavity_not_the_mastoid_cells() {
     assert!(s.what.starts_with("nasal cavity"), "{}", s.what);
     // The passages are a few millimetres wide: the wall is near.
     assert_walled("sinus", &s, (1.0, 40.0));
-    // Measured on the slices (1 × 1 × 2 mm voxels, no orientation: read as LPS, k = 0 the
-    // vertex): the nasal cavity from the nostrils (j ≈ 20, k ≈ 57) back to the choanae
+    // Measured on the slices (1 × 1 × 2 mm voxels, no orientation declared: read as LPI,
+    // guessed from the anatomy, k = 0 the vertex): the nasal cavity from the nostrils (j ≈ 20, k ≈ 57) back to the choanae
     // (j ≈ 100), between the hard palate (k ≈ 68) and the cribriform plate (k ≈ 38), the
     // septum at i ≈ 115; the sphenoid sinus behind it (j ≥ 95), the mastoid cells at the sides
-    // (i < 70, i > 185). World mm: x = i, y = j, z = 2k.
+    // (i < 70, i > 185). World mm: x = i, y = j, z = −2k.
     let eye = s.pose.eye_mm;
     assert!(
         (100.0..=135.0).contains(&eye.x)
             && (20.0..=85.0).contains(&eye.y)
-            && (76.0..=136.0).contains(&eye.z),
+            && (-136.0..=-76.0).contains(&eye.z),
         "{eye}: not in the nasal cavity"
     );
     // Looking back along the passages, towards the choanae.

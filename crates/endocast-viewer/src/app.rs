@@ -257,6 +257,19 @@ impl ViewerApp {
                 };
                 self.start_loading(source, None);
             }
+            Action::Reorient(code) => {
+                let Some(ScanSource::File { path, series, .. }) =
+                    self.session().map(|s| s.scene().source.clone())
+                else {
+                    return;
+                };
+                let source = ScanSource::File {
+                    path,
+                    series,
+                    orientation: Some(code),
+                };
+                self.start_loading(source, None);
+            }
             Action::SaveCase => self.autosave(true),
             Action::Message(m) => self.message = m,
         }

@@ -137,10 +137,10 @@ fn load(
         None => None,
     };
     let source = case_file.as_ref().map_or(source, |c| c.scan.clone());
-    let (volume, series) = source.load_with_series(progress)?;
+    let (volume, facts) = source.load_with_facts(progress)?;
     preparing.store(true, Ordering::Release);
     ctx.request_repaint();
-    let scene = Arc::new(Scene::new(source, volume).with_series(series));
+    let scene = Arc::new(Scene::new(source, volume).with_facts(facts));
     let repaint = ctx.clone();
     let mut session = Session::new(scene, preset, pose, move || repaint.request_repaint());
     let mut problems = Vec::new();

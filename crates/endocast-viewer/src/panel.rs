@@ -36,6 +36,9 @@ pub(crate) fn controls_ui(
     if let Some(uid) = series_ui(ui, &ready.session) {
         action = Some(Action::OpenSeries(uid));
     }
+    if let Some(code) = orientation_ui(ui, &ready.session) {
+        action = Some(Action::Reorient(code));
+    }
     ui.separator();
     view_controls_ui(ui, &mut ready.session);
     ui.separator();
@@ -135,6 +138,37 @@ fn series_ui(ui: &mut egui::Ui, session: &Session) -> Option<String> {
             }
         });
     chosen.filter(|uid| Some(uid) != current.as_ref())
+}
+
+/// For a file that declares no orientation: the one in force (guessed from the anatomy or
+/// given) and a button that turns the scan the other way up; returns the code asked for.
+fn orientation_ui(ui: &mut egui::Ui, session: &Session) -> Option<String> {
+    let scene = session.scene();
+    if scene.orientation_declared {
+        return None;
+    }
+    let code = scene.volume().geometry().orientation_code();
+    let flipped: String = code
+        .chars()
+        .map(|c| match c {
+            'S' => 'I',
+            'I' => 'S',
+            other => other,
+        })
+        .collect();
+    let mut asked = None;
+    ui.horizontal(|ui| {
+        ui.label(format!("orientation {code} (not in the file)"))
+            .on_hover_text("guessed from the anatomy, or as given with --orientation");
+        if ui
+            .button("Flip upside down")
+            .on_hover_text(format!("read the scan again as {flipped}"))
+            .clicked()
+        {
+            asked = Some(flipped.clone());
+        }
+    });
+    asked
 }
 
 fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {

@@ -5,6 +5,7 @@ use endocast_core::annotate::ScanIdentity;
 use endocast_core::navigate::{seed_voxel, Collider, DistanceField, Lumen, LumenSide};
 use endocast_core::render::Renderer;
 use endocast_core::Volume;
+use endocast_io::case::ScanFacts;
 pub use endocast_io::case::ScanSource;
 use endocast_io::SeriesSummary;
 use glam::DVec3;
@@ -110,6 +111,9 @@ pub struct Scene {
     pub identity: ScanIdentity,
     /// The series of the DICOM folder it was read from (empty for other sources).
     pub series_found: Vec<SeriesSummary>,
+    /// Whether the file declared its orientation (else it was guessed or given: the panel
+    /// offers to flip it).
+    pub orientation_declared: bool,
 }
 
 impl Scene {
@@ -125,12 +129,15 @@ impl Scene {
             histogram,
             value_range,
             series_found: Vec::new(),
+            orientation_declared: true,
         }
     }
 
-    /// The scene, knowing the series its DICOM folder holds.
-    pub fn with_series(mut self, series_found: Vec<SeriesSummary>) -> Self {
-        self.series_found = series_found;
+    /// The scene, knowing what its reader found: the series its DICOM folder holds, whether
+    /// the file declared its orientation.
+    pub fn with_facts(mut self, facts: ScanFacts) -> Self {
+        self.series_found = facts.series_found;
+        self.orientation_declared = facts.orientation_declared;
         self
     }
 

@@ -37,6 +37,9 @@ pub(crate) enum Action {
     Open,
     /// Read another series of the open DICOM folder (its SeriesInstanceUID).
     OpenSeries(String),
+    /// Read the scan again with its index axes pointing as this code says (a file that
+    /// declares no orientation, turned the other way up).
+    Reorient(String),
     /// Save the case now.
     SaveCase,
     /// Show a line in the status bar.

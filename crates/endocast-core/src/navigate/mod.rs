@@ -38,6 +38,7 @@ mod side;
 #[cfg(test)]
 mod test_util;
 mod trachea;
+mod upright;
 mod viewpoint;
 
 pub use aorta::{find_aorta, Aorta};
@@ -59,6 +60,7 @@ pub use nasal::{
 pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
 pub use trachea::find_trachea;
+pub use upright::{guess_head_orientation, UprightGuess};
 pub(crate) use viewpoint::looking_along;
 pub use viewpoint::{
     default_view, default_viewpoint, viewpoint_in, DefaultView, FramingReason, NOT_CONFIDENT,

@@ -32,7 +32,7 @@ pub use records::{
     peel_layer, AnnotationRecord, CaseCamera, CaseControls, CaseGeometry, CaseKeyFrame, CasePeel,
     CaseTransfer,
 };
-pub use scan::{IdentityRecord, ScanSource};
+pub use scan::{IdentityRecord, ScanFacts, ScanSource};
 
 use endocast_core::annotate::{Annotations, ScanIdentity};
 use serde::{Deserialize, Serialize};

@@ -31,19 +31,27 @@ pub enum ScanSource {
     },
 }
 
+/// What a front end offers around a scan it read.
+#[derive(Debug, Clone, Default)]
+pub struct ScanFacts {
+    /// The series of the DICOM folder it was read from (empty for other sources).
+    pub series_found: Vec<SeriesSummary>,
+    /// Whether the file declared its patient orientation (a phantom's is known); when it did
+    /// not, the orientation was guessed from the anatomy or given, and may be flipped.
+    pub orientation_declared: bool,
+}
+
 impl ScanSource {
     /// Reads or generates the volume; the error is one line naming the file and the problem.
     pub fn load(&self) -> Result<Volume, String> {
-        self.load_with_series(&Progress::default())
+        self.load_with_facts(&Progress::default())
             .map(|(volume, _)| volume)
     }
 
-    /// Reads or generates the volume, with the series a DICOM folder holds (empty for other
-    /// sources) so the user can choose another; the reader counts how far it is in `progress`.
-    pub fn load_with_series(
-        &self,
-        progress: &Progress,
-    ) -> Result<(Volume, Vec<SeriesSummary>), String> {
+    /// Reads or generates the volume, with what the viewer offers around it (the series a
+    /// DICOM folder holds, whether the file declared its orientation); the reader counts how
+    /// far it is in `progress`.
+    pub fn load_with_facts(&self, progress: &Progress) -> Result<(Volume, ScanFacts), String> {
         match self {
             Self::File {
                 path,
@@ -54,9 +62,13 @@ impl ScanSource {
                 options.series.clone_from(series);
                 options.orientation.clone_from(orientation);
                 options.progress = progress.clone();
-                crate::open(path, &options)
-                    .map(|loaded| (loaded.volume, loaded.source.series_found))
-                    .map_err(|e| format!("cannot read the scan: {e}"))
+                let loaded = crate::open(path, &options)
+                    .map_err(|e| format!("cannot read the scan: {e}"))?;
+                let facts = ScanFacts {
+                    series_found: loaded.source.series_found,
+                    orientation_declared: loaded.source.orientation_declared,
+                };
+                Ok((loaded.volume, facts))
             }
             Self::Phantom { name, size } => {
                 let phantom = Phantom::from_name(name)
@@ -65,7 +77,11 @@ impl ScanSource {
                     size: *size,
                     ..PhantomOptions::default()
                 };
-                Ok((phantom.build(&options), Vec::new()))
+                let facts = ScanFacts {
+                    series_found: Vec::new(),
+                    orientation_declared: true,
+                };
+                Ok((phantom.build(&options), facts))
             }
         }
     }
