@@ -48,6 +48,11 @@ pub struct SceneArgs {
     /// A second instrument beside the first (with --endoscope).
     #[arg(long, requires = "endoscope")]
     pub second_instrument: bool,
+    /// A DICOM segmentation (SEG: each segment a surface in its recommended colour) or dose
+    /// grid (RTDOSE: isodose surfaces at LEVELS in its units, default 50, 80 and 95 % of its
+    /// maximum) drawn with the scan. Repeatable.
+    #[arg(long, value_name = "FILE[:LEVELS]")]
+    pub overlay: Vec<String>,
 }
 
 impl SceneArgs {
@@ -59,6 +64,9 @@ impl SceneArgs {
             let (path, material) = mesh_spec(spec)?;
             let mesh = endocast_io::mesh::read_mesh(&path).context("cannot read the mesh")?;
             scene.add_mesh(&mesh, material);
+        }
+        for spec in &self.overlay {
+            eprintln!("{}", crate::overlay::add_overlay(&mut scene, spec)?);
         }
         if let Some(spec) = &self.grid {
             scene.add_grid(self.grid(spec)?, Material::GRID);

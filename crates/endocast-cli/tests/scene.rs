@@ -77,3 +77,67 @@ fn bad_geometry_options_are_clear_errors() {
     fails_with(&["mesh", volume, "-o", "x.stl"], "--iso or --preset");
     fails_with(&["mesh", volume, "--iso", "-480", "-o", "x.vtk"], "x.vtk");
 }
+
+#[test]
+fn a_segmentation_overlay_is_drawn_where_its_voxels_are() {
+    use endocast_testdata::overlays::{write_segmentation, Grid, SegFrame};
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let volume = path("shell.nii.gz");
+    assert!(
+        endocast(&["phantom", "sphere-shell", "-o", &volume, "--size", "48"])
+            .status
+            .success()
+    );
+    // A 9 × 9 × 5 mm block of one segment in the air ahead of the eye, z 5–9 mm.
+    let seg = path("block.dcm");
+    let grid = Grid {
+        origin: [-4.0, -4.0, 5.0],
+        spacing: [1.0, 1.0],
+        size: [9, 9],
+    };
+    let all: Vec<(usize, usize)> = (0..9).flat_map(|r| (0..9).map(move |c| (r, c))).collect();
+    let frames: Vec<SegFrame> = (5..10)
+        .map(|z| SegFrame {
+            segment: 1,
+            z: f64::from(z),
+            pixels: all.clone(),
+        })
+        .collect();
+    write_segmentation(
+        std::path::Path::new(&seg),
+        &grid,
+        &[(1, "block", [34865, 53485, 50171])],
+        &frames,
+    );
+    let depth = path("depth.npy");
+    let png = path("view.png");
+    let out = endocast(&[
+        "render",
+        &volume,
+        "-o",
+        &png,
+        "--depth-out",
+        &depth,
+        "--mode",
+        "iso",
+        "--eye",
+        "0,0,0",
+        "--look-at",
+        "0,0,1",
+        "--size",
+        "33x33",
+        "--overlay",
+        &seg,
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("overlay") && stderr.contains("block 0.4 ml"),
+        "{stderr}"
+    );
+    // The block's near face: half a voxel before its first plane of voxel centres.
+    let (_, depths) = read_npy(std::path::Path::new(&depth));
+    let centre = depths[16 * 33 + 16];
+    assert!((centre - 4.5).abs() < 0.1, "{centre}");
+}

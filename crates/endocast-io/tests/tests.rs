@@ -13,6 +13,7 @@ mod metaimage;
 mod mp4;
 mod nifti;
 mod nrrd;
+mod overlay;
 mod peel_real_scans;
 mod scans_understood;
 mod stereo_real_scans;

@@ -4,6 +4,8 @@
 //! line on the terminal, written past the test harness's capture so that a run which checked
 //! nothing says so.
 
+pub mod overlays;
+
 use std::io::Write;
 use std::path::PathBuf;
 

@@ -49,6 +49,7 @@
 mod frame;
 mod jpegls;
 mod lengths;
+mod overlay;
 mod pixels;
 mod rle;
 mod scan;
@@ -56,6 +57,8 @@ mod series;
 mod stack;
 mod stream_size;
 mod values;
+
+pub use overlay::{read_overlay, Overlay, OverlayKind, Segment};
 
 use crate::error::{ReadError, Result};
 use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
@@ -75,6 +78,9 @@ use std::path::Path;
 /// decoded ([`ReadError::Unsupported`]), a truncated or malformed file, or a volume beyond
 /// [`OpenOptions::limits`].
 pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
+    if path.is_file() {
+        overlay::refuse_as_scan(path, &options.limits)?;
+    }
     let mut warnings = Vec::new();
     let files = scan::list_files(path, &options.limits)?;
     options.progress.begin(ReadStep::Headers, files.len());
