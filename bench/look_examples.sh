@@ -9,8 +9,9 @@
 set -euo pipefail
 out=${1:-docs/examples}
 data=../shared/data
-bin=${ENDOCAST:-target/release/endocast}
-[ -n "${ENDOCAST:-}" ] || cargo build --release -q -p endocast-cli
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
+bin=$endocast
 head=("$data/head-ct-stanford-cthead/CThead.nhdr" --orientation LPI --preset sinus)
 fisheye=(--lens equidistant --fov 120 --size 512x512)
 nasal=(--eye 104,44,-120 --look-at 104,63.779,-122.967 --up 0,0,1)
