@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 source bench/cargo_bin.sh
 endocast_binary
 ENDOCAST=$endocast ENDOCAST_README_PICTURES=write ENDOCAST_README_XVFB=1 \
-  cargo test -q -p endocast-cli --test tests -- readme::every --exact --nocapture
+  cargo test -q -p endocast-cli --test tests -- readme::every_readme_command_runs_as_written_and_makes_its_picture --exact --nocapture
 python=${PYTHON:-python3}
 if "$python" -c 'import endocast' 2>/dev/null; then
   sed -n '/^```python$/,/^```$/p' README.md | sed '1d;$d' | "$python" -
