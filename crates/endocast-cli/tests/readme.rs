@@ -233,6 +233,7 @@ struct Scratch {
 }
 
 impl Scratch {
+    /// Makes the folder; the binary is `$ENDOCAST` when set, else the one cargo built.
     fn new() -> Self {
         let dir = tempfile::tempdir().unwrap();
         let work = dir.path().join("work");
