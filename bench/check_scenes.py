@@ -6,7 +6,7 @@ per scene, the value at the eye, how far the lumen (by the scene's iso threshold
 eye along the view direction, the smallest distance from the eye to the threshold over 200
 directions, and |up·view|. Needs numpy and nibabel (e.g. /opt/peers-venv from
 ../shared/peers/install_vtk.sh).  Usage, from the repository root:
-    /opt/peers-venv/bin/python bench/check_scenes.py [target/release/endocast]
+    /opt/peers-venv/bin/python bench/check_scenes.py [ENDOCAST]  (default: bench/cargo_bin.py's)
 """
 import json
 import os
@@ -14,6 +14,7 @@ import subprocess
 import sys
 import tempfile
 
+import cargo_bin
 import nibabel as nib
 import numpy as np
 
@@ -57,7 +58,7 @@ class Scan:
 
 
 def main():
-    exe = sys.argv[1] if len(sys.argv) > 1 else "target/release/endocast"
+    exe = sys.argv[1] if len(sys.argv) > 1 else cargo_bin.endocast()
     doc = json.load(open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenes.json")))
     golden = np.pi * (3 - np.sqrt(5))
     sphere = [np.array([np.sqrt(1 - z * z) * np.cos(golden * i), np.sqrt(1 - z * z) * np.sin(golden * i), z])

@@ -5,8 +5,9 @@
 # Usage: bench/load.sh [RUNS]   (from the repository root, with ../shared/data beside it)
 set -euo pipefail
 runs=${1:-7}
-cargo build --release -p endocast-cli >/dev/null
-bin=target/release/endocast
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
+bin=$endocast
 here=$(dirname "$0")
 for series in abdomen-ct-pancreas-dicom chest-ct-airways-dicom; do
   dir=../shared/data/$series

@@ -11,8 +11,9 @@ runs=${1:-3}
 out=${OUT:-bench/out}
 py=${VTK_PYTHON:-/opt/peers-venv/bin/python}
 mkdir -p "$out"
-cargo build --release -p endocast-cli >/dev/null
-bin=target/release/endocast
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
+bin=$endocast
 colon=$out/colon256.nii.gz
 [ -f "$colon" ] || $bin phantom colon --size 256 -o "$colon" >/dev/null
 cthead=$out/cthead.nii.gz

@@ -11,12 +11,13 @@ set -euo pipefail
 runs=${1:-3}
 out=${OUT:-bench/out}
 mkdir -p "$out/nav"
-cargo build --release -q -p endocast-cli
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
 cargo build --release -q -p endocast-core --example navigate_colon
-bin=target/release/endocast
+bin=$endocast
 
 echo "== 1. colon phantom 512×512×478 ($runs runs)"
-for _ in $(seq "$runs"); do target/release/examples/navigate_colon 512; done
+for _ in $(seq "$runs"); do "$release_dir/examples/navigate_colon" 512; done
 
 echo "== 2. real scans: endocast path ($runs runs)"
 for _ in $(seq "$runs"); do bench/real_paths.sh "$out/paths" 2>/dev/null; done
@@ -27,7 +28,7 @@ colon=$out/colon512.nii.gz
 # The colon's two ends: the first and last camera of the renderer benchmark's path.
 [ -f "$out/colon512_path_lps.json" ] || {
   cargo build --release -q -p endocast-io --example colon_path
-  target/release/examples/colon_path --size 512 --frames 60 --out-dir "$out" --path-only
+  "$release_dir/examples/colon_path" --size 512 --frames 60 --out-dir "$out" --path-only
 }
 read -r from to < <(python3 -c "
 import json, sys

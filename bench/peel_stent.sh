@@ -4,10 +4,11 @@
 # posterior at the vertebra behind the wall, 512×512, 90°. Rounds of: iso at 150 (the near
 # wall), peel 1 and peel last at 150 (front discarded), the docs' peel (35 % of the front kept
 # through the angioscopy TF, context for unpeeled rays), and the angioscopy preset (two-iso).
-# Usage: bench/peel_stent.sh [ROUNDS]   (from the repository root, after a release build)
+# Usage: bench/peel_stent.sh [ROUNDS]   (from the repository root)
 set -euo pipefail
 rounds=${1:-2}
-endocast=target/release/endocast
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
 scan=../shared/data/aorta-stent-cta/stent.nrrd
 path=$(mktemp --suffix=.json)
 trap 'rm -f "$path"' EXIT

@@ -15,8 +15,9 @@ set -euo pipefail
 out=${1:-bench/out/paths}
 data=../shared/data
 mkdir -p "$out"
-cargo build --release -q -p endocast-cli
-bin=target/release/endocast
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
+bin=$endocast
 $bin path "$data/chest-ct-airways-dicom" --preset bronchoscopy \
   --from -9.84,66.32,51.5 -o "$out/trachea.json"
 $bin path "$data/abdomen-ct-pancreas-dicom" --preset angioscopy \

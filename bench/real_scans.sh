@@ -8,7 +8,9 @@ frames=${1:-60}
 out=${OUT:-bench/out}
 data=../shared/data
 [ -f "$out/paths/ventricle.json" ] || bench/real_paths.sh "$out/paths"
-bin=target/release/endocast
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
+bin=$endocast
 run() { # scan path preset [options]
   local scan=$1 path=$2 preset=$3
   shift 3

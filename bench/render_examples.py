@@ -1,16 +1,18 @@
 #!/usr/bin/env python3
 """Renders the example images in docs/examples/ from the poses in bench/scenes.json (inside the
 trachea, the aorta, the nasal cavity and a lateral ventricle) with each scene's preset, plus an
-iso view of each, using the release build of `endocast`. Run from the repository root with
-../shared/data beside it: python3 bench/render_examples.py"""
+iso view of each, with the `endocast` bench/cargo_bin.py finds ($ENDOCAST, else the release
+build). Run from the repository root with ../shared/data beside it: python3 bench/render_examples.py"""
 import json
 import subprocess
 
-subprocess.run(["cargo", "build", "--release", "-p", "endocast-cli"], check=True)
+import cargo_bin
+
+exe = cargo_bin.endocast()
 scenes = json.load(open("bench/scenes.json"))["scenes"]
 for scene in scenes:
     triple = lambda key: ",".join(str(v) for v in scene[key])
-    base = ["target/release/endocast", "render", scene["volume"], "--size", "384x384",
+    base = [exe, "render", scene["volume"], "--size", "384x384",
             "--eye", triple("eye"), "--look-at", triple("look_at"), "--up", triple("up"),
             "--iso", str(scene["iso"])]
     for key, value in scene.get("open_options", {}).items():

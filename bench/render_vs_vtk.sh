@@ -12,12 +12,13 @@ set -euo pipefail
 frames=${1:-60}
 out=${OUT:-bench/out}
 mkdir -p "$out"
-cargo build --release -p endocast-cli >/dev/null
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
 cargo build --release -p endocast-io --example colon_path >/dev/null
-bin=target/release/endocast
+bin=$endocast
 nii=$out/colon512.nii.gz
-[ -f "$nii" ] || target/release/examples/colon_path --size 512 --frames "$frames" --out-dir "$out"
-target/release/examples/colon_path --size 512 --frames "$frames" --out-dir "$out" --path-only
+[ -f "$nii" ] || "$release_dir/examples/colon_path" --size 512 --frames "$frames" --out-dir "$out"
+"$release_dir/examples/colon_path" --size 512 --frames "$frames" --out-dir "$out" --path-only
 path=$out/colon512_path_lps.json
 rm -f "$out/endocast.jsonl"
 

@@ -7,8 +7,9 @@
 set -euo pipefail
 runs=${1:-3}
 data=../shared/data
-cargo build --release -q -p endocast-cli
-bin="$(cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')/release/endocast"
+source "$(dirname "$0")/cargo_bin.sh"
+endocast_binary
+bin=$endocast
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "| scan | preset | structure | median ms | runs (ms) |"

@@ -20,12 +20,13 @@ peers=${PEERS:-../shared/peers}
 py=${PY:-/opt/peers-venv/bin/python}
 export VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow
 
+source "$(dirname "$0")/cargo_bin.sh"
 cargo build --release -p endocast-io --example colon_path >/dev/null
 nii=$out/colon$size.nii.gz
 if [ -f "$nii" ]; then
-  target/release/examples/colon_path --size "$size" --frames "$frames" --out-dir "$out" --path-only
+  "$release_dir/examples/colon_path" --size "$size" --frames "$frames" --out-dir "$out" --path-only
 else
-  target/release/examples/colon_path --size "$size" --frames "$frames" --out-dir "$out"
+  "$release_dir/examples/colon_path" --size "$size" --frames "$frames" --out-dir "$out"
 fi
 path=$out/colon${size}_path_vtk.txt
 results=$out/vtk_peer.jsonl

@@ -12,6 +12,7 @@ mod look;
 mod navigation;
 mod phantom_convert;
 mod presets;
+mod readme;
 mod real_scans;
 mod render;
 mod scene;
