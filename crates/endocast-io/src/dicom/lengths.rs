@@ -55,6 +55,9 @@ struct Walker<R> {
     /// The sequences and items open at `pos`: where each ends, `None` for an undefined length
     /// (closed by its delimiter).
     open: Vec<Option<u64>>,
+    /// The nesting depth from which elements are implicit VR little endian whatever the
+    /// transfer syntax: inside a sequence stored as UN (PS3.5 6.2.2), until it closes.
+    implicit_from: Option<usize>,
 }
 
 /// Where a walk stopped.
@@ -76,6 +79,7 @@ pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()
         pos: 0,
         len,
         open: Vec::new(),
+        implicit_from: None,
     };
     let io = |e| ReadError::io(path, e);
     let mut magic = [0u8; 4];
@@ -134,6 +138,7 @@ fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) ->
         pos: 0,
         len,
         open: Vec::new(),
+        implicit_from: None,
     };
     w.walk()
         .map(|_| ())
@@ -203,10 +208,17 @@ impl<R: Read + Seek> Walker<R> {
             };
             let current = match (in_meta, encoding) {
                 (true, _) => Encoding::ExplicitLittle,
+                (false, _) if self.in_un_sequence() => Encoding::ImplicitLittle,
                 (false, Some(encoding)) => encoding,
                 (false, None) => return Ok(Walked::Deflated(start)),
             };
             let (tag, length, vr) = self.element_header(head, current)?;
+            // A sequence stored as UN holds implicit VR little endian items.
+            let inner = if vr == Some(*b"UN") {
+                Encoding::ImplicitLittle
+            } else {
+                current
+            };
             if tag.0 == 0xFFFE {
                 in_fragments = self.item(tag, length, in_fragments)?;
                 continue;
@@ -214,7 +226,7 @@ impl<R: Read + Seek> Walker<R> {
             if length == UNDEFINED {
                 // A sequence (or encapsulated pixel data): its items follow inline.
                 in_fragments |= tag == (0x7FE0, 0x0010);
-                self.open(None)?;
+                self.open_sequence(None, vr == Some(*b"UN"))?;
                 continue;
             }
             self.check(tag, length)?;
@@ -225,8 +237,8 @@ impl<R: Read + Seek> Walker<R> {
                     .map_or(u64::MAX, |n| self.pos + n);
             } else if tag == (0x0002, 0x0010) && in_meta {
                 encoding = self.transfer_syntax(length)?;
-            } else if vr == Some(*b"SQ") || self.starts_with_item(length, current)? {
-                self.open(Some(end))?;
+            } else if vr == Some(*b"SQ") || self.starts_with_item(length, inner)? {
+                self.open_sequence(Some(end), vr == Some(*b"UN"))?;
             } else {
                 self.skip(u64::from(length))?;
             }
@@ -251,6 +263,26 @@ impl<R: Read + Seek> Walker<R> {
         }
         self.open.push(end);
         Ok(())
+    }
+
+    /// Opens a sequence ending at `end`; one stored as UN (`un`) holds implicit VR items.
+    fn open_sequence(&mut self, end: Option<u64>, un: bool) -> Result<(), String> {
+        self.open(end)?;
+        if un && self.implicit_from.is_none() {
+            self.implicit_from = Some(self.open.len());
+        }
+        Ok(())
+    }
+
+    /// Whether `pos` lies inside a sequence stored as UN (forgotten once it has closed).
+    fn in_un_sequence(&mut self) -> bool {
+        match self.implicit_from {
+            Some(depth) if self.open.len() >= depth => true,
+            _ => {
+                self.implicit_from = None;
+                false
+            }
+        }
     }
 
     /// Closes the defined-length sequences and items that end at or before `pos`.
