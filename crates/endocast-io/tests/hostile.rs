@@ -768,3 +768,29 @@ fn zero_padding_after_the_pixel_data_is_ignored_with_a_warning() {
         loaded.warnings
     );
 }
+
+#[test]
+fn an_implicit_vr_data_set_under_an_explicit_vr_meta_group_is_read_with_a_warning() {
+    let image = Image::ct(2, 2);
+    // Every element re-encoded without its VR: tag, 4-byte length, value.
+    let mut bytes = meta(EXPLICIT_LE);
+    for encoded in image.0.values() {
+        let vr: [u8; 2] = [encoded[4], encoded[5]];
+        let value_at = if is_long(&vr) { 12 } else { 8 };
+        bytes.extend(implicit(
+            (
+                u16::from_le_bytes([encoded[0], encoded[1]]),
+                u16::from_le_bytes([encoded[2], encoded[3]]),
+            ),
+            &encoded[value_at..],
+        ));
+    }
+    let (_dir, path) = file_with("implicit-body.dcm", &bytes);
+    let loaded = read_dicom(&path).unwrap();
+    let (_dir, explicit) = file_with("explicit.dcm", &image.bytes(EXPLICIT_LE));
+    assert_eq!(
+        loaded.volume.voxels(),
+        read_dicom(&explicit).unwrap().volume.voxels()
+    );
+    assert!(has_warning(&loaded, "implicit VR"), "{:?}", loaded.warnings);
+}

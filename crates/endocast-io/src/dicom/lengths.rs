@@ -145,6 +145,18 @@ fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) ->
         .map_err(|message| ReadError::format(path, format!("in the inflated data set: {message}")))
 }
 
+/// The data set's encoding from its first element's VR bytes `vr`: a meta group saying
+/// explicit VR little endian over a data set without a valid VR is implicit VR (as pydicom
+/// and dicom-rs's adaptive decoder read it; see `open`).
+fn body_encoding(declared: Option<Encoding>, vr: [u8; 2]) -> Option<Encoding> {
+    match declared {
+        Some(Encoding::ExplicitLittle) if !KNOWN_VRS.contains(&&vr) => {
+            Some(Encoding::ImplicitLittle)
+        }
+        other => other,
+    }
+}
+
 impl<R: Read + Seek> Walker<R> {
     fn seek_to(&mut self, pos: u64) -> io::Result<()> {
         self.reader.seek(SeekFrom::Start(pos))?;
@@ -193,6 +205,8 @@ impl<R: Read + Seek> Walker<R> {
         // Where the meta group ends by its group length (dicom-rs stops there).
         let mut meta_end = u64::MAX;
         let mut in_fragments = false;
+        // Whether the first element of the data set is still to come.
+        let mut first_of_body = true;
         while self.pos + 8 <= self.len {
             self.close_ended();
             let start = self.pos;
@@ -206,6 +220,9 @@ impl<R: Read + Seek> Walker<R> {
             } else {
                 start < meta_end
             };
+            if !in_meta && std::mem::take(&mut first_of_body) {
+                encoding = body_encoding(encoding, [head[4], head[5]]);
+            }
             let current = match (in_meta, encoding) {
                 (true, _) => Encoding::ExplicitLittle,
                 (false, _) if self.in_un_sequence() => Encoding::ImplicitLittle,

@@ -4,8 +4,10 @@
 //! # How a series is read
 //!
 //! 1. `scan`: every file under the directory is listed (sorted) and its header, everything
-//!    before PixelData, is parsed in parallel. Files without the DICOM magic, DICOM objects
-//!    without an image and unreadable headers are skipped and reported in one warning.
+//!    before PixelData, is parsed in parallel (a data set in implicit VR under a meta group
+//!    that says explicit VR is read as implicit VR, warned, as pydicom does: `open`). Files
+//!    without the DICOM magic, DICOM objects without an image and unreadable headers are
+//!    skipped and reported in one warning.
 //! 2. `series`: images are grouped by SeriesInstanceUID; the largest series is loaded unless
 //!    [`OpenOptions::series`] names another.
 //! 3. `stack`: frames (a file is one frame, an enhanced multi-frame file many) are ordered by
@@ -59,6 +61,7 @@ mod jpeg12;
 mod jpegls;
 mod lengths;
 mod lut;
+mod open;
 mod pixels;
 mod rle;
 mod scan;

@@ -7,7 +7,8 @@
 //! one load per voxel.
 
 use super::frame::compressed_frame;
-use super::scan::{chain, open_error, ImageFile, PixelLayout};
+use super::open::{self, chain};
+use super::scan::{ImageFile, PixelLayout};
 use super::{jpeg12, jpegls, rle, stream_size};
 use crate::error::{ReadError, Result};
 use crate::guard;
@@ -16,7 +17,7 @@ use dicom_core::{DicomValue, PrimitiveValue};
 use dicom_dictionary_std::tags;
 use dicom_encoding::adapters::PixelDataObject;
 use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
-use dicom_object::{DefaultDicomObject, OpenFileOptions};
+use dicom_object::DefaultDicomObject;
 use dicom_pixeldata::PixelDecoder;
 use dicom_transfer_syntax_registry::TransferSyntaxRegistry;
 use rayon::prelude::*;
@@ -296,9 +297,7 @@ pub(super) fn decode_file(
     map: &SampleMap,
 ) -> Result<(Vec<FrameStats>, Option<String>)> {
     let path = file.path.as_path();
-    let object = guard::quietly(|| OpenFileOptions::new().open_file(path))
-        .map_err(|panicked| ReadError::format(path, panicked.to_string()))?
-        .map_err(|e| open_error(path, &e))?;
+    let (object, _) = open::open(path, false)?;
     let pixel_data = object
         .get(tags::PIXEL_DATA)
         .ok_or_else(|| ReadError::format(path, "expected a PixelData element, found none"))?;

@@ -3,15 +3,15 @@
 
 use super::lengths;
 use super::lut::ModalityLut;
+use super::open::{self, Body};
 use crate::error::{ReadError, Result};
-use crate::guard;
 use crate::limits::Limits;
 use crate::progress::Progress;
 use crate::samples::Rescale;
 use dicom_core::header::HasLength;
 use dicom_core::{Tag, VR};
 use dicom_dictionary_std::tags;
-use dicom_object::{InMemDicomObject, OpenFileOptions};
+use dicom_object::InMemDicomObject;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::io::Read;
@@ -162,53 +162,24 @@ pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
     if let Err(e) = lengths::check_element_lengths(path, max_inflated) {
         return Scanned::Unreadable(e);
     }
-    let opened = guard::quietly(|| {
-        OpenFileOptions::new()
-            .read_until(tags::PIXEL_DATA)
-            .open_file(path)
-    });
-    let object = match opened {
-        Ok(Ok(object)) => object,
-        Ok(Err(e)) => return Scanned::Unreadable(open_error(path, &e)),
-        Err(panicked) => return Scanned::Unreadable(ReadError::format(path, panicked.to_string())),
+    let (object, body) = match open::open(path, true) {
+        Ok(opened) => opened,
+        Err(e) => return Scanned::Unreadable(e),
     };
     match image_file(path, &object, &object.meta().transfer_syntax, limits) {
-        Ok(Some(image)) => Scanned::Image(image),
+        Ok(Some(mut image)) => {
+            if let Body::Implicit = body {
+                image.notes.push(format!(
+                    "{}: the meta group says explicit VR, but the data set is implicit VR; \
+                     it was read as implicit VR (as pydicom does)",
+                    path.display()
+                ));
+            }
+            Scanned::Image(image)
+        }
         Ok(None) => Scanned::NoImage,
         Err(e) => Scanned::Unreadable(e),
     }
-}
-
-/// Turns a dicom-object open error into ours: an unknown or undecodable transfer syntax is
-/// [`ReadError::Unsupported`], anything else a format error.
-pub(super) fn open_error(path: &Path, error: &dicom_object::ReadError) -> ReadError {
-    use dicom_object::ReadError as E;
-    match error {
-        E::OpenFile { source, .. } | E::ReadFile { source, .. } => {
-            ReadError::io(path, std::io::Error::new(source.kind(), source.to_string()))
-        }
-        E::ReadUnrecognizedTransferSyntax { uid, .. } => ReadError::unsupported(
-            path,
-            format!("transfer syntax {uid} (not a transfer syntax this reader knows)"),
-        ),
-        E::ReadUnsupportedTransferSyntax { uid, name, .. }
-        | E::ReadUnsupportedTransferSyntaxWithSuggestion { uid, name, .. } => {
-            ReadError::unsupported(path, format!("transfer syntax {uid} ({name})"))
-        }
-        other => ReadError::format(path, format!("not a readable DICOM file: {}", chain(other))),
-    }
-}
-
-/// An error and its causes in one line, so that "premature end" says where.
-pub(super) fn chain(error: &dyn std::error::Error) -> String {
-    let mut text = error.to_string();
-    let mut source = error.source();
-    while let Some(cause) = source {
-        text.push_str(": ");
-        text.push_str(&cause.to_string());
-        source = cause.source();
-    }
-    text
 }
 
 /// `DICM` at byte 128 (after the preamble) or at byte 0 (a file without preamble).
