@@ -637,3 +637,160 @@ fn a_truncated_ascii_stl_is_refused() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Valid files that pydicom and nibabel read (issue 32, item 5; the whole corpus of their test
+// files is compared in crates/endocast-py/tests/test_peers_corpus.py): read, not refused.
+
+/// 16-bit little-endian words as bytes.
+fn words(values: &[u16]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+/// A sequence of one defined-length item holding the encoded `elements`, stored as `vr`.
+fn sequence(tag: (u16, u16), vr: &[u8; 2], elements: &[u8]) -> Vec<u8> {
+    let mut value = item(0xE000, elements.len() as u32);
+    value.extend_from_slice(elements);
+    let mut out = header(tag, vr, value.len() as u32);
+    out.extend(value);
+    out
+}
+
+/// One implicit-VR little-endian element (tag, 4-byte length, value).
+fn implicit(tag: (u16, u16), value: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    out.extend_from_slice(&tag.0.to_le_bytes());
+    out.extend_from_slice(&tag.1.to_le_bytes());
+    out.extend_from_slice(&(value.len() as u32).to_le_bytes());
+    out.extend_from_slice(value);
+    out
+}
+
+#[test]
+fn a_modality_lut_sequence_maps_the_stored_values() {
+    let mut image = Image::ct(1, 4);
+    image.0.remove(&(0x28, 0x1052));
+    image.0.remove(&(0x28, 0x1053));
+    // Three entries from stored value 1: 0 clamps to the first, 3 is the last (63 488).
+    let mut lut = element((0x28, 0x3002), b"US", &words(&[3, 1, 16]));
+    lut.extend(element(
+        (0x28, 0x3006),
+        b"OW",
+        &words(&[100, 40_000, 63_488]),
+    ));
+    image
+        .set((0x28, 0x3000), sequence((0x28, 0x3000), b"SQ", &lut))
+        .set(
+            (0x7FE0, 0x10),
+            element((0x7FE0, 0x10), b"OW", &words(&[0, 1, 2, 3])),
+        );
+    let (_dir, path) = file_with("lut.dcm", &image.bytes(EXPLICIT_LE));
+    let volume = read_dicom(&path).unwrap().volume;
+    let values: Vec<_> = (0..4).map(|i| volume.physical(i, 0, 0).unwrap()).collect();
+    assert_eq!(values, vec![100.0, 100.0, 40_000.0, 63_488.0]);
+}
+
+#[test]
+fn frames_without_positions_are_stacked_at_their_spacing_with_a_warning() {
+    let mut image = Image::ct(2, 2);
+    image.0.remove(&(0x20, 0x32));
+    image.0.remove(&(0x20, 0x37));
+    let pixels: Vec<u16> = (0..12).collect();
+    image
+        .text((0x28, 8), b"IS", "3")
+        .text((0x18, 0x88), b"DS", "2.5")
+        .set(
+            (0x7FE0, 0x10),
+            element((0x7FE0, 0x10), b"OW", &words(&pixels)),
+        );
+    let (_dir, path) = file_with("frames.dcm", &image.bytes(EXPLICIT_LE));
+    let loaded = read_dicom(&path).unwrap();
+    let volume = &loaded.volume;
+    assert_eq!(volume.dims(), [2, 2, 3]);
+    assert_eq!(volume.geometry().spacing_mm().z, 2.5);
+    for k in 0..3 {
+        assert_eq!(
+            volume.physical(1, 1, k),
+            Some(4.0 * k as f64 + 3.0 - 1024.0)
+        );
+    }
+    assert!(
+        has_warning(&loaded, "SpacingBetweenSlices"),
+        "{:?}",
+        loaded.warnings
+    );
+    assert!(has_warning(&loaded, "assumed"), "{:?}", loaded.warnings);
+}
+
+#[test]
+fn a_sequence_stored_as_un_is_read_as_the_implicit_vr_sequence_it_is() {
+    // (0018,9346) as UN of a defined length, holding one implicit-VR item (PS3.5 6.2.2). (One
+    // of undefined length is walked too, but dicom-rs 0.10 then parses its items as explicit
+    // VR and refuses the file.)
+    let code = implicit((8, 0x100), b"113691");
+    let mut image = Image::ct(2, 2);
+    image.set((0x18, 0x9346), sequence((0x18, 0x9346), b"UN", &code));
+    let (_dir, path) = file_with("un-sequence.dcm", &image.bytes(EXPLICIT_LE));
+    read_dicom(&path).unwrap();
+}
+
+#[test]
+fn a_siemens_mosaic_is_read_as_its_tiled_image_with_a_warning() {
+    let mut image = Image::ct(4, 4);
+    image
+        .text((8, 8), b"CS", "ORIGINAL\\PRIMARY\\M\\ND\\MOSAIC")
+        .text((0x19, 0x10), b"LO", "SIEMENS MR HEADER")
+        .short((0x19, 0x100A), 4);
+    let (_dir, path) = file_with("mosaic.dcm", &image.bytes(EXPLICIT_LE));
+    let loaded = read_dicom(&path).unwrap();
+    assert_eq!(loaded.volume.dims(), [4, 4, 1]);
+    assert!(
+        has_warning(&loaded, "mosaic of 4 slices"),
+        "{:?}",
+        loaded.warnings
+    );
+    assert!(has_warning(&loaded, "dcm2niix"), "{:?}", loaded.warnings);
+}
+
+#[test]
+fn zero_padding_after_the_pixel_data_is_ignored_with_a_warning() {
+    let mut image = Image::ct(2, 2);
+    image.set(
+        (0x7FE0, 0x10),
+        element((0x7FE0, 0x10), b"OW", &words(&[1, 2, 3, 4, 0, 0, 0, 0])),
+    );
+    let (_dir, path) = file_with("padded.dcm", &image.bytes(EXPLICIT_LE));
+    let loaded = read_dicom(&path).unwrap();
+    assert_eq!(loaded.volume.physical(1, 1, 0), Some(4.0 - 1024.0));
+    assert!(
+        has_warning(&loaded, "8 bytes of zeros"),
+        "{:?}",
+        loaded.warnings
+    );
+}
+
+#[test]
+fn an_implicit_vr_data_set_under_an_explicit_vr_meta_group_is_read_with_a_warning() {
+    let image = Image::ct(2, 2);
+    // Every element re-encoded without its VR: tag, 4-byte length, value.
+    let mut bytes = meta(EXPLICIT_LE);
+    for encoded in image.0.values() {
+        let vr: [u8; 2] = [encoded[4], encoded[5]];
+        let value_at = if is_long(&vr) { 12 } else { 8 };
+        bytes.extend(implicit(
+            (
+                u16::from_le_bytes([encoded[0], encoded[1]]),
+                u16::from_le_bytes([encoded[2], encoded[3]]),
+            ),
+            &encoded[value_at..],
+        ));
+    }
+    let (_dir, path) = file_with("implicit-body.dcm", &bytes);
+    let loaded = read_dicom(&path).unwrap();
+    let (_dir, explicit) = file_with("explicit.dcm", &image.bytes(EXPLICIT_LE));
+    assert_eq!(
+        loaded.volume.voxels(),
+        read_dicom(&explicit).unwrap().volume.voxels()
+    );
+    assert!(has_warning(&loaded, "implicit VR"), "{:?}", loaded.warnings);
+}

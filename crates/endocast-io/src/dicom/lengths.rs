@@ -55,6 +55,9 @@ struct Walker<R> {
     /// The sequences and items open at `pos`: where each ends, `None` for an undefined length
     /// (closed by its delimiter).
     open: Vec<Option<u64>>,
+    /// The nesting depth from which elements are implicit VR little endian whatever the
+    /// transfer syntax: inside a sequence stored as UN (PS3.5 6.2.2), until it closes.
+    implicit_from: Option<usize>,
 }
 
 /// Where a walk stopped.
@@ -76,6 +79,7 @@ pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()
         pos: 0,
         len,
         open: Vec::new(),
+        implicit_from: None,
     };
     let io = |e| ReadError::io(path, e);
     let mut magic = [0u8; 4];
@@ -134,10 +138,23 @@ fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) ->
         pos: 0,
         len,
         open: Vec::new(),
+        implicit_from: None,
     };
     w.walk()
         .map(|_| ())
         .map_err(|message| ReadError::format(path, format!("in the inflated data set: {message}")))
+}
+
+/// The data set's encoding from its first element's VR bytes `vr`: a meta group saying
+/// explicit VR little endian over a data set without a valid VR is implicit VR (as pydicom
+/// and dicom-rs's adaptive decoder read it; see `open`).
+fn body_encoding(declared: Option<Encoding>, vr: [u8; 2]) -> Option<Encoding> {
+    match declared {
+        Some(Encoding::ExplicitLittle) if !KNOWN_VRS.contains(&&vr) => {
+            Some(Encoding::ImplicitLittle)
+        }
+        other => other,
+    }
 }
 
 impl<R: Read + Seek> Walker<R> {
@@ -188,6 +205,8 @@ impl<R: Read + Seek> Walker<R> {
         // Where the meta group ends by its group length (dicom-rs stops there).
         let mut meta_end = u64::MAX;
         let mut in_fragments = false;
+        // Whether the first element of the data set is still to come.
+        let mut first_of_body = true;
         while self.pos + 8 <= self.len {
             self.close_ended();
             let start = self.pos;
@@ -201,12 +220,22 @@ impl<R: Read + Seek> Walker<R> {
             } else {
                 start < meta_end
             };
+            if !in_meta && std::mem::take(&mut first_of_body) {
+                encoding = body_encoding(encoding, [head[4], head[5]]);
+            }
             let current = match (in_meta, encoding) {
                 (true, _) => Encoding::ExplicitLittle,
+                (false, _) if self.in_un_sequence() => Encoding::ImplicitLittle,
                 (false, Some(encoding)) => encoding,
                 (false, None) => return Ok(Walked::Deflated(start)),
             };
             let (tag, length, vr) = self.element_header(head, current)?;
+            // A sequence stored as UN holds implicit VR little endian items.
+            let inner = if vr == Some(*b"UN") {
+                Encoding::ImplicitLittle
+            } else {
+                current
+            };
             if tag.0 == 0xFFFE {
                 in_fragments = self.item(tag, length, in_fragments)?;
                 continue;
@@ -214,7 +243,7 @@ impl<R: Read + Seek> Walker<R> {
             if length == UNDEFINED {
                 // A sequence (or encapsulated pixel data): its items follow inline.
                 in_fragments |= tag == (0x7FE0, 0x0010);
-                self.open(None)?;
+                self.open_sequence(None, vr == Some(*b"UN"))?;
                 continue;
             }
             self.check(tag, length)?;
@@ -225,8 +254,8 @@ impl<R: Read + Seek> Walker<R> {
                     .map_or(u64::MAX, |n| self.pos + n);
             } else if tag == (0x0002, 0x0010) && in_meta {
                 encoding = self.transfer_syntax(length)?;
-            } else if vr == Some(*b"SQ") || self.starts_with_item(length, current)? {
-                self.open(Some(end))?;
+            } else if vr == Some(*b"SQ") || self.starts_with_item(length, inner)? {
+                self.open_sequence(Some(end), vr == Some(*b"UN"))?;
             } else {
                 self.skip(u64::from(length))?;
             }
@@ -251,6 +280,26 @@ impl<R: Read + Seek> Walker<R> {
         }
         self.open.push(end);
         Ok(())
+    }
+
+    /// Opens a sequence ending at `end`; one stored as UN (`un`) holds implicit VR items.
+    fn open_sequence(&mut self, end: Option<u64>, un: bool) -> Result<(), String> {
+        self.open(end)?;
+        if un && self.implicit_from.is_none() {
+            self.implicit_from = Some(self.open.len());
+        }
+        Ok(())
+    }
+
+    /// Whether `pos` lies inside a sequence stored as UN (forgotten once it has closed).
+    fn in_un_sequence(&mut self) -> bool {
+        match self.implicit_from {
+            Some(depth) if self.open.len() >= depth => true,
+            _ => {
+                self.implicit_from = None;
+                false
+            }
+        }
     }
 
     /// Closes the defined-length sequences and items that end at or before `pos`.

@@ -4,15 +4,18 @@
 //! # How a series is read
 //!
 //! 1. `scan`: every file under the directory is listed (sorted) and its header, everything
-//!    before PixelData, is parsed in parallel. Files without the DICOM magic, DICOM objects
-//!    without an image and unreadable headers are skipped and reported in one warning.
+//!    before PixelData, is parsed in parallel (a data set in implicit VR under a meta group
+//!    that says explicit VR is read as implicit VR, warned, as pydicom does: `open`). Files
+//!    without the DICOM magic, DICOM objects without an image and unreadable headers are
+//!    skipped and reported in one warning.
 //! 2. `series`: images are grouped by SeriesInstanceUID; the largest series is loaded unless
 //!    [`OpenOptions::series`] names another.
 //! 3. `stack`: frames (a file is one frame, an enhanced multi-frame file many) are ordered by
 //!    the projection of ImagePositionPatient on the slice normal (row × column cosine), never
 //!    by file name or InstanceNumber, which scanners number in either direction.
 //! 4. `pixels`: each file is decoded (uncompressed little/big endian, deflate, JPEG, JPEG 2000
-//!    through dicom-rs; RLE and JPEG-LS through our own `rle` and `jpegls`) straight into its
+//!    through dicom-rs; RLE, JPEG-LS and 12-bit JPEG through our own `rle`, `jpegls` and
+//!    `jpeg12`) straight into its
 //!    slice of the final voxel buffer, files in parallel. Peak memory is that buffer plus one
 //!    file per thread (a multi-frame file is held whole while its frames are decoded).
 //! 5. `values`: one value map for the series (exact when all slices share their rescale).
@@ -30,6 +33,11 @@
 //!   SliceThickness (which may overlap or leave gaps). A single slice, with no neighbour to
 //!   measure, takes its SliceThickness (or 1 mm, warned). PixelSpacing outside 0.001–1000 mm
 //!   is refused; `0\0` means unknown, like a missing one (1 mm, warned).
+//! - A multi-frame file whose frames carry no position of their own (or all the same one) is
+//!   stacked in file order along the slice normal at SpacingBetweenSlices, else
+//!   SliceThickness, else 1 mm, with a warning that says which (pydicom and nibabel keep such
+//!   frames in file order too). A Siemens mosaic (ImageType MOSAIC) is read as the one tiled
+//!   image it is stored as (not unpacked), with a warning that says so.
 //! - Slices must lie on one line (else [`ReadError::Inconsistent`]). When the gaps between
 //!   them differ by more than 1 %, the stack is resampled onto a uniform step (the smallest
 //!   gap, at most 4× the original slice count) by linear interpolation between the two
@@ -39,7 +47,9 @@
 //!
 //! # Values
 //!
-//! RescaleSlope/Intercept apply per slice (per frame through PixelValueTransformationSequence).
+//! RescaleSlope/Intercept apply per slice (per frame through PixelValueTransformationSequence);
+//! a Modality LUT (ModalityLUTSequence) replaces them: stored samples are mapped through it
+//! into the voxels, exactly (its outputs are unsigned 16-bit at most).
 //! When every slice shares them, voxels hold raw samples exactly (signed samples offset by
 //! 2^(BitsAllocated−1)) and the value map carries the rescale. Otherwise the physical range is
 //! requantised onto 16 bits (warned). BitsStored masks unused high bits and sign-extends;
@@ -47,8 +57,11 @@
 //! inverted so that bright means high, except for CT, whose Hounsfield units are kept.
 
 mod frame;
+mod jpeg12;
 mod jpegls;
 mod lengths;
+mod lut;
+mod open;
 mod overlay;
 mod pixels;
 mod rle;
@@ -87,6 +100,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let scanned = scan::scan_all(&files, &options.limits, &options.progress);
     let images = series::images(path, &files, scanned, &mut warnings)?;
     let (chosen, series_found) = series::choose(path, images, options.series.as_deref())?;
+    warnings.extend(chosen.iter().flat_map(|file| file.notes.iter().cloned()));
     let stack = Stack::build(path, &chosen, &mut warnings)?;
     let first = &chosen[0];
     let ts_names = chosen
@@ -94,7 +108,8 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         .map(|file| pixels::transfer_syntax_name(&file.path, &file.transfer_syntax))
         .collect::<Result<Vec<_>>>()?;
     let modality = Modality::from_code(&first.modality);
-    let invert = monochrome1_inversion(first, &modality, &mut warnings);
+    let invert = first.layout.modality_lut.is_none()
+        && monochrome1_inversion(first, &modality, &mut warnings);
     let map = SampleMap::new(&first.path, &first.layout, first.padding, invert)?;
     pixels::check_high_bit(first, &mut warnings)?;
 
@@ -110,7 +125,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         .check_dims(path, &[dims[0] as u64, dims[1] as u64, count as u64])?;
     let mut voxels = vec![0u16; total];
     let progress = &options.progress;
-    let stats = decode_all(
+    let (stats, padded) = decode_all(
         &chosen,
         &ts_names,
         &stack,
@@ -119,6 +134,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         &map,
         progress,
     )?;
+    warnings.extend(padded);
     let rescales: Vec<_> = stack.slices.iter().map(|s| s.rescale).collect();
     let value_map = values::unify(
         path,
@@ -155,7 +171,8 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
 }
 
 /// Decodes every slice of `stack` into its slot of `voxels`, one file per task, counting the
-/// files in `progress`, and returns the statistics of each slice in stack order.
+/// files in `progress`, and returns the statistics of each slice in stack order and the
+/// warnings of files whose pixel data carried padding.
 fn decode_all(
     files: &[ImageFile],
     ts_names: &[&str],
@@ -164,7 +181,7 @@ fn decode_all(
     slice_len: usize,
     map: &SampleMap,
     progress: &Progress,
-) -> Result<Vec<FrameStats>> {
+) -> Result<(Vec<FrameStats>, Vec<String>)> {
     // Hand each file the slots of its frames, so that a multi-frame file is opened once.
     let mut per_file: Vec<Vec<(usize, u32, &mut [u16])>> =
         files.iter().map(|_| Vec::new()).collect();
@@ -184,16 +201,20 @@ fn decode_all(
                 .into_iter()
                 .map(|(k, frame, slot)| (k, (frame, slot)))
                 .unzip();
-            let stats = pixels::decode_file(&files[file], ts_names[file], slots, map)?;
+            let (stats, padded) = pixels::decode_file(&files[file], ts_names[file], slots, map)?;
             progress.advance();
-            Ok(ks.into_iter().zip(stats).collect::<Vec<_>>())
+            Ok((ks.into_iter().zip(stats).collect::<Vec<_>>(), padded))
         })
         .collect::<Result<Vec<_>>>()?;
     let mut stats = vec![None; stack.slices.len()];
-    for (k, frame_stats) in decoded.into_iter().flatten() {
-        stats[k] = Some(frame_stats);
+    let mut padded = Vec::new();
+    for (frames, warning) in decoded {
+        padded.extend(warning);
+        for (k, frame_stats) in frames {
+            stats[k] = Some(frame_stats);
+        }
     }
-    Ok(stats.into_iter().flatten().collect())
+    Ok((stats.into_iter().flatten().collect(), padded))
 }
 
 /// Whether to invert MONOCHROME1 samples (minimum is white): yes, so that bright means high,

@@ -11,13 +11,12 @@
 //! allocated for them.
 
 use super::lengths::check_element_lengths;
-use super::scan::open_error;
+use super::open::open;
 use crate::error::{ReadError, Result};
-use crate::guard;
 use crate::Limits;
 use dicom_core::Tag;
 use dicom_dictionary_std::{tags, uids};
-use dicom_object::{InMemDicomObject, OpenFileOptions};
+use dicom_object::InMemDicomObject;
 use endocast_core::{Geometry, Modality, ValueMap, Volume};
 use glam::{DMat3, DVec3};
 use std::path::Path;
@@ -69,9 +68,7 @@ const PALETTE: [[f32; 3]; 6] = [
 /// shorter than the frames declared, a grid beyond `limits`.
 pub fn read_overlay(path: &Path, limits: &Limits) -> Result<Overlay> {
     check_element_lengths(path, limits.max_voxels.saturating_mul(4))?;
-    let object = guard::quietly(|| OpenFileOptions::new().open_file(path))
-        .map_err(|panicked| ReadError::format(path, panicked.to_string()))?
-        .map_err(|e| open_error(path, &e))?;
+    let (object, _) = open(path, false)?;
     let syntax = object.meta().transfer_syntax.trim_end_matches('\0');
     if ![
         uids::EXPLICIT_VR_LITTLE_ENDIAN,
@@ -106,12 +103,7 @@ pub(super) fn refuse_as_scan(path: &Path, limits: &Limits) -> Result<()> {
     if check_element_lengths(path, limits.max_voxels.saturating_mul(4)).is_err() {
         return Ok(());
     }
-    let opened = guard::quietly(|| {
-        OpenFileOptions::new()
-            .read_until(tags::PIXEL_DATA)
-            .open_file(path)
-    });
-    let Ok(Ok(object)) = opened else {
+    let Ok((object, _)) = open(path, true) else {
         return Ok(());
     };
     let what = match text(&object, tags::MODALITY).as_str() {

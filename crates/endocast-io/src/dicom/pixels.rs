@@ -6,8 +6,10 @@
 //! (`raw = stored + type_min`). The table is 128 KiB for 16-bit data and makes the inner loop
 //! one load per voxel.
 
-use super::scan::{chain, open_error, ImageFile, PixelLayout};
-use super::{jpegls, rle, stream_size};
+use super::frame::compressed_frame;
+use super::open::{self, chain};
+use super::scan::{ImageFile, PixelLayout};
+use super::{jpeg12, jpegls, rle, stream_size};
 use crate::error::{ReadError, Result};
 use crate::guard;
 use dicom_core::value::DicomValueType;
@@ -15,7 +17,7 @@ use dicom_core::{DicomValue, PrimitiveValue};
 use dicom_dictionary_std::tags;
 use dicom_encoding::adapters::PixelDataObject;
 use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
-use dicom_object::{DefaultDicomObject, OpenFileOptions};
+use dicom_object::DefaultDicomObject;
 use dicom_pixeldata::PixelDecoder;
 use dicom_transfer_syntax_registry::TransferSyntaxRegistry;
 use rayon::prelude::*;
@@ -66,17 +68,21 @@ impl SampleMap {
     ) -> Result<Self> {
         let bits = validate(path, layout)?;
         let allocated = u32::from(layout.bits_allocated);
-        let type_min = if layout.signed {
+        let lut = layout.modality_lut.as_ref();
+        // A Modality LUT's outputs are unsigned: they are the voxels themselves.
+        let type_min = if layout.signed && lut.is_none() {
             -(1i32 << (allocated - 1))
         } else {
             0
         };
+        let voxel = |raw| match lut {
+            Some(lut) => lut.apply(raw),
+            None => bits.voxel(raw, invert, type_min),
+        };
         let table = (0..1u32 << allocated)
-            .map(|word| bits.voxel(bits.raw(word), invert, type_min))
+            .map(|word| voxel(bits.raw(word)))
             .collect();
-        let padding = padding
-            .filter(|&p| bits.representable(p))
-            .map(|p| bits.voxel(p, invert, type_min));
+        let padding = padding.filter(|&p| bits.representable(p)).map(voxel);
         Ok(Self {
             table,
             padding,
@@ -282,27 +288,27 @@ impl FrameStats {
 }
 
 /// Reads `file` whole and decodes each `(frame number, slot)` into its slot, in parallel for
-/// compressed multi-frame files. Returns the statistics of each frame, in the order given.
+/// compressed multi-frame files. Returns the statistics of each frame, in the order given, and
+/// a warning when the pixel data carried trailing zero padding.
 pub(super) fn decode_file(
     file: &ImageFile,
     ts_name: &str,
     frames: Vec<(u32, &mut [u16])>,
     map: &SampleMap,
-) -> Result<Vec<FrameStats>> {
+) -> Result<(Vec<FrameStats>, Option<String>)> {
     let path = file.path.as_path();
-    let object = guard::quietly(|| OpenFileOptions::new().open_file(path))
-        .map_err(|panicked| ReadError::format(path, panicked.to_string()))?
-        .map_err(|e| open_error(path, &e))?;
+    let (object, _) = open::open(path, false)?;
     let pixel_data = object
         .get(tags::PIXEL_DATA)
         .ok_or_else(|| ReadError::format(path, "expected a PixelData element, found none"))?;
     match pixel_data.value() {
         DicomValue::Primitive(value) => {
-            check_native_length(file, value, map)?;
-            frames
+            let padded = check_native_length(file, value, map)?;
+            let stats = frames
                 .into_iter()
                 .map(|(frame, out)| native_frame(path, value, frame, out, map))
-                .collect()
+                .collect::<Result<_>>()?;
+            Ok((stats, padded))
         }
         DicomValue::PixelSequence(sequence) => {
             check_fragment_count(file, sequence.fragments().len())?;
@@ -314,7 +320,7 @@ pub(super) fn decode_file(
             } else {
                 registry_frame
             };
-            frames
+            let stats = frames
                 .into_par_iter()
                 .map(|(frame, out)| {
                     decode(&object, frame, out, map).map_err(|e| match e {
@@ -327,7 +333,8 @@ pub(super) fn decode_file(
                         }
                     })
                 })
-                .collect()
+                .collect::<Result<_>>()?;
+            Ok((stats, None))
         }
         DicomValue::Sequence(_) => Err(ReadError::format(
             path,
@@ -338,20 +345,34 @@ pub(super) fn decode_file(
 
 /// Uncompressed pixel data must hold exactly the frames the header declares (plus the pad byte
 /// of an odd length): fewer would leave slices unread, more means the header is wrong about
-/// the image (its size, sample width or NumberOfFrames).
-fn check_native_length(file: &ImageFile, value: &PrimitiveValue, map: &SampleMap) -> Result<()> {
+/// the image (its size, sample width or NumberOfFrames) — unless every surplus byte is zero,
+/// which some writers append as padding (pydicom reads such files too): that is ignored, and
+/// the returned warning says how many bytes were.
+fn check_native_length(
+    file: &ImageFile,
+    value: &PrimitiveValue,
+    map: &SampleMap,
+) -> Result<Option<String>> {
     let found = match value {
         PrimitiveValue::U8(bytes) => bytes.len(),
         PrimitiveValue::U16(words) => words.len() * 2,
         PrimitiveValue::I16(words) => words.len() * 2,
         // Another type: refused, naming it, by the frame conversion.
-        _ => return Ok(()),
+        _ => return Ok(None),
     };
     let layout = &file.layout;
     let (rows, columns, frames) = (layout.rows, layout.columns, file.frames.len());
     let expected = usize::from(rows) * usize::from(columns) * frames * map.bytes_per_sample;
     if found == expected || (expected % 2 == 1 && found == expected + 1) {
-        return Ok(());
+        return Ok(None);
+    }
+    if found > expected && surplus_is_zero(value, expected) {
+        return Ok(Some(format!(
+            "{}: PixelData (7FE0,0010) ends with {} bytes of zeros beyond Rows × Columns × \
+             NumberOfFrames ({expected} bytes); they were taken as padding and ignored",
+            file.path.display(),
+            found - expected
+        )));
     }
     Err(ReadError::inconsistent(
         &file.path,
@@ -363,6 +384,16 @@ fn check_native_length(file: &ImageFile, value: &PrimitiveValue, map: &SampleMap
             map.bytes_per_sample
         ),
     ))
+}
+
+/// Whether every byte of `value` from byte `from` on is zero.
+fn surplus_is_zero(value: &PrimitiveValue, from: usize) -> bool {
+    match value {
+        PrimitiveValue::U8(bytes) => bytes[from..].iter().all(|&b| b == 0),
+        PrimitiveValue::U16(words) => words[from / 2..].iter().all(|&w| w == 0),
+        PrimitiveValue::I16(words) => words[from / 2..].iter().all(|&w| w == 0),
+        _ => false,
+    }
 }
 
 /// Compressed pixel data hold at least one fragment a frame: fewer means frames are missing
@@ -400,10 +431,38 @@ fn registry_frame(
     map: &SampleMap,
 ) -> std::result::Result<FrameStats, FrameError> {
     check_stream_size(object, frame)?;
+    if let Ok((rows, columns, data)) = compressed_frame(object, frame) {
+        if jpeg12::is_12_bit(&data) {
+            return jpeg12_frame(&data, rows, columns, out, map);
+        }
+    }
     let decoded = guarded(|| object.decode_pixel_data_frame(frame))
         .and_then(|decoded| decoded.map_err(|e| chain(&e)))
         .map_err(FrameError::Decode)?;
     converted(decoded.data(), out, map)
+}
+
+/// Decodes a 12-bit JPEG frame (which dicom-rs's decoder refuses) through [`jpeg12`].
+fn jpeg12_frame(
+    data: &[u8],
+    rows: u16,
+    columns: u16,
+    out: &mut [u16],
+    map: &SampleMap,
+) -> std::result::Result<FrameStats, FrameError> {
+    let samples = jpeg12::decode(data, rows, columns).map_err(FrameError::Decode)?;
+    if samples.iter().any(|&s| s > map.max_word()) {
+        return Err(FrameError::Decode(
+            "the 12-bit JPEG stream holds samples wider than BitsAllocated allows".into(),
+        ));
+    }
+    if samples.len() < out.len() {
+        return Err(FrameError::Short {
+            needed: out.len() * map.bytes_per_sample,
+            found: samples.len() * map.bytes_per_sample,
+        });
+    }
+    Ok(map.convert(samples.into_iter(), out))
 }
 
 /// Refuses a compressed frame whose stream declares another size than Rows × Columns.
@@ -555,6 +614,7 @@ mod tests {
             high_bit: stored - 1,
             signed,
             photometric: "MONOCHROME2".into(),
+            modality_lut: None,
         }
     }
 

@@ -2,15 +2,16 @@
 //! parallel, into plain structs the later stages can reason about without the DICOM object.
 
 use super::lengths;
+use super::lut::ModalityLut;
+use super::open::{self, Body};
 use crate::error::{ReadError, Result};
-use crate::guard;
 use crate::limits::Limits;
 use crate::progress::Progress;
 use crate::samples::Rescale;
 use dicom_core::header::HasLength;
 use dicom_core::{Tag, VR};
 use dicom_dictionary_std::tags;
-use dicom_object::{InMemDicomObject, OpenFileOptions};
+use dicom_object::InMemDicomObject;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::io::Read;
@@ -79,6 +80,8 @@ pub(super) struct ImageFile {
     pub padding: Option<i32>,
     /// One entry per frame (one for a classic single-frame image).
     pub frames: Vec<FrameHeader>,
+    /// Warnings about what the header left unsaid and the reader assumed.
+    pub notes: Vec<String>,
 }
 
 /// How samples are stored; must be the same for every file of a series.
@@ -100,6 +103,8 @@ pub(super) struct PixelLayout {
     pub signed: bool,
     /// PhotometricInterpretation, trimmed (e.g. `MONOCHROME2`).
     pub photometric: String,
+    /// The Modality LUT, which replaces RescaleSlope/Intercept when present.
+    pub modality_lut: Option<ModalityLut>,
 }
 
 /// Where one frame lies and how its values map to physical units.
@@ -157,53 +162,24 @@ pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
     if let Err(e) = lengths::check_element_lengths(path, max_inflated) {
         return Scanned::Unreadable(e);
     }
-    let opened = guard::quietly(|| {
-        OpenFileOptions::new()
-            .read_until(tags::PIXEL_DATA)
-            .open_file(path)
-    });
-    let object = match opened {
-        Ok(Ok(object)) => object,
-        Ok(Err(e)) => return Scanned::Unreadable(open_error(path, &e)),
-        Err(panicked) => return Scanned::Unreadable(ReadError::format(path, panicked.to_string())),
+    let (object, body) = match open::open(path, true) {
+        Ok(opened) => opened,
+        Err(e) => return Scanned::Unreadable(e),
     };
     match image_file(path, &object, &object.meta().transfer_syntax, limits) {
-        Ok(Some(image)) => Scanned::Image(image),
+        Ok(Some(mut image)) => {
+            if let Body::Implicit = body {
+                image.notes.push(format!(
+                    "{}: the meta group says explicit VR, but the data set is implicit VR; \
+                     it was read as implicit VR (as pydicom does)",
+                    path.display()
+                ));
+            }
+            Scanned::Image(image)
+        }
         Ok(None) => Scanned::NoImage,
         Err(e) => Scanned::Unreadable(e),
     }
-}
-
-/// Turns a dicom-object open error into ours: an unknown or undecodable transfer syntax is
-/// [`ReadError::Unsupported`], anything else a format error.
-pub(super) fn open_error(path: &Path, error: &dicom_object::ReadError) -> ReadError {
-    use dicom_object::ReadError as E;
-    match error {
-        E::OpenFile { source, .. } | E::ReadFile { source, .. } => {
-            ReadError::io(path, std::io::Error::new(source.kind(), source.to_string()))
-        }
-        E::ReadUnrecognizedTransferSyntax { uid, .. } => ReadError::unsupported(
-            path,
-            format!("transfer syntax {uid} (not a transfer syntax this reader knows)"),
-        ),
-        E::ReadUnsupportedTransferSyntax { uid, name, .. }
-        | E::ReadUnsupportedTransferSyntaxWithSuggestion { uid, name, .. } => {
-            ReadError::unsupported(path, format!("transfer syntax {uid} ({name})"))
-        }
-        other => ReadError::format(path, format!("not a readable DICOM file: {}", chain(other))),
-    }
-}
-
-/// An error and its causes in one line, so that "premature end" says where.
-pub(super) fn chain(error: &dyn std::error::Error) -> String {
-    let mut text = error.to_string();
-    let mut source = error.source();
-    while let Some(cause) = source {
-        text.push_str(": ");
-        text.push_str(&cause.to_string());
-        source = cause.source();
-    }
-    text
 }
 
 /// `DICM` at byte 128 (after the preamble) or at byte 0 (a file without preamble).
@@ -238,6 +214,7 @@ fn image_file(
         ));
     }
     let bits_stored = integer(object, tags::BITS_STORED).unwrap_or(0u16);
+    let signed = integer::<u16>(object, tags::PIXEL_REPRESENTATION) == Some(1);
     let layout = PixelLayout {
         rows,
         columns,
@@ -245,16 +222,27 @@ fn image_file(
         bits_allocated: integer(object, tags::BITS_ALLOCATED).unwrap_or(0),
         bits_stored,
         high_bit: integer(object, tags::HIGH_BIT).unwrap_or(bits_stored.saturating_sub(1)),
-        signed: integer::<u16>(object, tags::PIXEL_REPRESENTATION) == Some(1),
+        signed,
         photometric: text(object, tags::PHOTOMETRIC_INTERPRETATION).to_ascii_uppercase(),
+        modality_lut: ModalityLut::read(path, object, signed)?,
     };
     let frame_count = integer::<u32>(object, tags::NUMBER_OF_FRAMES)
         .unwrap_or(1)
         .max(1);
     limits.check_slices(path, u64::from(frame_count))?;
-    let frames = (0..frame_count)
+    let mut frames = (0..frame_count)
         .map(|frame| frame_header(path, object, frame))
         .collect::<Result<Vec<_>>>()?;
+    let notes = mosaic_note(path, object)
+        .into_iter()
+        .chain(stack_unplaced_frames(path, object, &mut frames)?)
+        .collect();
+    if layout.modality_lut.is_some() {
+        // The LUT's outputs are the values (PS3.3 C.11.1: a LUT or a rescale, never both).
+        for frame in &mut frames {
+            frame.rescale = Rescale::IDENTITY;
+        }
+    }
     Ok(Some(ImageFile {
         path: path.to_path_buf(),
         series_uid: text(object, tags::SERIES_INSTANCE_UID),
@@ -264,7 +252,80 @@ fn image_file(
         padding: padding_value(object, layout.signed),
         layout,
         frames,
+        notes,
     }))
+}
+
+/// A multi-frame image whose frames share one position or have none (older multi-frame MR
+/// and NM files): its frames are stacked in file order along the slice normal (row × column
+/// cosine; axial when the orientation is missing too) from that position (or the origin), at
+/// SpacingBetweenSlices, else SliceThickness, else 1 mm. Returns the warning that says so;
+/// `None` when the frames are placed by the header.
+fn stack_unplaced_frames(
+    path: &Path,
+    object: &InMemDicomObject,
+    frames: &mut [FrameHeader],
+) -> Result<Option<String>> {
+    let first = frames[0];
+    let shared = |f: &FrameHeader| f.position == first.position;
+    if frames.len() < 2 || !frames.iter().all(shared) {
+        return Ok(None);
+    }
+    let orientation = first.orientation.unwrap_or([DVec3::X, DVec3::Y]);
+    let normal = orientation[0].cross(orientation[1]);
+    let between = floats(
+        path,
+        "SpacingBetweenSlices",
+        object,
+        tags::SPACING_BETWEEN_SLICES,
+    )?
+    .and_then(|v| v.first().map(|s| s.abs()));
+    let positive = |v: &f64| v.is_finite() && *v > 0.0;
+    let (step, source) = match (between.filter(positive), first.thickness.filter(positive)) {
+        (Some(step), _) => (step, "SpacingBetweenSlices"),
+        (None, Some(step)) => (step, "SliceThickness"),
+        (None, None) => (
+            1.0,
+            "nothing (no SpacingBetweenSlices or SliceThickness): 1 mm assumed",
+        ),
+    };
+    let origin = first.position.unwrap_or(DVec3::ZERO);
+    for (k, frame) in frames.iter_mut().enumerate() {
+        frame.position = Some(origin + normal * (step * k as f64));
+        frame.orientation = Some(orientation);
+    }
+    let placed = match (first.position, first.orientation) {
+        (Some(_), Some(_)) => "one ImagePositionPatient for all frames",
+        (None, Some(_)) => "no ImagePositionPatient (placed at the origin)",
+        (Some(_), None) => "one ImagePositionPatient and no ImageOrientationPatient (axial)",
+        (None, None) => "no ImagePositionPatient/ImageOrientationPatient (at the origin, axial)",
+    };
+    Ok(Some(format!(
+        "{}: {} frames with {placed}: stacked in file order along the slice normal, {step} mm          apart (from {source}); the slice positions are assumed, not read",
+        path.display(),
+        frames.len()
+    )))
+}
+
+/// The warning for a Siemens mosaic (ImageType MOSAIC), which tiles the slices of a volume in
+/// one image: it is read as that one image (as pydicom reads it), not unpacked, and the
+/// warning says so; `None` for any other image.
+fn mosaic_note(path: &Path, object: &InMemDicomObject) -> Option<String> {
+    let image_type = text(object, tags::IMAGE_TYPE).to_ascii_uppercase();
+    if !image_type.split('\\').any(|value| value.trim() == "MOSAIC") {
+        return None;
+    }
+    // NumberOfImagesInMosaic, when the Siemens private block (0019,0010) names it.
+    let siemens = text(object, Tag(0x0019, 0x0010)) == "SIEMENS MR HEADER";
+    let count = integer::<u32>(object, Tag(0x0019, 0x100A))
+        .filter(|_| siemens)
+        .map_or_else(String::new, |n| format!(" of {n} slices"));
+    Some(format!(
+        "{}: a Siemens mosaic{count} (ImageType {image_type}): its slices are tiled in this one \
+         image, which this reader does not unpack, so the volume is the tiled image, not the \
+         3-D scan; convert it first (e.g. dcm2niix to NIfTI) to measure or render the scan",
+        path.display()
+    ))
 }
 
 /// PixelPaddingValue as the raw sample it marks. Implicit VR files give no VR, so a signed
