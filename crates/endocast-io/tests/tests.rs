@@ -15,6 +15,7 @@ mod nifti;
 mod nrrd;
 mod peel_real_scans;
 mod scans_understood;
+mod series;
 mod stereo_real_scans;
 mod structures_found;
 mod test_volumes;
