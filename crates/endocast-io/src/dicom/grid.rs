@@ -84,7 +84,8 @@ pub(super) fn plan(
 }
 
 /// The step of a stack whose gaps are all one step but for a few (at most two, or a tenth of
-/// them) of a whole number of steps: the mean of the one-step gaps. `None` otherwise.
+/// them) of a whole number of steps, the grid keeping within [`MAX_RESAMPLE_FACTOR`] times the
+/// slices: the mean of the one-step gaps. `None` otherwise.
 fn missing_step(gaps: &[f64]) -> Option<f64> {
     let mut sorted = gaps.to_vec();
     sorted.sort_by(f64::total_cmp);
@@ -95,7 +96,9 @@ fn missing_step(gaps: &[f64]) -> Option<f64> {
         .zip(&steps)
         .all(|(g, &k)| k >= 1.0 && (g - k * median).abs() <= ON_PLANE * median);
     let skips = steps.iter().filter(|&&k| k > 1.0).count();
-    if !whole || skips == 0 || skips > (gaps.len() / 10).max(2) {
+    let planes = steps.iter().sum::<f64>() + 1.0;
+    let most = (MAX_RESAMPLE_FACTOR * (gaps.len() + 1)) as f64;
+    if !whole || skips == 0 || skips > (gaps.len() / 10).max(2) || planes > most {
         return None;
     }
     let single: Vec<f64> = gaps
@@ -201,9 +204,13 @@ fn missing_slices(names: &Names, offsets: &[f64], grid: &Grid) -> String {
             continue;
         }
         missing += skipped;
-        let at: Vec<String> = (pair[0] + 1..pair[1])
+        let mut at: Vec<String> = (pair[0] + 1..pair[1])
+            .take(EXAMPLES)
             .map(|p| names.position(p as f64 * grid.step_mm))
             .collect();
+        if skipped > EXAMPLES {
+            at.push("...".to_owned());
+        }
         gaps.push(format!(
             "between {} and {} a gap of {:.2} mm, {} steps of {:.2} mm (missing at {} mm)",
             names.slice(k, offsets),
@@ -370,6 +377,8 @@ mod tests {
             missing_step(&[5.0, 5.0, 5.0, 2.5, 2.5, 2.5, 2.5, 2.5]),
             None
         );
+        // A gap of a billion steps is no missing slice (nor a grid of a billion planes).
+        assert_eq!(missing_step(&[1.0, 1.0, 1e9, 1.0, 1.0]), None);
     }
 
     #[test]
