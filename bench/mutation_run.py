@@ -15,8 +15,9 @@ files.
     cargo build -p endocast-cli
     python3 bench/mutation_run.py --count 4000 --seed 32 --endocast target/debug/endocast OUT
 
-Writes OUT/mutants/NNNNN.ext (kept for a rerun), OUT/results.tsv (one line per mutant) and
-prints the table. A panic, timeout or kill is listed with its file: make it a fuzz seed.
+Writes OUT/results.tsv (one line per mutant) and prints the table. A mutant that panics, times
+out or is killed stays in OUT/mutants with its stderr (.err), listed at the end: make it a fuzz
+seed. The others are deleted once read (30 000 take 2.5 GB), unless --keep.
 """
 
 import argparse
@@ -144,6 +145,7 @@ def main():
     parser.add_argument("--endocast", default=str(ROOT / "target" / "debug" / "endocast"))
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds per read")
     parser.add_argument("--as-limit", type=int, default=4 << 30, help="address space, bytes")
+    parser.add_argument("--keep", action="store_true", help="keep every mutant, not only the bad")
     args = parser.parse_args()
 
     mutants = args.out / "mutants"
@@ -169,6 +171,8 @@ def main():
                 worst_wall = max(worst_wall, (wall, path.name))
             if outcome in ("panic", "timeout", "killed"):
                 bad.append(f"{path} ({name}, {damage}): {outcome}, exit {code}")
+            elif not args.keep:
+                path.unlink()
             results.write(f"{path.name}\t{name}\t{damage}\t{outcome}\t{code}\t{rss}\t{wall:.3f}\n")
     elapsed = time.monotonic() - started
     print(f"seeds: {len(pool)}; mutants: {args.count} (seed {args.seed}); {elapsed:.0f} s")
