@@ -23,6 +23,13 @@ pub struct InputArgs {
     /// index axes point, e.g. LPI for slices stored from the top of the head down.
     #[arg(long, value_name = "CODE")]
     pub orientation: Option<String>,
+    /// DICOM: read a series with missing slices (a gap of whole steps in evenly spaced slices),
+    /// filling them by interpolation (warned); refused without it.
+    #[arg(long)]
+    pub fill_missing_slices: bool,
+    /// NRRD/MetaImage: allow a detached data file outside the header's folder.
+    #[arg(long)]
+    pub allow_outside_data: bool,
     /// Raw input: dimensions X,Y,Z (makes the file be read as headerless samples).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_dims)]
     pub raw_dims: Option<[usize; 3]>,
@@ -63,6 +70,8 @@ impl InputArgs {
         options.limits = self.limits();
         options.raw = self.raw_spec()?;
         options.orientation.clone_from(&self.orientation);
+        options.fill_missing_slices = self.fill_missing_slices;
+        options.allow_outside_data = self.allow_outside_data;
         endocast_io::open(&self.path, &options).context("cannot read the scan")
     }
 

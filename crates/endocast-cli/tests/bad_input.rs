@@ -72,3 +72,37 @@ fn absurd_parameters() {
         "/no/such/dir/p.nii",
     );
 }
+
+/// Issue 32: a 14000² render under a 4 GiB address-space limit is refused before anything is
+/// allocated for it (it used to pass the memory check and abort past 9.9 GB): a clean error
+/// naming the limit and a non-zero exit, not a signal.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_huge_render_under_an_address_space_limit_is_refused_cleanly() {
+    if std::process::Command::new("prlimit")
+        .arg("--version")
+        .output()
+        .is_err()
+    {
+        eprintln!("skipped: no prlimit on this machine");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let raw = dir.path().join("v.raw");
+    std::fs::write(&raw, [0u8; 8 * 8 * 8 * 2]).unwrap();
+    let png = dir.path().join("view.png");
+    let out = std::process::Command::new("prlimit")
+        .args(["--as=4294967296", "--", env!("CARGO_BIN_EXE_endocast")])
+        .args(["render", raw.to_str().unwrap(), "--raw-dims", "8,8,8"])
+        .args(["--size", "14000x14000", "-o", png.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        stderr.contains("14000×14000") && stderr.contains("limit"),
+        "{stderr}"
+    );
+    assert!(!png.exists());
+}

@@ -20,6 +20,24 @@ fn phantom_then_convert_keeps_geometry_and_values() {
         String::from_utf8_lossy(&out.stderr)
     );
     let original = info_json(nii.to_str().unwrap(), &[]);
+    // The limits in force are part of the report, `--max-voxels` among them.
+    let limited = info_json(nii.to_str().unwrap(), &["--max-voxels", "100000"]);
+    let limits = &limited["limits"];
+    assert_eq!(limits["max_voxels"], 100_000);
+    for key in [
+        "max_slices",
+        "max_frame_bytes",
+        "max_image_pixels",
+        "max_frames",
+        "max_threads",
+        "max_texture_edge",
+    ] {
+        assert!(
+            limits[key].as_u64().is_some_and(|n| n > 0),
+            "{key}: {limits}"
+        );
+    }
+    assert!(limits.get("memory_counted_bytes").is_some(), "{limits}");
     for ext in ["nrrd", "mha", "nii"] {
         let converted = dir.path().join(format!("p.{ext}"));
         let out = endocast(&[

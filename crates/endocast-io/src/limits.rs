@@ -47,6 +47,19 @@ impl Default for Limits {
 }
 
 impl Limits {
+    /// The memory the defaults are computed from (see [`Limits`]), bytes; `None` where it
+    /// cannot be read (the defaults then assume 4 GiB).
+    pub fn memory_counted() -> Option<u64> {
+        memory_bytes()
+    }
+
+    /// The most pixels a single plain still may have under [`Limits::max_frame_bytes`] (what
+    /// [`Limits::check_frames`] allows for one frame without extra layers).
+    pub fn max_image_pixels(&self) -> u64 {
+        let per_pixel = view_bytes([1, 1], Layers::NONE).unwrap_or(u64::MAX).max(1);
+        self.max_frame_bytes / per_pixel
+    }
+
     /// Limits allowing at most `max_voxels` voxels (and the default slice count).
     pub fn with_max_voxels(max_voxels: u64) -> Self {
         Self {

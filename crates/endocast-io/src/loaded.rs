@@ -68,6 +68,14 @@ pub struct OpenOptions {
     /// the head down. Giving it for a file that declares its own orientation is an error.
     /// Default: none (such files are read as axis-aligned LPS, with a warning).
     pub orientation: Option<String>,
+    /// DICOM: fill missing slices (a gap of a whole number of steps in an otherwise evenly
+    /// spaced series, e.g. a file lost or unreadable) by interpolating between their
+    /// neighbours, with a warning naming them. Default: `false`, such a series is refused,
+    /// the error naming the gap.
+    pub fill_missing_slices: bool,
+    /// NRRD and MetaImage: allow a detached data file outside the header's folder (it must
+    /// still be a regular file). Default: `false`, such a file is refused.
+    pub allow_outside_data: bool,
     /// Where the reader counts how far it is (DICOM folders: headers, then files decoded), for
     /// a progress bar on another thread. Default: counts nobody looks at.
     pub progress: Progress,

@@ -31,7 +31,9 @@ fn case_with(n: usize) -> Case {
             1 => Shape::Stroke(vec![p, p + DVec3::X, p + DVec3::Y]),
             _ => Shape::Distance(p, p + DVec3::new(3.0, 4.0, 0.0)),
         };
-        marks.add(Annotation::new(shape).labelled(&format!("mark {i}")));
+        marks
+            .add(Annotation::new(shape).labelled(&format!("mark {i}")))
+            .unwrap();
     }
     let mut case = Case::new(source, Some(&identity));
     case.set_annotations(&marks);
@@ -225,7 +227,9 @@ fn changes_made_at_once_are_all_kept() {
             || Ok::<_, CaseError>(Case::new(source.clone(), Some(&identity))),
             |case| {
                 let mut marks = case.annotations(&path)?;
-                marks.add(Annotation::new(Shape::Point(DVec3::splat(n as f64))));
+                marks
+                    .add(Annotation::new(Shape::Point(DVec3::splat(n as f64))))
+                    .map_err(|e| CaseError::new(&path, e))?;
                 case.set_annotations(&marks);
                 Ok(())
             },

@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
+pub(crate) const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
 const IMPLICIT_LE: &str = "1.2.840.10008.1.2";
 const RLE: &str = "1.2.840.10008.1.2.5";
 const JPEG_BASELINE: &str = "1.2.840.10008.1.2.4.50";
@@ -63,7 +63,7 @@ fn is_long(vr: &[u8; 2]) -> bool {
 }
 
 /// One explicit-VR little-endian element; an odd value is padded (NUL for UIDs and bytes).
-fn element(tag: (u16, u16), vr: &[u8; 2], value: &[u8]) -> Vec<u8> {
+pub(crate) fn element(tag: (u16, u16), vr: &[u8; 2], value: &[u8]) -> Vec<u8> {
     let mut value = value.to_vec();
     if value.len() % 2 == 1 {
         value.push(if matches!(vr, b"UI" | b"OB" | b"UN") {
@@ -114,11 +114,11 @@ fn meta(transfer_syntax: &str) -> Vec<u8> {
 }
 
 /// A one-slice CT image as a map of its encoded elements, so that tests can replace any.
-struct Image(BTreeMap<(u16, u16), Vec<u8>>);
+pub(crate) struct Image(BTreeMap<(u16, u16), Vec<u8>>);
 
 impl Image {
     /// Rows × columns of 16-bit samples (12 stored), placed, spaced, rescaled to HU.
-    fn ct(rows: u16, columns: u16) -> Self {
+    pub(crate) fn ct(rows: u16, columns: u16) -> Self {
         let pixels: Vec<u8> = (0..u32::from(rows) * u32::from(columns))
             .flat_map(|i| (i as u16 * 37 % 4000).to_le_bytes())
             .collect();
@@ -145,12 +145,12 @@ impl Image {
         image
     }
 
-    fn set(&mut self, tag: (u16, u16), encoded: Vec<u8>) -> &mut Self {
+    pub(crate) fn set(&mut self, tag: (u16, u16), encoded: Vec<u8>) -> &mut Self {
         self.0.insert(tag, encoded);
         self
     }
 
-    fn text(&mut self, tag: (u16, u16), vr: &[u8; 2], value: &str) -> &mut Self {
+    pub(crate) fn text(&mut self, tag: (u16, u16), vr: &[u8; 2], value: &str) -> &mut Self {
         self.set(tag, element(tag, vr, value.as_bytes()))
     }
 
@@ -178,7 +178,7 @@ impl Image {
     }
 
     /// The file, in `transfer_syntax` (whose pixel data the test has set).
-    fn bytes(&self, transfer_syntax: &str) -> Vec<u8> {
+    pub(crate) fn bytes(&self, transfer_syntax: &str) -> Vec<u8> {
         let mut out = meta(transfer_syntax);
         out.extend(self.data_set());
         out
@@ -500,6 +500,26 @@ fn data_files_outside_the_header_folder_are_refused() {
     let path = inner.join("v.nhdr");
     std::fs::write(&path, nrrd_header("2 2 2", "raw", Some("data/v.raw"))).unwrap();
     read_nrrd(&path).unwrap();
+}
+
+#[test]
+fn data_files_elsewhere_are_read_when_allowed_but_must_still_be_regular_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let inner = dir.path().join("scan");
+    std::fs::create_dir(&inner).unwrap();
+    std::fs::write(dir.path().join("outside.raw"), [0u8; 16]).unwrap();
+    let mut allowed = OpenOptions::default();
+    allowed.allow_outside_data = true;
+    let path = inner.join("v.nhdr");
+    std::fs::write(&path, nrrd_header("2 2 2", "raw", Some("../outside.raw"))).unwrap();
+    nrrd::read(&path, &allowed).unwrap();
+    let mhd = inner.join("v.mhd");
+    std::fs::write(&mhd, metaimage_header("2 2 2", false, "../outside.raw")).unwrap();
+    metaimage::read(&mhd, &allowed).unwrap();
+    if cfg!(unix) {
+        std::fs::write(&path, nrrd_header("2 2 2", "raw", Some("/dev/zero"))).unwrap();
+        refused(nrrd::read(&path, &allowed), &path, &["not a regular file"]);
+    }
 }
 
 #[test]

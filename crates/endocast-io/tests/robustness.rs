@@ -2,7 +2,9 @@
 //! flipped bytes, header numbers replaced by 0, negative, huge and NaN values, missing detached
 //! files) must each give `Ok` or a clean `Err` — never a panic, never an allocation beyond the
 //! configured limit. Truncated files must give `Err`; valid ones must load and keep no more
-//! than 1.1 × their voxel bytes (plus a little bookkeeping).
+//! than 1.1 × their voxel bytes (plus a little bookkeeping). Every refusal stays within
+//! issue 32's bounds: at most [`MEMORY_BUDGET`] (56 MiB, under its 100 MB) allocated and
+//! [`REFUSAL_TIME`] taken.
 //!
 //! This is its own test binary with a single test so that the counting allocator below measures
 //! only the reader under test.
@@ -17,6 +19,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 /// Forwards to the system allocator, keeping the current and peak number of bytes allocated.
 struct Counting;
@@ -58,6 +61,9 @@ const MAX_VOXELS: u64 = 1 << 20;
 /// voxels at the limit in the widest sample type, plus room for decoders' buffers.
 const MEMORY_BUDGET: usize = (MAX_VOXELS as usize) * 8 + (48 << 20);
 
+/// The longest a refusal may take (issue 32: no refusal takes over 2 s).
+const REFUSAL_TIME: Duration = Duration::from_secs(2);
+
 /// Bytes a loaded volume may keep beyond 1.1 × its voxel bytes: the `Loaded` record's strings.
 const RETAINED_SLACK: usize = 64 << 10;
 
@@ -94,6 +100,7 @@ impl Tally {
         let options = options();
         let before = CURRENT.load(Ordering::Relaxed);
         PEAK.store(before, Ordering::Relaxed);
+        let start = Instant::now();
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             open(&dir.join(entry), &options).map(|loaded| {
                 // What a loaded volume keeps: its voxels and little else.
@@ -102,6 +109,11 @@ impl Tally {
             })
         }));
         let used = PEAK.load(Ordering::Relaxed).saturating_sub(before);
+        let took = start.elapsed();
+        if matches!(outcome, Ok(Err(_))) && took > REFUSAL_TIME {
+            self.failures
+                .push(format!("{what}: refused after {took:?}"));
+        }
         match outcome {
             Err(_) => self.failures.push(format!("{what}: panicked")),
             Ok(Ok((retained, voxel_bytes)))

@@ -16,6 +16,7 @@ mod nrrd;
 mod overlay;
 mod peel_real_scans;
 mod scans_understood;
+mod series;
 mod stereo_real_scans;
 mod structures_found;
 mod test_volumes;

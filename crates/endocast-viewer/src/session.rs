@@ -617,10 +617,11 @@ impl Session {
         self.find_lumen();
     }
 
-    /// Labels the surface point seen at pixel `(x, y)`; false when no surface is seen there.
+    /// Labels the surface point seen at pixel `(x, y)`; false when no surface is seen there
+    /// (or no annotation id is left).
     pub fn annotate_pixel(&mut self, x: usize, y: usize, label: &str) -> bool {
         self.surface_point(x, y)
-            .map(|p| {
+            .and_then(|p| {
                 let mark = Annotation::new(Shape::Point(p)).labelled(label);
                 self.add_mark(mark)
             })
@@ -628,11 +629,12 @@ impl Session {
     }
 
     /// Measures between the surface points seen at pixels `a` and `b`: adds the measurement
-    /// and returns its length, mm; `None` when either pixel shows no surface.
+    /// and returns its length, mm; `None` when either pixel shows no surface (or no annotation
+    /// id is left).
     pub fn measure_pixels(&mut self, a: [usize; 2], b: [usize; 2]) -> Option<f64> {
         let p = self.surface_point(a[0], a[1])?;
         let q = self.surface_point(b[0], b[1])?;
-        self.add_mark(Annotation::new(Shape::Distance(p, q)));
+        self.add_mark(Annotation::new(Shape::Distance(p, q)))?;
         Some(p.distance(q))
     }
 
@@ -655,13 +657,13 @@ impl Session {
     }
 
     /// Ends the stroke being drawn, adding it (labelled `label`) when it has a point; returns
-    /// its id.
+    /// its id (`None` when it has none, or no annotation id is left).
     pub fn finish_stroke(&mut self, label: &str) -> Option<u32> {
         let points = std::mem::take(&mut self.stroke);
-        (!points.is_empty()).then(|| {
-            let mark = Annotation::new(Shape::Stroke(points)).labelled(label);
-            self.add_mark(mark)
-        })
+        if points.is_empty() {
+            return None;
+        }
+        self.add_mark(Annotation::new(Shape::Stroke(points)).labelled(label))
     }
 
     /// The annotations, oldest first.
@@ -681,9 +683,11 @@ impl Session {
         self.marks_revision += 1;
     }
 
-    fn add_mark(&mut self, mark: Annotation) -> u32 {
+    /// Adds `mark`; `None` when no annotation id is left.
+    fn add_mark(&mut self, mark: Annotation) -> Option<u32> {
+        let id = self.marks.add(mark).ok()?;
         self.marks_revision += 1;
-        self.marks.add(mark)
+        Some(id)
     }
 
     /// A number that grows with every change of the annotations or the stroke being drawn

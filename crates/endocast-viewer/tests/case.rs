@@ -332,7 +332,9 @@ fn an_autosave_never_overwrites_what_another_program_saved_meanwhile() {
         || unreachable!(),
         |case| {
             let mut marks = case.annotations(&path)?;
-            marks.add(Annotation::new(Shape::Point(glam::DVec3::ZERO)));
+            marks
+                .add(Annotation::new(Shape::Point(glam::DVec3::ZERO)))
+                .map_err(|e| CaseError::new(&path, e))?;
             case.set_annotations(&marks);
             Ok::<_, CaseError>(())
         },

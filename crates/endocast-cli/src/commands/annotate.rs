@@ -134,7 +134,7 @@ pub fn run(args: &AnnotateArgs) -> Result<()> {
             };
             let annotation = annotation(add, &points)?;
             let added = opened.save(&args.case, |marks| {
-                let id = marks.add(annotation);
+                let id = marks.add(annotation)?;
                 marks.get(id).cloned().context("the annotation just added")
             })?;
             println!("added {}", line(&added));

@@ -42,6 +42,9 @@ pub struct BenchArgs {
     /// For files that declare no patient orientation: where their index axes point (e.g. LPI).
     #[arg(long, value_name = "CODE")]
     orientation: Option<String>,
+    /// DICOM: fill missing slices by interpolation (warned) instead of refusing the series.
+    #[arg(long)]
+    fill_missing_slices: bool,
     /// Size of the colon phantom (512 gives the paper's 512×512×478).
     #[arg(long, value_name = "N", default_value_t = 512)]
     phantom_size: usize,
@@ -426,6 +429,7 @@ fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, 
     let poses = read_path(path, args.frames)?;
     let mut options = OpenOptions::default();
     options.orientation.clone_from(&args.orientation);
+    options.fill_missing_slices = args.fill_missing_slices;
     let loaded = endocast_io::open(volume, &options).context("cannot read the scan")?;
     let ScanLook { settings, look, .. } = on_path(args, &loaded.volume, &poses)?;
     let what = match look {

@@ -3,8 +3,9 @@
 use crate::input::InputArgs;
 use anyhow::Result;
 use clap::Args;
+use endocast_core::look::MAX_TEXELS;
 use endocast_core::{Modality, Volume};
-use endocast_io::Loaded;
+use endocast_io::{Limits, Loaded};
 use serde::Serialize;
 
 /// Arguments of `endocast info`.
@@ -38,7 +39,58 @@ struct Report {
     voxel_bytes: usize,
     series_uid: Option<String>,
     series_found: Vec<SeriesReport>,
+    limits: LimitsReport,
     warnings: Vec<String>,
+}
+
+/// The resource limits in force, so that a user can see what a refusal was measured against.
+#[derive(Serialize)]
+struct LimitsReport {
+    /// The memory the defaults derive from (physical, cgroup or address-space limit), bytes;
+    /// `None` when unreadable.
+    memory_counted_bytes: Option<u64>,
+    max_voxels: u64,
+    max_slices: u64,
+    /// Memory the frames of one view may take, bytes.
+    max_frame_bytes: u64,
+    /// The largest plain still, in pixels (e.g. `--size` W×H with W·H at most this).
+    max_image_pixels: u64,
+    max_frames: u64,
+    max_threads: usize,
+    /// The longest edge of a texture image, pixels.
+    max_texture_edge: usize,
+}
+
+impl LimitsReport {
+    fn new(limits: &Limits) -> Self {
+        Self {
+            memory_counted_bytes: Limits::memory_counted(),
+            max_voxels: limits.max_voxels,
+            max_slices: limits.max_slices,
+            max_frame_bytes: limits.max_frame_bytes,
+            max_image_pixels: limits.max_image_pixels(),
+            max_frames: limits.max_frames,
+            max_threads: limits.max_threads,
+            max_texture_edge: MAX_TEXELS,
+        }
+    }
+
+    /// One line: `limits:       memory counted 15.6 GiB, voxels 2092957696, ...`.
+    fn text(&self) -> String {
+        let gib = |bytes: u64| format!("{:.1} GiB", bytes as f64 / f64::from(1u32 << 30));
+        format!(
+            "limits:       memory counted {}, voxels {}, slices {}, frame memory {}, image \
+             pixels {}, frames {}, threads {}, texture edge {}\n",
+            self.memory_counted_bytes.map_or("unknown".into(), gib),
+            self.max_voxels,
+            self.max_slices,
+            gib(self.max_frame_bytes),
+            self.max_image_pixels,
+            self.max_frames,
+            self.max_threads,
+            self.max_texture_edge
+        )
+    }
 }
 
 #[derive(Serialize)]
@@ -58,7 +110,8 @@ struct SeriesReport {
 /// Runs `endocast info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
     let loaded = args.input.open()?;
-    let report = Report::new(&args.input.path.display().to_string(), &loaded);
+    let path = args.input.path.display().to_string();
+    let report = Report::new(&path, &loaded, &args.input.limits());
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -68,7 +121,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
 }
 
 impl Report {
-    fn new(path: &str, loaded: &Loaded) -> Self {
+    fn new(path: &str, loaded: &Loaded, limits: &Limits) -> Self {
         let volume: &Volume = &loaded.volume;
         let g = volume.geometry();
         let (lo, hi) = volume.physical_range();
@@ -109,6 +162,7 @@ impl Report {
                     images: s.images,
                 })
                 .collect(),
+            limits: LimitsReport::new(limits),
             warnings: loaded.warnings.clone(),
         }
     }
@@ -157,6 +211,7 @@ impl Report {
                 );
             }
         }
+        out += &self.limits.text();
         for w in &self.warnings {
             out += &format!("warning:      {w}\n");
         }

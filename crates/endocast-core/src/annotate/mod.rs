@@ -18,9 +18,10 @@
 //! use glam::DVec3;
 //!
 //! let mut marks = Annotations::default();
-//! let id = marks.add(Annotation::new(Shape::Distance(DVec3::ZERO, DVec3::new(3.0, 4.0, 0.0))));
+//! let id = marks.add(Annotation::new(Shape::Distance(DVec3::ZERO, DVec3::new(3.0, 4.0, 0.0))))?;
 //! assert_eq!(marks.get(id).unwrap().distance_mm(), Some(5.0));
 //! assert_eq!(marks.get(id).unwrap().caption(), "5.0 mm");
+//! # Ok::<(), endocast_core::annotate::IdsExhausted>(())
 //! ```
 
 mod draw;
@@ -166,6 +167,16 @@ impl Annotation {
     }
 }
 
+/// A new annotation would need an id past `u32::MAX`: ids are one more than the largest, and
+/// the largest is already the most an id may be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "no annotation id is left: a new id is one more than the largest, and the largest is \
+     already {max} (renumber the case's annotations)",
+    max = u32::MAX
+)]
+pub struct IdsExhausted;
+
 /// The annotations of a case, oldest first, each with a unique id.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Annotations {
@@ -174,36 +185,34 @@ pub struct Annotations {
 
 impl Annotations {
     /// A set holding `items` as they are (ids kept; a case file's). Duplicate ids are renumbered
-    /// after the largest. Linear in the count (the ids seen so far are hashed, not searched),
+    /// after the largest (an error when that would pass `u32::MAX`). Linear in the count (the ids seen so far are hashed, not searched),
     /// so that a case of hundreds of thousands of annotations opens at once.
-    pub fn from_items(items: Vec<Annotation>) -> Self {
+    pub fn from_items(items: Vec<Annotation>) -> Result<Self, IdsExhausted> {
         let mut taken = HashSet::with_capacity(items.len());
-        let mut largest = 0;
+        let mut largest = 0u32;
         let items = items
             .into_iter()
             .map(|item| {
                 let id = if item.id == 0 || taken.contains(&item.id) {
-                    largest + 1
+                    largest.checked_add(1).ok_or(IdsExhausted)?
                 } else {
                     item.id
                 };
                 taken.insert(id);
                 largest = largest.max(id);
-                Annotation { id, ..item }
+                Ok(Annotation { id, ..item })
             })
-            .collect();
-        Self { items }
+            .collect::<Result<_, _>>()?;
+        Ok(Self { items })
     }
 
-    /// Adds `annotation` with a new id (one more than the largest) and returns the id.
-    pub fn add(&mut self, annotation: Annotation) -> u32 {
-        let id = self.next_id();
+    /// Adds `annotation` with a new id (one more than the largest) and returns the id; nothing
+    /// is added when the largest id is already `u32::MAX`.
+    pub fn add(&mut self, annotation: Annotation) -> Result<u32, IdsExhausted> {
+        let largest = self.items.iter().map(|a| a.id).max().unwrap_or(0);
+        let id = largest.checked_add(1).ok_or(IdsExhausted)?;
         self.items.push(Annotation { id, ..annotation });
-        id
-    }
-
-    fn next_id(&self) -> u32 {
-        self.items.iter().map(|a| a.id).max().unwrap_or(0) + 1
+        Ok(id)
     }
 
     /// Removes annotation `id`; returns it, or `None` when there is none.

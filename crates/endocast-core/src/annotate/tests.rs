@@ -102,7 +102,8 @@ fn a_stroke_drawn_in_one_view_lands_on_the_same_surface_point_in_three_others() 
         }
         // The decal is drawn where the stroke's middle projects.
         let mut image = Image::from_frame(&frame, [0.0; 3]).unwrap();
-        let marks = Annotations::from_items(vec![Annotation::new(Shape::Stroke(points.clone()))]);
+        let marks =
+            Annotations::from_items(vec![Annotation::new(Shape::Stroke(points.clone()))]).unwrap();
         assert_eq!(
             draw(&mut image, &seen, marks.items(), &DrawOptions::default()),
             1
@@ -176,8 +177,10 @@ fn measurements_and_labels_are_drawn_with_their_text() {
         seen.pick(44.5, 32.5).unwrap(),
     );
     let mut marks = Annotations::default();
-    let id = marks.add(Annotation::new(Shape::Distance(a, b)));
-    marks.add(Annotation::new(Shape::Point(seen.pick(32.5, 50.5).unwrap())).labelled("ostium"));
+    let id = marks.add(Annotation::new(Shape::Distance(a, b))).unwrap();
+    marks
+        .add(Annotation::new(Shape::Point(seen.pick(32.5, 50.5).unwrap())).labelled("ostium"))
+        .unwrap();
     let mut image = Image::new(64, 64, [0; 3]).unwrap();
     assert_eq!(
         draw(&mut image, &seen, marks.items(), &DrawOptions::default()),
@@ -207,15 +210,16 @@ fn measurements_and_labels_are_drawn_with_their_text() {
 fn ids_stay_unique_and_shapes_check_their_points() {
     let mut marks = Annotations::default();
     let p = Annotation::new(Shape::Point(DVec3::ZERO));
-    let [one, two] = [marks.add(p.clone()), marks.add(p.clone())];
+    let [one, two] = [marks.add(p.clone()).unwrap(), marks.add(p.clone()).unwrap()];
     assert_eq!((one, two), (1, 2));
     assert!(marks.remove(one).is_some());
-    assert_eq!(marks.add(p.clone()), 3);
+    assert_eq!(marks.add(p.clone()), Ok(3));
     assert!(marks.remove(9).is_none());
     let kept = Annotations::from_items(vec![
         Annotation { id: 5, ..p.clone() },
         Annotation { id: 5, ..p.clone() },
-    ]);
+    ])
+    .unwrap();
     assert_eq!(
         kept.items().iter().map(|a| a.id).collect::<Vec<_>>(),
         [5, 6]
@@ -228,6 +232,24 @@ fn ids_stay_unique_and_shapes_check_their_points() {
     let stroke = Shape::from_points("stroke", &[DVec3::ZERO, DVec3::X]).unwrap();
     assert_eq!(stroke.kind(), "stroke");
     assert_eq!(stroke.points().len(), 2);
+}
+
+#[test]
+fn ids_past_the_largest_u32_are_refused_not_wrapped() {
+    let p = Annotation::new(Shape::Point(DVec3::ZERO));
+    let last = Annotation {
+        id: u32::MAX,
+        ..p.clone()
+    };
+    let mut marks = Annotations::from_items(vec![last.clone()]).unwrap();
+    assert_eq!(marks.add(p.clone()), Err(IdsExhausted));
+    assert_eq!(marks.len(), 1);
+    assert!(IdsExhausted.to_string().contains("4294967295"));
+    // A duplicate id after the largest possible one cannot be renumbered either.
+    assert_eq!(
+        Annotations::from_items(vec![last.clone(), last]),
+        Err(IdsExhausted)
+    );
 }
 
 #[test]

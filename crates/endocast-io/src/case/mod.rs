@@ -217,7 +217,7 @@ impl Case {
             .map(AnnotationRecord::annotation)
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| CaseError::new(path, e))?;
-        Ok(Annotations::from_items(items))
+        Annotations::from_items(items).map_err(|e| CaseError::new(path, e))
     }
 
     /// Replaces the annotations.

@@ -248,7 +248,9 @@ impl<R: Read + Seek> Walker<R> {
             }
             self.check(tag, length)?;
             let end = self.pos + u64::from(length);
-            if tag == (0x0002, 0x0000) && in_meta {
+            // Only the first group length counts: dicom-rs reads a later (0002,0000) as an
+            // ordinary element and still ends the meta group where the first one said.
+            if tag == (0x0002, 0x0000) && in_meta && meta_end == u64::MAX {
                 meta_end = self
                     .group_length(length)?
                     .map_or(u64::MAX, |n| self.pos + n);

@@ -38,12 +38,18 @@
 //!   SliceThickness, else 1 mm, with a warning that says which (pydicom and nibabel keep such
 //!   frames in file order too). A Siemens mosaic (ImageType MOSAIC) is read as the one tiled
 //!   image it is stored as (not unpacked), with a warning that says so.
+//! - Only the main stack is read: the largest group of images sharing an orientation and a
+//!   size (`planes`). Images in another plane or of another size (a localiser) are set aside,
+//!   named in a warning.
 //! - Slices must lie on one line (else [`ReadError::Inconsistent`]). When the gaps between
-//!   them differ by more than 1 %, the stack is resampled onto a uniform step (the smallest
-//!   gap, at most 4× the original slice count) by linear interpolation between the two
-//!   neighbouring slices; the first and last slices stay exactly where they were. The limits
-//!   are checked before the resampled buffer is allocated; while it is filled, the decoded
-//!   stack is held too (freed before returning).
+//!   them differ by more than 1 % (`grid`), every real slice is still kept exactly: the stack
+//!   goes onto a finer grid (the smallest gap, or a half, third or quarter of it when that puts
+//!   every slice on a plane; at most 4× the slice count), each real slice copied onto its
+//!   nearest plane (the move warned) and only the planes between them interpolated linearly.
+//!   One or two gaps of a whole number of steps in an otherwise even stack are missing slices:
+//!   refused, naming the gap, unless [`OpenOptions::fill_missing_slices`] asks to fill them
+//!   (warned). The limits are checked before the resampled buffer is allocated; while it is
+//!   filled, the decoded stack is held too (freed before returning).
 //!
 //! # Values
 //!
@@ -57,6 +63,7 @@
 //! inverted so that bright means high, except for CT, whose Hounsfield units are kept.
 
 mod frame;
+mod grid;
 mod jpeg12;
 mod jpegls;
 mod lengths;
@@ -64,6 +71,7 @@ mod lut;
 mod open;
 mod overlay;
 mod pixels;
+mod planes;
 mod rle;
 mod scan;
 mod series;
@@ -101,7 +109,15 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let images = series::images(path, &files, scanned, &mut warnings)?;
     let (chosen, series_found) = series::choose(path, images, options.series.as_deref())?;
     warnings.extend(chosen.iter().flat_map(|file| file.notes.iter().cloned()));
+    let chosen = planes::main_stack(path, chosen, &mut warnings);
     let stack = Stack::build(path, &chosen, &mut warnings)?;
+    let grid = grid::plan(
+        path,
+        &stack,
+        &chosen,
+        options.fill_missing_slices,
+        &mut warnings,
+    )?;
     let first = &chosen[0];
     let ts_names = chosen
         .iter()
@@ -146,18 +162,18 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         &mut warnings,
     )?;
 
-    let (voxels, geometry) = match stack.uniform_resampling(path, &mut warnings) {
-        Some((new_count, step_mm)) => {
+    let voxels = match &grid.planes {
+        Some(planes) => {
             let total = options
                 .limits
-                .check_dims(path, &[dims[0] as u64, dims[1] as u64, new_count as u64])?;
+                .check_dims(path, &[dims[0] as u64, dims[1] as u64, grid.count as u64])?;
             let mut resampled = vec![0u16; total];
-            let offsets: Vec<f64> = stack.slices.iter().map(|s| s.offset_mm).collect();
-            stack::resample(&voxels, slice_len, &offsets, &mut resampled, step_mm);
-            (resampled, stack.geometry(path, dims, new_count, step_mm)?)
+            grid::resample(&voxels, slice_len, planes, &mut resampled);
+            resampled
         }
-        None => (voxels, stack.geometry(path, dims, count, stack.spacing.z)?),
+        None => voxels,
     };
+    let geometry = stack.geometry(path, dims, grid.count, grid.step_mm)?;
     let volume = Volume::new(geometry, voxels, value_map, modality)
         .map_err(|e| ReadError::format(path, e.to_string()))?;
     let mut source = SourceInfo::new(Format::Dicom, stored_type(first, ts_names[0]));

@@ -1,24 +1,16 @@
-//! Ordering the frames of a series into a stack, its geometry, and resampling an unevenly
-//! spaced stack onto a uniform step.
+//! Ordering the frames of a series into a stack and its geometry.
 
 use super::scan::{FrameHeader, ImageFile};
 use crate::error::{ReadError, Result};
 use crate::samples::Rescale;
 use endocast_core::Geometry;
 use glam::{DMat3, DVec3};
-use rayon::prelude::*;
 use std::path::Path;
 
 /// Two slices closer than this (mm) are the same slice stored twice.
 const DUPLICATE_MM: f64 = 1e-3;
-/// Largest relative deviation of a gap from the mean gap that still counts as uniform.
-const UNEVEN_TOLERANCE: f64 = 0.01;
-/// Resampling never makes more than this many times the original number of slices.
-const MAX_RESAMPLE_FACTOR: usize = 4;
 /// Smallest tilt (degrees) between the stack direction and the slice normal worth a warning.
 const TILT_WARNING_DEG: f64 = 0.05;
-/// Headers round cosines to about six digits; orientations closer than this agree.
-const ORIENTATION_TOLERANCE: f64 = 1e-4;
 
 /// One frame of the stack: which file and frame it comes from and where it lies.
 #[derive(Debug, Clone, Copy)]
@@ -134,41 +126,6 @@ impl Stack {
             ReadError::inconsistent(root, format!("the slices do not form a grid: {e}"))
         })
     }
-
-    /// When the gaps between slices are uneven, the uniform resampling to apply: the number
-    /// of slices and their step (mm), spanning exactly the first to the last slice.
-    pub(super) fn uniform_resampling(
-        &self,
-        root: &Path,
-        warnings: &mut Vec<String>,
-    ) -> Option<(usize, f64)> {
-        let gaps: Vec<f64> = self
-            .slices
-            .windows(2)
-            .map(|pair| pair[1].offset_mm - pair[0].offset_mm)
-            .collect();
-        let mean = self.spacing.z;
-        if gaps
-            .iter()
-            .all(|g| (g - mean).abs() <= UNEVEN_TOLERANCE * mean)
-        {
-            return None;
-        }
-        let span = self.slices.last()?.offset_mm;
-        let smallest = gaps.iter().copied().fold(f64::INFINITY, f64::min);
-        let original = self.slices.len();
-        // Gaps are positive (duplicates were dropped), so the ratio is finite.
-        let wanted = (span / smallest).round() as usize + 1;
-        let count = wanted.clamp(original, MAX_RESAMPLE_FACTOR * original);
-        let step = span / (count - 1) as f64;
-        warnings.push(format!(
-            "{}: uneven gaps between slices ({} mm); resampled {original} slices onto {count} \
-             slices {step:.3} mm apart by linear interpolation along the stack",
-            root.display(),
-            distinct_gaps(&gaps)
-        ));
-        Some((count, step))
-    }
 }
 
 /// Where every frame is, its orientation and pixel spacing, once validated.
@@ -208,21 +165,6 @@ fn place_frames(
             ))
         }
     };
-    for &(file, frame) in frames {
-        if let Some([row, column]) = frame.orientation {
-            if !row.abs_diff_eq(orientation[0], ORIENTATION_TOLERANCE)
-                || !column.abs_diff_eq(orientation[1], ORIENTATION_TOLERANCE)
-            {
-                return Err(differs(
-                    root,
-                    files,
-                    first_file,
-                    file,
-                    "ImageOrientationPatient",
-                ));
-            }
-        }
-    }
     let pixel_spacing = match first.pixel_spacing {
         Some(spacing) => spacing,
         None => {
@@ -343,84 +285,5 @@ fn warn_tilt(root: &Path, stack_direction: DVec3, normal: DVec3, warnings: &mut 
              normal; the grid is kept sheared (not resampled in-plane)",
             root.display()
         ));
-    }
-}
-
-/// The distinct gaps, to 0.01 mm, in order of first appearance: "1.14, 4.22, 7.38".
-fn distinct_gaps(gaps: &[f64]) -> String {
-    let mut seen: Vec<f64> = Vec::new();
-    for gap in gaps {
-        let rounded = (gap * 100.0).round() / 100.0;
-        if !seen.contains(&rounded) {
-            seen.push(rounded);
-        }
-    }
-    seen.iter()
-        .map(|g| format!("{g:.2}"))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// Resamples `source` (slices of `slice_len` voxels at `offsets_mm`) onto `count` slices
-/// `step_mm` apart, each a linear blend of its two neighbouring source slices. The first and
-/// last output slices are the first and last source slices exactly.
-pub(super) fn resample(
-    source: &[u16],
-    slice_len: usize,
-    offsets_mm: &[f64],
-    output: &mut [u16],
-    step_mm: f64,
-) {
-    let last = offsets_mm.len() - 1;
-    output
-        .par_chunks_mut(slice_len)
-        .enumerate()
-        .for_each(|(index, out)| {
-            let at = (index as f64 * step_mm).min(offsets_mm[last]);
-            // The source slice at or before `at`, but never the last (it needs a successor).
-            let below = offsets_mm.partition_point(|&o| o <= at).clamp(1, last) - 1;
-            let (t0, t1) = (offsets_mm[below], offsets_mm[below + 1]);
-            let weight = ((at - t0) / (t1 - t0)).clamp(0.0, 1.0);
-            let a = &source[below * slice_len..(below + 1) * slice_len];
-            let b = &source[(below + 1) * slice_len..(below + 2) * slice_len];
-            blend(a, b, weight, out);
-        });
-}
-
-fn blend(a: &[u16], b: &[u16], weight: f64, out: &mut [u16]) {
-    if weight == 0.0 {
-        out.copy_from_slice(a);
-    } else if weight == 1.0 {
-        out.copy_from_slice(b);
-    } else {
-        // Fixed point (16 fractional bits) keeps the loop on integers.
-        let w = (weight * 65536.0).round() as u32;
-        for ((o, &x), &y) in out.iter_mut().zip(a).zip(b) {
-            let mixed = u32::from(x) * (65536 - w) + u32::from(y) * w;
-            *o = ((mixed + 32768) >> 16) as u16;
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn resampling_keeps_the_ends_and_blends_linearly() {
-        // Three one-voxel slices at 0, 1 and 4 mm holding 0, 100 and 400.
-        let source = [0u16, 100, 400];
-        let offsets = [0.0, 1.0, 4.0];
-        let mut output = [0u16; 5];
-        resample(&source, 1, &offsets, &mut output, 1.0);
-        assert_eq!(output, [0, 100, 200, 300, 400]);
-    }
-
-    #[test]
-    fn distinct_gaps_are_listed_once() {
-        assert_eq!(
-            distinct_gaps(&[1.141, 4.22, 1.139, 7.38]),
-            "1.14, 4.22, 7.38"
-        );
     }
 }

@@ -46,7 +46,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         DataFile::Local => path,
         DataFile::Detached(file) => file.as_path(),
     };
-    let mut data = open_data(path, data_path, &header, count, &mut warnings)?;
+    let mut data = open_data(path, data_path, &header, count, options, &mut warnings)?;
     let (voxels, map) = read_voxels(
         data_path,
         &mut data,
@@ -196,11 +196,15 @@ fn open_data(
     data_path: &Path,
     header: &Header,
     count: usize,
+    options: &OpenOptions,
     warnings: &mut Vec<String>,
 ) -> Result<Data> {
     let (base, file_len) = match header.data_file {
         DataFile::Local => (header.text_bytes, file_len(path)?),
-        DataFile::Detached(_) => (0, detached::data_file_len(path, data_path)?),
+        DataFile::Detached(_) => (
+            0,
+            detached::data_file_len_where(path, data_path, options.allow_outside_data)?,
+        ),
     };
     let file = File::open(data_path).map_err(|e| ReadError::io(data_path, e))?;
     let raw_bytes = count as u64 * header.element.size() as u64;

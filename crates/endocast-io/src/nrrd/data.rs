@@ -12,6 +12,7 @@ use crate::compressed;
 use crate::detached;
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
+use crate::loaded::OpenOptions;
 use crate::samples::{read_voxels, ElementType, Endian, Rescale};
 use endocast_core::ValueMap;
 use flate2::read::MultiGzDecoder;
@@ -40,13 +41,14 @@ pub(super) fn read_samples(
     header: &Header,
     count: usize,
     endian: Endian,
-    limits: &Limits,
+    options: &OpenOptions,
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<u16>, ValueMap)> {
-    let segments = segments(header_path, header, count, limits)?;
+    let segments = segments(header_path, header, count, &options.limits)?;
     for segment in &segments {
         // Name a missing, misplaced or short slice before allocating or reading anything.
-        let len = detached::data_file_len(header_path, &segment.path)?;
+        let len =
+            detached::data_file_len_where(header_path, &segment.path, options.allow_outside_data)?;
         check_holds(segment, header, len)?;
     }
     let mut chain = Chain {

@@ -40,8 +40,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let count = options.limits.check_dims(path, &header.sizes)?;
     let geometry = geometry(path, &header, &axes, &mut warnings)?;
     let endian = endian(path, &header, &mut warnings);
-    let (voxels, map) =
-        data::read_samples(path, &header, count, endian, &options.limits, &mut warnings)?;
+    let (voxels, map) = data::read_samples(path, &header, count, endian, options, &mut warnings)?;
     let volume = Volume::new(geometry, voxels, map, Modality::Unknown)
         .map_err(|e| ReadError::format(path, e.to_string()))?;
     let mut source = SourceInfo::new(Format::Nrrd, stored_type(&header, endian));
