@@ -49,9 +49,21 @@ impl Volume {
 }
 
 /// Reads a scan as every endocast command does: a DICOM directory or file (the largest series,
-/// or `series`), NIfTI, NRRD, MetaImage.
+/// or `series`), NIfTI, NRRD, MetaImage. Keywords as the command's options: `max_voxels`,
+/// `orientation` (for a file that declares none, e.g. "LPI"; a head CT is otherwise turned
+/// upright from its anatomy), `fill_missing_slices` (accept a DICOM series with missing slices,
+/// interpolated and warned), `allow_outside_data` (a detached NRRD/MetaImage data file outside
+/// the header's folder).
 #[pyfunction]
-#[pyo3(signature = (path, series = None, *, max_voxels = None, orientation = None))]
+#[pyo3(signature = (
+    path,
+    series = None,
+    *,
+    max_voxels = None,
+    orientation = None,
+    fill_missing_slices = false,
+    allow_outside_data = false,
+))]
 #[allow(clippy::needless_pass_by_value)] // PyO3 hands arguments over by value.
 pub fn open(
     py: Python<'_>,
@@ -59,6 +71,8 @@ pub fn open(
     series: Option<String>,
     max_voxels: Option<u64>,
     orientation: Option<String>,
+    fill_missing_slices: bool,
+    allow_outside_data: bool,
 ) -> PyResult<Volume> {
     let mut options = OpenOptions::default();
     options.series = series;
@@ -66,6 +80,8 @@ pub fn open(
         options.limits = Limits::with_max_voxels(max);
     }
     options.orientation = orientation;
+    options.fill_missing_slices = fill_missing_slices;
+    options.allow_outside_data = allow_outside_data;
     let loaded = py
         .detach(|| endocast_io::open(&path, &options))
         .map_err(to_py)?;

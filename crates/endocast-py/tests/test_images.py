@@ -111,3 +111,10 @@ def test_help_documents_every_option():
     assert "nibabel" in endocast.as_volume.__doc__
     for function in [endocast.fly, endocast.path, endocast.default_view]:
         assert "preset" in function.__doc__, function.__name__
+
+
+def test_open_takes_the_readers_options(colon):
+    plain = endocast.open(colon)
+    lenient = endocast.open(colon, fill_missing_slices=True, allow_outside_data=True)
+    np.testing.assert_array_equal(plain.voxels, lenient.voxels)
+    assert "fill_missing_slices" in endocast.open.__doc__

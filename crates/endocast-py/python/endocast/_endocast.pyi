@@ -75,6 +75,8 @@ def open(
     *,
     max_voxels: Optional[int] = None,
     orientation: Optional[str] = None,
+    fill_missing_slices: bool = False,
+    allow_outside_data: bool = False,
 ) -> Volume:
     """Read a DICOM directory or file, NIfTI, NRRD or MetaImage scan."""
 
