@@ -6,16 +6,23 @@ use numpy::{PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-/// Writes an RGB or RGBA uint8 image (height, width, 3 or 4) to `path` as an 8-bit PNG.
+/// Writes an RGB or RGBA uint8 image (height, width, 3 or 4) to `path` as an 8-bit PNG; any
+/// view of one (`rgba[..., :3]`) will do.
 #[pyfunction]
 #[allow(clippy::needless_pass_by_value)] // PyO3 hands arguments over by value.
 pub fn save_png(path: PathBuf, image: PyReadonlyArray3<'_, u8>) -> PyResult<()> {
     let &[height, width, channels] = image.shape() else {
         return Err(error("the image must have 3 dimensions"));
     };
-    let pixels = image.as_slice().map_err(|_| {
-        error("the image must be C-contiguous (numpy.ascontiguousarray makes it so)")
-    })?;
+    // A view (`rgba[..., :3]`, a transposed or flipped image) is copied into row order.
+    let owned;
+    let pixels = match image.as_slice() {
+        Ok(pixels) => pixels,
+        Err(_) => {
+            owned = image.as_array().iter().copied().collect::<Vec<u8>>();
+            &owned
+        }
+    };
     let (w, h) = (width as u32, height as u32);
     match channels {
         3 => endocast_io::write_png_rgb8(&path, w, h, pixels),

@@ -118,3 +118,12 @@ def test_open_takes_the_readers_options(colon):
     lenient = endocast.open(colon, fill_missing_slices=True, allow_outside_data=True)
     np.testing.assert_array_equal(plain.voxels, lenient.voxels)
     assert "fill_missing_slices" in endocast.open.__doc__
+
+
+def test_save_png_takes_a_view_of_the_image(colon, tmp_path):
+    rgba, _ = endocast.render(endocast.open(colon), size=(24, 16))
+    out = tmp_path / "view.png"
+    endocast.save_png(out, rgba[..., :3])
+    np.testing.assert_array_equal(read_png_rgb(out), rgba[..., :3])
+    endocast.save_png(out, rgba[::-1, :, :3])
+    np.testing.assert_array_equal(read_png_rgb(out), rgba[::-1, :, :3])
