@@ -333,7 +333,8 @@ fn stated_step(
 /// `frames` one frame per slice (frame `k` is tile `k`), placed as dcm2niix places them
 /// ([`Mosaic::first_position`], then along the slice normal at [`stated_step`]). Returns the
 /// tiling and the warning that says how; `None` for any other image. Refuses a mosaic whose
-/// slice count, position or orientation is missing, or whose tiles do not fit the image.
+/// slice count, position or orientation is missing, of several frames, or whose tiles do not
+/// fit the image.
 fn unpack_mosaic(
     path: &Path,
     object: &InMemDicomObject,
@@ -363,6 +364,9 @@ fn unpack_mosaic(
     let (Some(position), Some(orientation)) = (first.position, first.orientation) else {
         return Err(refuse("ImagePositionPatient and ImageOrientationPatient"));
     };
+    if frames.len() > 1 {
+        return Err(refuse("a single frame (it has several: NumberOfFrames)"));
+    }
     let mosaic = Mosaic::new(path, [layout.rows, layout.columns], count, count_source)?;
     let spacing = first.pixel_spacing.unwrap_or([1.0, 1.0]);
     let start = mosaic.first_position(position, orientation, spacing);
