@@ -6,7 +6,8 @@ use crate::common::{endocast, hit_share};
 use endocast_testdata::shared_data;
 use std::path::Path;
 
-/// Shared scans that hold a volume (dicom-transfer-syntaxes holds one 2D slice per file).
+/// Shared scans that hold a volume (not dicom-transfer-syntaxes, whose files are the same small
+/// 64 × 64 × 35 EPI mosaic in nine encodings, for the decoders).
 const SCANS: [&str; 10] = [
     "abdomen-ct-pancreas-dicom",
     "aorta-stent-cta/stent.nrrd",

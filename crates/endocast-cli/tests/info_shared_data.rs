@@ -95,8 +95,8 @@ const EXPECTED: &[Expected] = &[
     },
     Expected {
         path: "dicom-transfer-syntaxes/1.dcm",
-        dims: [384, 384, 1],
-        spacing_mm: [0.0, 0.0, 0.0],
+        dims: [64, 64, 35],
+        spacing_mm: [3.25, 3.25, 3.6],
         min: (0.0, 0.0),
         max: (2362.0, 0.0),
     },

@@ -13,7 +13,8 @@ Analyze), each file put in one class:
 - endocast only: endocast reads a file its peer cannot decode;
 - differs with a warning: values or geometry differ and endocast said why, or endocast reads
   the file by a stated convention and said so (MONOCHROME1 inverted so that bright is high; the
-  first of several NIfTI volumes; a Siemens mosaic read as its one tiled image, not unpacked);
+  first of several NIfTI volumes); a Siemens mosaic is compared unpacked, as nibabel's
+  MosaicWrapper unpacks it;
 - and the two that must stay empty: refused although the peer reads a grey-scale image, and
   differs without a warning.
 
@@ -98,8 +99,8 @@ def frame_attribute(ds, frame, sequence, keyword):
 def pydicom_frames(path):
     """(frames as float64 [frame, row, column], [per frame: position or None], row cosine,
     column cosine, (row spacing, column spacing) or None, pixel padding mask or None, the word
-    endocast's warning must contain (MONOCHROME1 inverted, mosaic not unpacked) or None, the
-    tolerance of a lossy JPEG decoder)."""
+    endocast's warning must contain (MONOCHROME1 inverted) or None, the tolerance of a lossy
+    JPEG decoder). A Siemens mosaic gives its slices, as nibabel unpacks them."""
     import pydicom
     from pydicom.pixels import apply_modality_lut
 
@@ -117,8 +118,9 @@ def pydicom_frames(path):
                 raise NotGreyscale(f"{ds.get('SamplesPerPixel')} samples, {bits} bits")
             raw = ds.pixel_array
             said = None
+            mosaic_positions = None
             if "MOSAIC" in ds.get("ImageType", []):
-                said = "mosaic"  # read as the one tiled image it is stored as, warned
+                raw, mosaic_positions = unpack_mosaic(ds, raw)
             inverted = kind[1] == "MONOCHROME1" and kind[0] != "CT"
             if inverted:
                 said = "MONOCHROME1"
@@ -128,7 +130,7 @@ def pydicom_frames(path):
         raise
     except Exception as e:  # noqa: BLE001 - any peer failure means "the peer cannot"
         raise PeerCannot(f"{type(e).__name__}: {e}") from e
-    frames = raw.reshape((-1, ds.Rows, ds.Columns))
+    frames = raw.reshape((-1, *raw.shape[-2:]))
     values = np.empty(frames.shape, np.float64)
     for f, frame in enumerate(frames):
         slope = frame_attribute(ds, f, "PixelValueTransformationSequence", "RescaleSlope")
@@ -137,8 +139,8 @@ def pydicom_frames(path):
             values[f] = apply_modality_lut(frame, ds)
         else:
             values[f] = frame * float(slope) + float(intercept or 0.0)
-    positions = []
-    for f in range(len(frames)):
+    positions = mosaic_positions or []
+    for f in range(len(positions), len(frames)):
         ipp = frame_attribute(ds, f, "PlanePositionSequence", "ImagePositionPatient")
         positions.append(None if not ipp else np.array([float(v) for v in ipp]))
     iop = frame_attribute(ds, 0, "PlaneOrientationSequence", "ImageOrientationPatient")
@@ -157,6 +159,21 @@ def pydicom_frames(path):
     if ds.file_meta.get("TransferSyntaxUID") in LOSSY_JPEG:
         unit = abs(float(frame_attribute(ds, 0, "PixelValueTransformationSequence", "RescaleSlope") or 1))
     return values, positions, cosines, spacing, padding, said, unit
+
+
+def unpack_mosaic(ds, raw):
+    """The slices of a Siemens mosaic [slice, row, column] and their positions, as nibabel's
+    MosaicWrapper gives them (its count, first position, normal and spacing)."""
+    from nibabel.nicom.dicomwrappers import MosaicWrapper
+
+    wrapper = MosaicWrapper(ds)
+    count = wrapper.n_mosaic
+    side = int(np.ceil(np.sqrt(count)))
+    rows, columns = ds.Rows // side, ds.Columns // side
+    tiles = raw.reshape(side, rows, side, columns).transpose(0, 2, 1, 3)
+    affine = wrapper.affine  # DICOM patient (LPS) mm; column 2 is the step between slices
+    positions = [affine[:3, 3] + k * affine[:3, 2] for k in range(count)]
+    return tiles.reshape(-1, rows, columns)[:count], positions
 
 
 def invert_monochrome1(raw, ds):
@@ -283,7 +300,7 @@ def classify(path):
 
 def expected_warning(peer, is_nifti):
     """What endocast must say about a file it reads differently by convention: the first of
-    several NIfTI volumes, MONOCHROME1 inverted, a Siemens mosaic not unpacked."""
+    several NIfTI volumes, MONOCHROME1 inverted."""
     if is_nifti:
         return "volume" if peer[0].ndim > 3 and np.prod(peer[0].shape[3:]) > 1 else None
     return peer[5]

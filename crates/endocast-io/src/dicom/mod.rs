@@ -36,8 +36,13 @@
 //! - A multi-frame file whose frames carry no position of their own (or all the same one) is
 //!   stacked in file order along the slice normal at SpacingBetweenSlices, else
 //!   SliceThickness, else 1 mm, with a warning that says which (pydicom and nibabel keep such
-//!   frames in file order too). A Siemens mosaic (ImageType MOSAIC) is read as the one tiled
-//!   image it is stored as (not unpacked), with a warning that says so.
+//!   frames in file order too). A Siemens mosaic (ImageType MOSAIC) is unpacked
+//!   (`mosaic`, as dcm2niix and nibabel do): NumberOfImagesInMosaic slices (from (0019,100A),
+//!   else the CSA image header (0029,1010), else refused), tiled row by row in
+//!   `ceil(sqrt(N))` tiles a side; the first slice lies half the difference between the
+//!   image and a tile from the stored ImagePositionPatient, the others along the CSA
+//!   SliceNormalVector (else row × column cosine) at SpacingBetweenSlices, else
+//!   SliceThickness; a warning says which.
 //! - Only the main stack is read: the largest group of images sharing an orientation and a
 //!   size (`planes`). Images in another plane or of another size (a localiser) are set aside,
 //!   named in a warning.
@@ -62,12 +67,14 @@
 //! PixelPaddingValue voxels take the lowest real value of the series (warned). MONOCHROME1 is
 //! inverted so that bright means high, except for CT, whose Hounsfield units are kept.
 
+mod csa;
 mod frame;
 mod grid;
 mod jpeg12;
 mod jpegls;
 mod lengths;
 mod lut;
+mod mosaic;
 mod open;
 mod overlay;
 mod pixels;
@@ -85,6 +92,7 @@ use crate::error::{ReadError, Result};
 use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::progress::{Progress, ReadStep};
 use endocast_core::{Modality, Volume};
+use mosaic::Mosaic;
 use pixels::{FrameStats, SampleMap};
 use rayon::prelude::*;
 use scan::ImageFile;
@@ -217,7 +225,10 @@ fn decode_all(
                 .into_iter()
                 .map(|(k, frame, slot)| (k, (frame, slot)))
                 .unzip();
-            let (stats, padded) = pixels::decode_file(&files[file], ts_names[file], slots, map)?;
+            let (stats, padded) = match &files[file].mosaic {
+                Some(mosaic) => decode_mosaic(&files[file], mosaic, ts_names[file], slots, map)?,
+                None => pixels::decode_file(&files[file], ts_names[file], slots, map)?,
+            };
             progress.advance();
             Ok((ks.into_iter().zip(stats).collect::<Vec<_>>(), padded))
         })
@@ -231,6 +242,35 @@ fn decode_all(
         }
     }
     Ok((stats.into_iter().flatten().collect(), padded))
+}
+
+/// Decodes the one tiled image of a mosaic and copies each `(tile, slot)` into its slot, as
+/// [`pixels::decode_file`] does for the frames of other files.
+fn decode_mosaic(
+    file: &ImageFile,
+    mosaic: &Mosaic,
+    ts_name: &str,
+    tiles: Vec<(u32, &mut [u16])>,
+    map: &SampleMap,
+) -> Result<(Vec<FrameStats>, Option<String>)> {
+    let mut stored = file.clone();
+    [stored.layout.rows, stored.layout.columns] = mosaic.stored;
+    stored.frames.truncate(1);
+    let mut whole = vec![0u16; mosaic.stored_len()];
+    let (_, padded) = pixels::decode_file(&stored, ts_name, vec![(0, &mut whole)], map)?;
+    let stats = tiles
+        .into_iter()
+        .map(|(tile, slot)| {
+            mosaic.copy_tile(&whole, tile, slot).ok_or_else(|| {
+                ReadError::format(
+                    &file.path,
+                    format!("mosaic tile {tile} does not fit the tiled image"),
+                )
+            })?;
+            Ok(map.measure(slot))
+        })
+        .collect::<Result<_>>()?;
+    Ok((stats, padded))
 }
 
 /// Whether to invert MONOCHROME1 samples (minimum is white): yes, so that bright means high,

@@ -108,11 +108,17 @@ impl SampleMap {
 
     /// Maps `words` into `out` and measures the result.
     fn convert(&self, words: impl Iterator<Item = u16>, out: &mut [u16]) -> FrameStats {
+        for (slot, word) in out.iter_mut().zip(words) {
+            *slot = self.table[usize::from(word)];
+        }
+        self.measure(out)
+    }
+
+    /// The statistics of mapped `voxels`.
+    pub(super) fn measure(&self, voxels: &[u16]) -> FrameStats {
         let mut stats = FrameStats::EMPTY;
         let padding = self.padding.map_or(u32::MAX, u32::from);
-        for (slot, word) in out.iter_mut().zip(words) {
-            let value = self.table[usize::from(word)];
-            *slot = value;
+        for &value in voxels {
             if u32::from(value) == padding {
                 stats.padding += 1;
             } else {

@@ -1,8 +1,10 @@
 //! Finding DICOM files and reading their headers (everything before the pixel data), in
 //! parallel, into plain structs the later stages can reason about without the DICOM object.
 
+use super::csa;
 use super::lengths;
 use super::lut::ModalityLut;
+use super::mosaic::Mosaic;
 use super::open::{self, Body};
 use crate::error::{ReadError, Result};
 use crate::limits::Limits;
@@ -82,6 +84,9 @@ pub(super) struct ImageFile {
     pub frames: Vec<FrameHeader>,
     /// Warnings about what the header left unsaid and the reader assumed.
     pub notes: Vec<String>,
+    /// For a Siemens mosaic, how its slices are tiled in the stored image (`layout` and
+    /// `frames` then describe the slices, one frame per tile).
+    pub mosaic: Option<Mosaic>,
 }
 
 /// How samples are stored; must be the same for every file of a series.
@@ -215,7 +220,7 @@ fn image_file(
     }
     let bits_stored = integer(object, tags::BITS_STORED).unwrap_or(0u16);
     let signed = integer::<u16>(object, tags::PIXEL_REPRESENTATION) == Some(1);
-    let layout = PixelLayout {
+    let mut layout = PixelLayout {
         rows,
         columns,
         samples_per_pixel: integer(object, tags::SAMPLES_PER_PIXEL).unwrap_or(1),
@@ -233,10 +238,14 @@ fn image_file(
     let mut frames = (0..frame_count)
         .map(|frame| frame_header(path, object, frame))
         .collect::<Result<Vec<_>>>()?;
-    let notes = mosaic_note(path, object)
+    let mut notes: Vec<String> = stack_unplaced_frames(path, object, &mut frames)?
         .into_iter()
-        .chain(stack_unplaced_frames(path, object, &mut frames)?)
         .collect();
+    let mosaic = unpack_mosaic(path, object, &mut layout, &mut frames)?.map(|(mosaic, note)| {
+        notes.push(note);
+        mosaic
+    });
+    limits.check_slices(path, frames.len() as u64)?;
     if layout.modality_lut.is_some() {
         // The LUT's outputs are the values (PS3.3 C.11.1: a LUT or a rescale, never both).
         for frame in &mut frames {
@@ -253,6 +262,7 @@ fn image_file(
         layout,
         frames,
         notes,
+        mosaic,
     }))
 }
 
@@ -273,22 +283,7 @@ fn stack_unplaced_frames(
     }
     let orientation = first.orientation.unwrap_or([DVec3::X, DVec3::Y]);
     let normal = orientation[0].cross(orientation[1]);
-    let between = floats(
-        path,
-        "SpacingBetweenSlices",
-        object,
-        tags::SPACING_BETWEEN_SLICES,
-    )?
-    .and_then(|v| v.first().map(|s| s.abs()));
-    let positive = |v: &f64| v.is_finite() && *v > 0.0;
-    let (step, source) = match (between.filter(positive), first.thickness.filter(positive)) {
-        (Some(step), _) => (step, "SpacingBetweenSlices"),
-        (None, Some(step)) => (step, "SliceThickness"),
-        (None, None) => (
-            1.0,
-            "nothing (no SpacingBetweenSlices or SliceThickness): 1 mm assumed",
-        ),
-    };
+    let (step, source) = stated_step(path, object, first.thickness)?;
     let origin = first.position.unwrap_or(DVec3::ZERO);
     for (k, frame) in frames.iter_mut().enumerate() {
         frame.position = Some(origin + normal * (step * k as f64));
@@ -307,25 +302,155 @@ fn stack_unplaced_frames(
     )))
 }
 
-/// The warning for a Siemens mosaic (ImageType MOSAIC), which tiles the slices of a volume in
-/// one image: it is read as that one image (as pydicom reads it), not unpacked, and the
-/// warning says so; `None` for any other image.
-fn mosaic_note(path: &Path, object: &InMemDicomObject) -> Option<String> {
+/// The step between slices the header states, with the field it comes from:
+/// SpacingBetweenSlices, else SliceThickness (`thickness`), else 1 mm.
+fn stated_step(
+    path: &Path,
+    object: &InMemDicomObject,
+    thickness: Option<f64>,
+) -> Result<(f64, &'static str)> {
+    let between = floats(
+        path,
+        "SpacingBetweenSlices",
+        object,
+        tags::SPACING_BETWEEN_SLICES,
+    )?
+    .and_then(|v| v.first().map(|s| s.abs()));
+    let positive = |v: &f64| v.is_finite() && *v > 0.0;
+    Ok(
+        match (between.filter(positive), thickness.filter(positive)) {
+            (Some(step), _) => (step, "SpacingBetweenSlices"),
+            (None, Some(step)) => (step, "SliceThickness"),
+            (None, None) => (
+                1.0,
+                "nothing (no SpacingBetweenSlices or SliceThickness): 1 mm assumed",
+            ),
+        },
+    )
+}
+
+/// A Siemens mosaic (ImageType MOSAIC) is unpacked: `layout` becomes that of one tile and
+/// `frames` one frame per slice (frame `k` is tile `k`), placed as dcm2niix places them
+/// ([`Mosaic::first_position`], then along the slice normal at [`stated_step`]). Returns the
+/// tiling and the warning that says how; `None` for any other image. Refuses a mosaic whose
+/// slice count, position or orientation is missing, of several frames, or whose tiles do not
+/// fit the image.
+fn unpack_mosaic(
+    path: &Path,
+    object: &InMemDicomObject,
+    layout: &mut PixelLayout,
+    frames: &mut Vec<FrameHeader>,
+) -> Result<Option<(Mosaic, String)>> {
     let image_type = text(object, tags::IMAGE_TYPE).to_ascii_uppercase();
     if !image_type.split('\\').any(|value| value.trim() == "MOSAIC") {
+        return Ok(None);
+    }
+    let refuse = |what: &str| {
+        ReadError::format(
+            path,
+            format!(
+                "a Siemens mosaic (ImageType {image_type}) without {what}: its slices cannot \
+                 be unpacked; convert it with the scanner's software or dcm2niix"
+            ),
+        )
+    };
+    let (count, count_source) = mosaic_count(object).ok_or_else(|| {
+        refuse(
+            "NumberOfImagesInMosaic (neither (0019,100A) of the SIEMENS MR HEADER block nor \
+             the CSA image header (0029,1010) gives it)",
+        )
+    })?;
+    let first = frames[0];
+    let (Some(position), Some(orientation)) = (first.position, first.orientation) else {
+        return Err(refuse("ImagePositionPatient and ImageOrientationPatient"));
+    };
+    if frames.len() > 1 {
+        return Err(refuse("a single frame (it has several: NumberOfFrames)"));
+    }
+    let mosaic = Mosaic::new(path, [layout.rows, layout.columns], count, count_source)?;
+    let spacing = first.pixel_spacing.unwrap_or([1.0, 1.0]);
+    let start = mosaic.first_position(position, orientation, spacing);
+    let (normal, normal_source) = mosaic_normal(object, orientation);
+    let (step, step_source) = stated_step(path, object, first.thickness)?;
+    *frames = (0..count)
+        .map(|k| FrameHeader {
+            frame: u32::from(k),
+            position: Some(start + normal * (step * f64::from(k))),
+            ..first
+        })
+        .collect();
+    [layout.rows, layout.columns] = mosaic.tile;
+    let [rows, columns] = mosaic.tile;
+    let note = format!(
+        "{}: a Siemens mosaic (ImageType {image_type}) unpacked into {count} slices of {rows} \
+         rows × {columns} columns ({side} × {side} tiles; the count from {count_source}): the \
+         first slice placed at the centre of the tiled image (as dcm2niix does), the others \
+         {step} mm apart (from {step_source}) along {normal_source}",
+        path.display(),
+        side = mosaic.per_side,
+    );
+    Ok(Some((mosaic, note)))
+}
+
+/// NumberOfImagesInMosaic and where it was found: the SIEMENS MR HEADER's (0019,100A), else
+/// the CSA image header's field.
+fn mosaic_count(object: &InMemDicomObject) -> Option<(u16, &'static str)> {
+    let siemens = text(object, Tag(0x0019, 0x0010)) == "SIEMENS MR HEADER";
+    let tag = Tag(0x0019, 0x100A);
+    let stored = object
+        .get(tag)
+        .filter(|_| siemens)
+        .and_then(|element| match element.vr() {
+            // Implicit VR: the two bytes of the US it is.
+            VR::UN => Some(u16::from_le_bytes(
+                element.to_bytes().ok()?.as_ref().try_into().ok()?,
+            )),
+            _ => integer(object, tag),
+        });
+    let csa = || {
+        csa_field(object, "NumberOfImagesInMosaic")?
+            .first()?
+            .parse()
+            .ok()
+    };
+    match stored {
+        Some(count) => Some((count, "NumberOfImagesInMosaic (0019,100A)")),
+        None => csa().map(|count| (count, "the CSA image header (0029,1010)")),
+    }
+}
+
+/// The slice normal of a mosaic and where it came from: the CSA image header's
+/// SliceNormalVector when it is a unit vector along ± the row × column cosine (it says which
+/// way the slices run), else that cross product.
+fn mosaic_normal(object: &InMemDicomObject, [row, column]: [DVec3; 2]) -> (DVec3, &'static str) {
+    let cross = row.cross(column);
+    let csa = csa_field(object, "SliceNormalVector").and_then(|values| {
+        let numbers: Vec<f64> = values
+            .iter()
+            .map(|v| v.parse().ok())
+            .collect::<Option<_>>()?;
+        let [x, y, z] = numbers[..] else { return None };
+        let normal = DVec3::new(x, y, z);
+        let unit = normal.is_finite() && (normal.length() - 1.0).abs() < 1e-2;
+        (unit && normal.dot(cross).abs() > 1.0 - 1e-3).then(|| normal.normalize())
+    });
+    match csa {
+        Some(normal) => (normal, "the CSA image header's SliceNormalVector"),
+        None => (
+            cross,
+            "the row × column cosine (no usable SliceNormalVector in a CSA image header)",
+        ),
+    }
+}
+
+/// The items of field `name` of the CSA image header (0029,1010), when the SIEMENS CSA HEADER
+/// block holds one that parses.
+fn csa_field(object: &InMemDicomObject, name: &str) -> Option<Vec<String>> {
+    if text(object, Tag(0x0029, 0x0010)) != "SIEMENS CSA HEADER" {
         return None;
     }
-    // NumberOfImagesInMosaic, when the Siemens private block (0019,0010) names it.
-    let siemens = text(object, Tag(0x0019, 0x0010)) == "SIEMENS MR HEADER";
-    let count = integer::<u32>(object, Tag(0x0019, 0x100A))
-        .filter(|_| siemens)
-        .map_or_else(String::new, |n| format!(" of {n} slices"));
-    Some(format!(
-        "{}: a Siemens mosaic{count} (ImageType {image_type}): its slices are tiled in this one \
-         image, which this reader does not unpack, so the volume is the tiled image, not the \
-         3-D scan; convert it first (e.g. dcm2niix to NIfTI) to measure or render the scan",
-        path.display()
-    ))
+    let bytes = object.get(Tag(0x0029, 0x1010))?.to_bytes().ok()?;
+    csa::field(&bytes, name)
 }
 
 /// PixelPaddingValue as the raw sample it marks. Implicit VR files give no VR, so a signed
