@@ -13,7 +13,7 @@ use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::StereoRig;
-use endocast_core::look::{self, Look, RayPass, Shading};
+use endocast_core::look::{self, Look, RayPass, RayPassSettings, Shading};
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::quality::reduced_camera;
@@ -460,15 +460,14 @@ fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
     }
 }
 
-/// Refuses `--size` before anything is allocated where the heaviest of the benchmark's renders (a
-/// plain frame, a look, a stereo pair) would take more memory than the limits allow ([`Limits::check_frames`]).
+/// Refuses `--size` before anything is allocated where any of the benchmark's renders (a plain
+/// frame, a look, a stereo pair) would take more memory than the limits allow
+/// ([`Limits::check_frames`]).
 fn check_size(size: [usize; 2]) -> Result<()> {
     let limits = Limits::default();
-    for kind in [
-        RenderKind::Plain(Layers::NONE),
-        RenderKind::Look,
-        RenderKind::Stereo,
-    ] {
+    // The look without secretion, whose ray pass renders the most layers.
+    let look = RenderKind::Look(RayPassSettings::default().traced_layers());
+    for kind in [RenderKind::Plain(Layers::NONE), look, RenderKind::Stereo] {
         limits
             .check_frames(Path::new("--size"), size, kind, 1)
             .context("the image is too large")?;
