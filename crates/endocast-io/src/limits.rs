@@ -178,7 +178,9 @@ pub enum RenderKind {
     /// optional layers.
     Plain(Layers),
     /// A two-stage look (clinical, realistic): its ray pass renders frames with these layers
-    /// ([`traced_layers`](endocast_core::look::RayPassSettings::traced_layers)), which become a G-buffer shaded into a frame.
+    /// ([`RayPassSettings::traced_layers`]), which become a G-buffer shaded into a frame.
+    ///
+    /// [`RayPassSettings::traced_layers`]: endocast_core::look::RayPassSettings::traced_layers
     Look(Layers),
     /// A stereo pair of the plain look, written as one image or two.
     Stereo,
