@@ -3,9 +3,8 @@
 use crate::parse::{parse_dims, parse_spacing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::render::Layers;
 use endocast_io::raw::RawSpec;
-use endocast_io::{ElementType, Endian, Limits, Loaded, OpenOptions};
+use endocast_io::{ElementType, Endian, Limits, Loaded, OpenOptions, RenderKind};
 use std::path::{Path, PathBuf};
 
 /// How to read the input scan.
@@ -54,11 +53,17 @@ impl InputArgs {
             .map_or_else(Limits::default, Limits::with_max_voxels)
     }
 
-    /// Refuses before anything is read or rendered when `frames` frames of `size` for `output`
-    /// would take more memory than the limits allow.
-    pub fn check_frames(&self, output: &Path, size: [usize; 2], frames: u64) -> Result<()> {
+    /// Refuses before the frames are allocated when `frames` views of `size` for `output`,
+    /// rendered as `kind` says, would take more memory than the limits allow.
+    pub fn check_frames(
+        &self,
+        output: &Path,
+        size: [usize; 2],
+        kind: RenderKind,
+        frames: u64,
+    ) -> Result<()> {
         self.limits()
-            .check_frames(output, size, Layers::NONE, frames)
+            .check_frames(output, size, kind, frames)
             .context("the image is too large")?;
         Ok(())
     }

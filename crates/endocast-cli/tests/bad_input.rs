@@ -79,6 +79,21 @@ fn absurd_parameters() {
 #[test]
 #[cfg(target_os = "linux")]
 fn a_huge_render_under_an_address_space_limit_is_refused_cleanly() {
+    refused_under_4_gib("14000×14000", &["--size", "14000x14000"]);
+}
+
+/// Issue 32: the memory a look takes is checked once the look is known, before its buffers
+/// are: a 3000² clinical view, whose plain frames would fit in a quarter of 4 GiB, is refused.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_look_too_large_for_the_memory_is_refused_before_rendering() {
+    refused_under_4_gib("3000×3000", &["--size", "3000x3000", "--look", "clinical"]);
+}
+
+/// Renders an 8³ scan with `options` under a 4 GiB address-space limit and checks that it is
+/// refused cleanly, the error naming `size` and the limit, and no image written.
+#[cfg(target_os = "linux")]
+fn refused_under_4_gib(size: &str, options: &[&str]) {
     if std::process::Command::new("prlimit")
         .arg("--version")
         .output()
@@ -94,14 +109,15 @@ fn a_huge_render_under_an_address_space_limit_is_refused_cleanly() {
     let out = std::process::Command::new("prlimit")
         .args(["--as=4294967296", "--", env!("CARGO_BIN_EXE_endocast")])
         .args(["render", raw.to_str().unwrap(), "--raw-dims", "8,8,8"])
-        .args(["--size", "14000x14000", "-o", png.to_str().unwrap()])
+        .args(options)
+        .args(["-o", png.to_str().unwrap()])
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(
-        stderr.contains("14000×14000") && stderr.contains("limit"),
+        stderr.contains(size) && stderr.contains("limit"),
         "{stderr}"
     );
     assert!(!png.exists());

@@ -50,7 +50,7 @@ pub use escape::escape;
 pub use image_out::{
     write_image_rgb8, write_jpeg_rgb8, write_npy_f32, write_png_rgb8, write_png_rgba8, ImageFormat,
 };
-pub use limits::Limits;
+pub use limits::{Limits, RenderKind};
 pub use loaded::{Format, Loaded, OpenOptions, SeriesSummary, SourceInfo};
 pub use open::{open, write};
 pub use progress::{Progress, ReadProgress, ReadStep};

@@ -1,7 +1,9 @@
 //! Resource limits checked before any allocation a header (or an image size) asks for.
 
 use crate::error::{ReadError, Result};
-use endocast_core::render::{Frame, Layers};
+use endocast_core::look::{GBuffer, Look};
+use endocast_core::render::{Frame, Layers, StereoFrames};
+use endocast_core::views::Image;
 use std::path::Path;
 
 /// Caps on what a header or an option may make us allocate. A file that claims more is refused
@@ -34,7 +36,13 @@ pub const THREADS_PER_CORE: usize = 8;
 
 impl Default for Limits {
     fn default() -> Self {
-        let memory = memory_bytes().unwrap_or(1 << 32);
+        Self::for_memory(memory_bytes().unwrap_or(1 << 32))
+    }
+}
+
+impl Limits {
+    /// The default limits for a process that may use `memory` bytes (see [`Limits`]).
+    pub fn for_memory(memory: u64) -> Self {
         let cores = std::thread::available_parallelism().map_or(1, usize::from);
         Self {
             max_voxels: memory / 4,
@@ -56,8 +64,7 @@ impl Limits {
     /// The most pixels a single plain still may have under [`Limits::max_frame_bytes`] (what
     /// [`Limits::check_frames`] allows for one frame without extra layers).
     pub fn max_image_pixels(&self) -> u64 {
-        let per_pixel = view_bytes([1, 1], Layers::NONE).unwrap_or(u64::MAX).max(1);
-        self.max_frame_bytes / per_pixel
+        self.max_frame_bytes / RenderKind::Plain(Layers::NONE).bytes_per_pixel()
     }
 
     /// Limits allowing at most `max_voxels` voxels (and the default slice count).
@@ -99,18 +106,21 @@ impl Limits {
         Ok(())
     }
 
-    /// Refuses `frames` rendered frames of `[width, height]` pixels with `layers` (e.g. two
-    /// for a stereo pair) when rendering and writing them would take more than
-    /// [`Limits::max_frame_bytes`] ([`view_bytes`] each); `path` is the output they are for.
-    /// Returns the bytes.
+    /// Refuses `frames` views of `[width, height]` pixels rendered as `kind` says (e.g. a view
+    /// and a dashboard) when rendering and writing them would take more than
+    /// [`Limits::max_frame_bytes`] ([`RenderKind::bytes_per_pixel`] each); `path` is the
+    /// output they are for. Returns the bytes.
     pub fn check_frames(
         &self,
         path: &Path,
         [width, height]: [usize; 2],
-        layers: Layers,
+        kind: RenderKind,
         frames: u64,
     ) -> Result<u64> {
-        let bytes = view_bytes([width, height], layers).and_then(|b| b.checked_mul(frames));
+        let bytes = (width as u64)
+            .checked_mul(height as u64)
+            .and_then(|pixels| pixels.checked_mul(kind.bytes_per_pixel()))
+            .and_then(|b| b.checked_mul(frames));
         let requested = bytes.unwrap_or(u64::MAX);
         if requested > self.max_frame_bytes {
             let count = match frames {
@@ -161,24 +171,94 @@ impl Limits {
     }
 }
 
-/// What one view takes, bytes a pixel, at the peak of rendering and writing it, besides the
-/// float buffers of its frame ([`Frame::bytes_for`], counted three times: a still's frame being
-/// rendered, its running mean and the copy handed out), whatever the look: the look's G-buffer,
-/// its smoothed copy and the smoothing's planes (80), the 8-bit image and the encoder's copy
-/// of it (8).
-///
-/// Measured (peak resident memory of `endocast render`, 1000² to 4000² pixels): 76 bytes a
-/// pixel for the plain look, 81 for the realistic, 142 for the clinical; the estimate, with a
-/// plain frame's 24 bytes, is 160.
-const VIEW_BYTES_PER_PIXEL: u64 = 88;
+/// What a command renders, as far as its memory goes (see [`RenderKind::bytes_per_pixel`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RenderKind {
+    /// The plain look, in any mode and with any `--still` count, its frames holding these
+    /// optional layers.
+    Plain(Layers),
+    /// A two-stage look (clinical, realistic): its ray pass renders frames with these layers
+    /// ([`RayPassSettings::traced_layers`]), which become a G-buffer shaded into a frame.
+    ///
+    /// [`RayPassSettings::traced_layers`]: endocast_core::look::RayPassSettings::traced_layers
+    Look(Layers),
+    /// A stereo pair of the plain look, written as one image or two.
+    Stereo,
+}
 
-/// The memory one view of `[width, height]` pixels with `layers` takes at its peak (see
-/// [`VIEW_BYTES_PER_PIXEL`]); `None` when it overflows.
-fn view_bytes([width, height]: [usize; 2], layers: Layers) -> Option<u64> {
-    let pixels = (width as u64).checked_mul(height as u64)?;
-    Frame::bytes_for([width, height], layers)?
-        .checked_mul(3)?
-        .checked_add(pixels.checked_mul(VIEW_BYTES_PER_PIXEL)?)
+/// The bytes the PNG or JPEG encoder holds a pixel of the image it writes: its filtered copy
+/// and the compressed stream (at most the image's size).
+pub const ENCODER_BYTES_PER_PIXEL: u64 = 2 * Image::BYTES_PER_PIXEL as u64;
+
+/// What [`RenderKind::bytes_per_pixel`] adds for the buffers kept per thread or per row
+/// (tiles' rows, the smoothing's bands): under a byte a pixel measured at 2000² and more.
+pub const MARGIN_BYTES_PER_PIXEL: u64 = 4;
+
+impl RenderKind {
+    /// The kind of a view drawn with a two-stage `look`, or else a stereo pair (`stereo`), or
+    /// else the plain look without optional layers.
+    pub fn of(look: Option<&Look>, stereo: bool) -> Self {
+        match (look, stereo) {
+            (Some(look), _) => Self::Look(look.ray.traced_layers()),
+            (None, true) => Self::Stereo,
+            (None, false) => Self::Plain(Layers::NONE),
+        }
+    }
+
+    /// The bytes a pixel of the view takes at the peak of rendering and writing it, from the
+    /// buffers' sizes (a single still is rendered as a still of one frame, so its running mean
+    /// is counted whatever the `--still` count), and [`MARGIN_BYTES_PER_PIXEL`]:
+    /// - plain: a frame being rendered ([`Frame::rendering_bytes_per_pixel`]) beside the
+    ///   still's mean, or the last frame, the mean and the copy handed out;
+    /// - look: beside the still's mean, a pass's frame being rendered, or that frame with the
+    ///   hit positions, normals and secretion the search beyond secretion adds, or the
+    ///   G-buffer and its shaded frame;
+    /// - stereo: the left eye's frame beside the right one being rendered and the start-up
+    ///   the right eye reuses, or both frames, their 8-bit images and the combined image (side
+    ///   by side: two) with the encoder's copies;
+    ///
+    /// and for every kind at least the frame, its 8-bit image and the encoder's copies. After
+    /// a render with optional layers, the tiles' memory (two small blocks a tile) is counted as
+    /// still held: the allocator was measured to keep most of it (a 4000² clinical view),
+    /// which it does not after a render without layers.
+    pub fn bytes_per_pixel(self) -> u64 {
+        let frame = per_pixel(Frame::BYTES_PER_PIXEL);
+        let rendering = |layers| per_pixel(Frame::rendering_bytes_per_pixel(layers));
+        let image = per_pixel(Image::BYTES_PER_PIXEL);
+        let written = image + ENCODER_BYTES_PER_PIXEL;
+        let peak = match self {
+            Self::Plain(layers) => {
+                let with_layers = per_pixel(Frame::bytes_per_pixel(layers));
+                (rendering(layers) + with_layers).max(kept_tiles(layers) + 3 * with_layers)
+            }
+            Self::Look(traced) => {
+                let found = Frame::bytes_per_pixel(Layers::HIT_POSITION | Layers::NORMAL);
+                let found = per_pixel(found + size_of::<f32>());
+                let shading = per_pixel(GBuffer::BYTES_PER_PIXEL) + frame;
+                let after = kept_tiles(traced) + found.max(shading);
+                frame + rendering(traced).max(after)
+            }
+            Self::Stereo => {
+                let start_up = per_pixel(StereoFrames::SCRATCH_BYTES_PER_PIXEL);
+                let rendering = frame + rendering(Layers::NONE) + start_up;
+                rendering.max(2 * frame + 2 * image + 2 * written)
+            }
+        };
+        peak.max(frame + written) + MARGIN_BYTES_PER_PIXEL
+    }
+}
+
+/// The bytes a pixel of a render's tiles takes after the render with `layers`: all of them
+/// with optional layers (see [`RenderKind::bytes_per_pixel`]), none without.
+fn kept_tiles(layers: Layers) -> u64 {
+    if layers.is_empty() {
+        return 0;
+    }
+    per_pixel(Frame::rendering_bytes_per_pixel(layers) - Frame::bytes_per_pixel(layers))
+}
+
+fn per_pixel(bytes: usize) -> u64 {
+    bytes as u64
 }
 
 fn join_dims(dims: &[u64]) -> String {
@@ -257,23 +337,19 @@ mod tests {
             ..Limits::default()
         };
         let p = Path::new("view.png");
-        // 160 bytes a pixel: three frames of colour, depth and value, the look's buffers, the
-        // image and the encoder's.
+        let plain = RenderKind::Plain(Layers::NONE);
+        // 76 bytes a pixel: three frames of colour, depth and value, and the margin.
         assert_eq!(
-            limits.check_frames(p, [512, 512], Layers::NONE, 2).unwrap(),
-            2 * 160 * 512 * 512
+            limits.check_frames(p, [512, 512], plain, 2).unwrap(),
+            2 * 76 * 512 * 512
         );
-        // At least what renders were measured to take: 4.6 GB for 8000² (plain) and 2.17 GB
-        // for 4000² (the clinical look).
-        let at_least = |edge, bytes| view_bytes([edge, edge], Layers::NONE).unwrap() >= bytes;
-        assert!(at_least(8000, 4_600_000_000) && at_least(4000, 2_170_000_000));
         let err = limits
-            .check_frames(p, [100_000, 100_000], Layers::NONE, 1)
+            .check_frames(p, [100_000, 100_000], plain, 1)
             .unwrap_err();
         assert!(matches!(
             err,
             ReadError::Limit {
-                requested: 1_600_000_000_000,
+                requested: 760_000_000_000,
                 ..
             }
         ));
@@ -283,7 +359,62 @@ mod tests {
             "{message}"
         );
         assert!(limits
-            .check_frames(p, [usize::MAX, 2], Layers::ALL, 1)
+            .check_frames(p, [usize::MAX, 2], RenderKind::Plain(Layers::ALL), 1)
             .is_err());
+    }
+
+    #[test]
+    fn each_kind_counts_the_buffers_it_holds_at_once() {
+        let bytes = |b: usize| b as u64;
+        let frame = bytes(Frame::BYTES_PER_PIXEL);
+        let image = bytes(Image::BYTES_PER_PIXEL);
+        let written = frame + image + ENCODER_BYTES_PER_PIXEL;
+        let traced = [Layers::NONE, Layers::HIT_POSITION | Layers::NORMAL];
+        for layers in traced.into_iter().chain([Layers::ALL]) {
+            let with_layers = bytes(Frame::bytes_per_pixel(layers));
+            let rendering = bytes(Frame::rendering_bytes_per_pixel(layers));
+            let plain = RenderKind::Plain(layers).bytes_per_pixel();
+            assert!(plain >= 3 * with_layers + kept_tiles(layers));
+            assert!(plain >= rendering + with_layers && plain >= written);
+        }
+        // The tiles: a finished pixel and, with layers, its optional layers.
+        assert_eq!(kept_tiles(Layers::NONE), 0);
+        assert_eq!(kept_tiles(traced[1]), 24 + 40);
+        let found = bytes(Frame::bytes_per_pixel(traced[1])) + bytes(size_of::<f32>());
+        for layers in traced {
+            let look = RenderKind::Look(layers).bytes_per_pixel();
+            let rendering = bytes(Frame::rendering_bytes_per_pixel(layers));
+            let shading = bytes(GBuffer::BYTES_PER_PIXEL) + 2 * frame;
+            assert!(look >= shading + kept_tiles(layers));
+            assert!(look >= rendering + frame && look >= found + frame && look >= written);
+        }
+        let stereo = RenderKind::Stereo.bytes_per_pixel();
+        let start_up = bytes(StereoFrames::SCRATCH_BYTES_PER_PIXEL);
+        let rendering = bytes(Frame::rendering_bytes_per_pixel(Layers::NONE));
+        assert!(stereo >= frame + rendering + start_up);
+        assert!(stereo >= 2 * frame + 4 * image + 2 * ENCODER_BYTES_PER_PIXEL);
+    }
+
+    #[test]
+    fn the_look_decides_what_memory_allows() {
+        const GIB: u64 = 1 << 30;
+        let p = Path::new("view.png");
+        let plain = RenderKind::Plain(Layers::NONE);
+        // A plain 8000² still fits a 24 GiB machine (a quarter of it for frames).
+        let big = Limits::for_memory(24 * GIB);
+        assert!(big.check_frames(p, [8000, 8000], plain, 1).is_ok());
+        assert!(big.max_image_pixels() >= 8000 * 8000);
+        // Where a plain 4000² still fits with little to spare, the looks and a stereo pair
+        // are refused.
+        let short = Limits::for_memory(4 * 80 * 4000 * 4000);
+        assert!(short.check_frames(p, [4000, 4000], plain, 1).is_ok());
+        let without_secretion = RenderKind::Look(Layers::HIT_POSITION | Layers::NORMAL);
+        for kind in [
+            RenderKind::Look(Layers::NONE),
+            without_secretion,
+            RenderKind::Stereo,
+        ] {
+            assert!(short.check_frames(p, [4000, 4000], kind, 1).is_err());
+        }
     }
 }

@@ -9,10 +9,12 @@ use endocast_core::look::{still_view, MAX_STILL_FRAMES};
 use endocast_core::render::{Camera, Frame, Prepared};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
+use endocast_io::{Limits, RenderKind};
 use numpy::ndarray::{Array, IxDyn};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::path::Path;
 
 /// Stereo options: how the eyes are combined, their distance and the focus distance (mm).
 struct Stereo {
@@ -86,6 +88,10 @@ pub fn render<'py>(
             "the clinical and realistic looks draw no stereo pair yet; use look=\"plain\"",
         ));
     }
+    let kind = RenderKind::of(look.look.as_ref(), stereo.is_some());
+    Limits::default()
+        .check_frames(Path::new("size"), camera.size(), kind, 1)
+        .map_err(to_py)?;
     let renderer = volume.renderer().clone();
     let view = py.detach(|| -> PyResult<View> {
         let prepared = renderer.prepare(&look.settings).map_err(to_py)?;

@@ -13,17 +13,17 @@ use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::camera::StereoRig;
-use endocast_core::look::{self, Look, RayPass, Shading};
+use endocast_core::look::{self, Look, RayPass, RayPassSettings, Shading};
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{
-    Camera, Frame, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings, Renderer,
-    StereoFrames,
+    Camera, Frame, Layers, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings,
+    Renderer, StereoFrames,
 };
 use endocast_core::Volume;
 use endocast_io::route_file::{read_camera_path, CameraPath};
-use endocast_io::{Limits, OpenOptions};
+use endocast_io::{Limits, OpenOptions, RenderKind};
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -101,6 +101,7 @@ struct Measured {
 
 /// Runs `endocast bench`.
 pub fn run(args: &BenchArgs) -> Result<()> {
+    check_size(args.size)?;
     let preset = args.look.preset()?;
     let (renderer, poses, mut cells) = match &args.volume {
         None => paper_protocol(args)?,
@@ -457,6 +458,21 @@ fn read_path(path: &Path, frames: usize) -> Result<Vec<Pose>> {
             .spread_poses(frame_count(frames)?, LOOK_AHEAD_MM)
             .context("cannot sample the path"),
     }
+}
+
+/// Refuses `--size` before anything is allocated where any of the benchmark's renders (a plain
+/// frame, a look, a stereo pair) would take more memory than the limits allow
+/// ([`Limits::check_frames`]).
+fn check_size(size: [usize; 2]) -> Result<()> {
+    let limits = Limits::default();
+    // The look without secretion, whose ray pass renders the most layers.
+    let look = RenderKind::Look(RayPassSettings::default().traced_layers());
+    for kind in [RenderKind::Plain(Layers::NONE), look, RenderKind::Stereo] {
+        limits
+            .check_frames(Path::new("--size"), size, kind, 1)
+            .context("the image is too large")?;
+    }
+    Ok(())
 }
 
 /// `--frames`, refused above the limit ([`Limits::check_frame_count`]) before a pose is made.

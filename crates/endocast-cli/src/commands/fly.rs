@@ -27,7 +27,7 @@ use endocast_core::views::stereo::StereoOutput;
 use endocast_core::Volume;
 use endocast_io::route_file::read_route;
 use endocast_io::video::{open_sink, FrameSink, VideoOptions};
-use endocast_io::Limits;
+use endocast_io::{Limits, RenderKind};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -113,11 +113,15 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         );
     }
     let stereo = flight_stereo(args)?;
-    // Per frame: one render per eye and, for a dashboard, its composite image.
-    let eyes = if stereo.is_some() { 2 } else { 1 };
-    let dashboard = u64::from(args.layout == LayoutArg::Dashboard);
-    args.input
-        .check_frames(&args.output, args.size, eyes + dashboard)?;
+    // Per frame: the view (both eyes of a pair) and, for a dashboard, its composite image
+    // (counted as one more view); checked again once the look is known.
+    let views = 1 + u64::from(args.layout == LayoutArg::Dashboard);
+    let check = |look| {
+        let kind = RenderKind::of(look, stereo.is_some());
+        args.input
+            .check_frames(&args.output, args.size, kind, views)
+    };
+    check(None)?;
     let route = read_route(&args.route).context("cannot read the path")?;
     let shots = shots(&route, args)?;
     let mut sinks = Sinks::open(&args.output, &video_options(args), stereo.map(|s| s.output))?;
@@ -138,6 +142,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         .look
         .on_scan(&loaded.volume, &args.lumen, pose, args.fov_deg)?;
     study_report::say(&study);
+    check(look.as_ref())?;
     let window = slice_window(args.window.as_deref(), study.window())?;
     let lumen = if needs_lumen {
         Some(lumen_at_start(&study, &loaded.volume, first.eye_mm)?)

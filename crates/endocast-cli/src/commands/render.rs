@@ -20,7 +20,7 @@ use endocast_core::tissue::short;
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
 use endocast_core::Volume;
-use endocast_io::ImageFormat;
+use endocast_io::{ImageFormat, RenderKind};
 use glam::DVec3;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -80,8 +80,12 @@ pub struct RenderArgs {
 /// Runs `endocast render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     ImageFormat::for_path(&args.output).context("cannot write the image")?;
-    let eyes = if args.stereo.stereo.is_some() { 2 } else { 1 };
-    args.input.check_frames(&args.output, args.size, eyes)?;
+    // Refused before the scan is read where even the plain look's frames would not fit.
+    let check = |look| {
+        let kind = RenderKind::of(look, args.stereo.stereo.is_some());
+        args.input.check_frames(&args.output, args.size, kind, 1)
+    };
+    check(None)?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
@@ -90,6 +94,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .look
         .on_scan(&loaded.volume, &args.lumen, args.pose.pose()?, args.fov)?;
     study_report::say(&look.study);
+    check(look.look.as_ref())?;
     if !(1..=MAX_STILL_FRAMES).contains(&args.still) {
         bail!(
             "--still must be between 1 and {MAX_STILL_FRAMES} frames, not {}",

@@ -7,8 +7,7 @@ use super::LookError;
 use crate::camera::Camera;
 use crate::render::quality::{reduced_camera, upsample};
 use crate::render::{
-    Crossing, Frame, Layers, Mode, Prepared, Quality, RenderOptions, RenderSettings, RenderStats,
-    Renderer,
+    Crossing, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, RenderStats, Renderer,
 };
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -41,6 +40,9 @@ pub struct GBuffer {
 }
 
 impl GBuffer {
+    /// The bytes a pixel takes: depth, hit position, normal and secretion.
+    pub const BYTES_PER_PIXEL: usize = 2 * size_of::<f32>() + 2 * size_of::<[f32; 3]>();
+
     /// Number of pixels.
     pub fn len(&self) -> usize {
         self.width * self.height
@@ -141,11 +143,7 @@ impl RayPass {
             reduced => reduced_camera(camera, reduced.reduced_size(full)),
         };
         let with_secretion = self.settings.secretion != SecretionMode::Off;
-        let layers = if with_secretion {
-            Layers::NONE
-        } else {
-            Layers::HIT_POSITION | Layers::NORMAL
-        };
+        let layers = self.settings.traced_layers();
         // The look shades the G-buffer itself: the renderer only finds the surfaces.
         let options = RenderOptions {
             grid_shift: shift,

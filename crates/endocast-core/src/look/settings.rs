@@ -2,6 +2,7 @@
 //! the rays again.
 
 use super::{check, LookError};
+use crate::render::Layers;
 
 /// How the ray pass treats secretion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -71,6 +72,16 @@ impl Default for RayPassSettings {
 }
 
 impl RayPassSettings {
+    /// The optional layers the pass renders its frame with: the tissue's hit positions and
+    /// normals, or none with secretion (the secretion's search to the tissue finds them).
+    pub fn traced_layers(&self) -> Layers {
+        if self.secretion == SecretionMode::Off {
+            Layers::HIT_POSITION | Layers::NORMAL
+        } else {
+            Layers::NONE
+        }
+    }
+
     /// Checks every number against its range.
     pub fn validate(&self) -> Result<(), LookError> {
         check("tissue threshold", self.tissue_hu, true, "finite numbers")?;

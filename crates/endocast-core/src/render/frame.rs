@@ -222,19 +222,27 @@ impl Frame {
         rgba
     }
 
-    /// The bytes the buffers of a `[width, height]` frame with `layers` take (colour, depth and
-    /// value always, the optional layers asked for), or `None` when the count overflows: what a
-    /// caller checks against its memory limit before asking for such a frame.
-    pub fn bytes_for([width, height]: [usize; 2], layers: Layers) -> Option<u64> {
+    /// The bytes a pixel of a frame without optional layers takes: colour, depth and value.
+    pub const BYTES_PER_PIXEL: usize = size_of::<Premultiplied>() + 2 * size_of::<f32>();
+
+    /// The bytes a pixel of a frame with `layers` takes: colour, depth and value always, the
+    /// optional layers asked for. Rendering into a frame holds more for a while (see
+    /// [`Frame::rendering_bytes_per_pixel`]).
+    pub fn bytes_per_pixel(layers: Layers) -> usize {
         let optional = |on: Layers, bytes: usize| if layers.contains(on) { bytes } else { 0 };
-        let per_pixel = size_of::<Premultiplied>()
-            + 2 * size_of::<f32>()
+        Self::BYTES_PER_PIXEL
             + optional(Layers::HIT_POSITION, size_of::<[f32; 3]>())
             + optional(Layers::NORMAL, size_of::<[f32; 3]>())
-            + optional(Layers::DEPTHS, size_of::<[f32; DEPTH_LAYERS]>());
+            + optional(Layers::DEPTHS, size_of::<[f32; DEPTH_LAYERS]>())
+    }
+
+    /// The bytes the buffers of a `[width, height]` frame with `layers` take
+    /// ([`Frame::bytes_per_pixel`] each), or `None` when the count overflows: what a caller
+    /// checks against its memory limit before asking for such a frame.
+    pub fn bytes_for([width, height]: [usize; 2], layers: Layers) -> Option<u64> {
         (width as u64)
             .checked_mul(height as u64)?
-            .checked_mul(per_pixel as u64)
+            .checked_mul(Self::bytes_per_pixel(layers) as u64)
     }
 
     /// Sizes the frame's buffers for `[width, height]` and `layers` (keeping their memory):

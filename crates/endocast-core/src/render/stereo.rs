@@ -50,6 +50,12 @@ pub struct StereoFrames {
     starts: SearchStarts,
 }
 
+impl StereoFrames {
+    /// The bytes a pixel of the second eye's start-up takes besides the two frames: its
+    /// search starts and the first eye's depths.
+    pub const SCRATCH_BYTES_PER_PIXEL: usize = size_of::<[f32; 2]>() + size_of::<f32>();
+}
+
 /// Where each pixel's isosurface search of the second eye may start (see the module doc).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SearchStarts {

@@ -11,6 +11,20 @@ use super::options::{Cancelled, Progress};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+impl Frame {
+    /// The bytes a pixel takes at the peak of a render into a frame with `layers`: the frame's
+    /// buffers and the tiles' (the finished pixels and, with layers, their optional layers),
+    /// every tile being held until the frame is put together from them.
+    pub fn rendering_bytes_per_pixel(layers: Layers) -> usize {
+        let extra = if layers.is_empty() {
+            0
+        } else {
+            size_of::<Extra>()
+        };
+        Self::bytes_per_pixel(layers) + size_of::<Pixel>() + extra
+    }
+}
+
 /// Edge of the square pixel tiles rendered as one task.
 pub(crate) const TILE: usize = 16;
 

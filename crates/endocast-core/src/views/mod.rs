@@ -99,6 +99,9 @@ fn check_size(width: usize, height: usize) -> Result<(), ViewError> {
 }
 
 impl Image {
+    /// The bytes a pixel takes: 8-bit red, green and blue.
+    pub const BYTES_PER_PIXEL: usize = 3;
+
     /// An image of `width × height` pixels filled with `fill`.
     pub fn new(width: usize, height: usize, fill: Rgb) -> Result<Self, ViewError> {
         check_size(width, height)?;
@@ -112,7 +115,7 @@ impl Image {
     /// An image from `width · height · 3` bytes, row 0 at the top.
     pub fn from_rgb(width: usize, height: usize, rgb: Vec<u8>) -> Result<Self, ViewError> {
         check_size(width, height)?;
-        let expected = width * height * 3;
+        let expected = width * height * Self::BYTES_PER_PIXEL;
         if rgb.len() != expected {
             return Err(ViewError::BufferLength {
                 width,
