@@ -82,7 +82,8 @@ def _paeth(a, b, c):
 
 
 def read_png_rgb(path):
-    """The pixels of an 8-bit RGB PNG (as `endocast render` writes) as (height, width, 3)."""
+    """The colour of an 8-bit RGB or RGBA PNG (not interlaced; as `endocast render` and
+    `save_png` write) as (height, width, 3)."""
     data = Path(path).read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG"
     pos, idat = 8, b""
@@ -91,12 +92,13 @@ def read_png_rgb(path):
         chunk = data[pos + 8 : pos + 8 + length]
         pos += 12 + length
         if kind == b"IHDR":
-            width, height, depth, color = struct.unpack(">IIBB", chunk[:10])
-            assert (depth, color) == (8, 2), "only 8-bit RGB"
+            width, height, depth, color, _, _, interlace = struct.unpack(">IIBBBBB", chunk)
+            assert depth == 8 and color in (2, 6) and interlace == 0, "only 8-bit RGB(A)"
         elif kind == b"IDAT":
             idat += chunk
     raw = zlib.decompress(idat)
-    stride, bpp = 3 * width, 3
+    bpp = 3 if color == 2 else 4
+    stride = bpp * width
     rows, prev = [], bytearray(stride)
     for y in range(height):
         start = y * (stride + 1)
@@ -108,4 +110,4 @@ def read_png_rgb(path):
             line[x] = (line[x] + add) & 0xFF
         rows.append(bytes(line))
         prev = line
-    return np.frombuffer(b"".join(rows), np.uint8).reshape(height, width, 3)
+    return np.frombuffer(b"".join(rows), np.uint8).reshape(height, width, bpp)[..., :3]
