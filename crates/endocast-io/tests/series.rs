@@ -2,7 +2,7 @@
 //! unevenly spaced slices keep every real slice exactly, a missing slice is refused unless the
 //! caller asks to fill it. Small synthetic series of 4×4 CT slices, one value each.
 
-use crate::hostile::{element, Image, EXPLICIT_LE};
+use crate::dicom_bytes::{element, Image, EXPLICIT_LE};
 use endocast_io::{dicom, Loaded, OpenOptions, ReadError};
 use glam::DVec3;
 use std::path::Path;

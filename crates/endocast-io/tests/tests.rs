@@ -6,6 +6,8 @@ mod case;
 mod corruption;
 mod cross_format;
 mod dicom;
+mod dicom_bytes;
+mod dicom_peers;
 mod hostile;
 mod image_out;
 mod mesh;
