@@ -6,7 +6,6 @@ mod input;
 mod look;
 mod lumen;
 mod optics;
-mod overlay;
 mod parse;
 mod peel;
 mod pose_args;

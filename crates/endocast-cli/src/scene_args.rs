@@ -7,6 +7,7 @@ use clap::Args;
 use endocast_core::scene::{
     Endoscope, GridPlane, Marker, Material, Scene, DEFAULT_INSTRUMENT_LENGTH_MM,
 };
+use endocast_io::overlay_scene::add_overlay;
 use glam::DVec3;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -66,7 +67,8 @@ impl SceneArgs {
             scene.add_mesh(&mesh, material);
         }
         for spec in &self.overlay {
-            eprintln!("{}", crate::overlay::add_overlay(&mut scene, spec)?);
+            let limits = endocast_io::Limits::default();
+            eprintln!("{}", add_overlay(&mut scene, spec, &limits)?.summary);
         }
         if let Some(spec) = &self.grid {
             scene.add_grid(self.grid(spec)?, Material::GRID);

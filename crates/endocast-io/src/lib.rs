@@ -35,6 +35,7 @@ pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;
 mod open;
+pub mod overlay_scene;
 pub mod path_file;
 mod progress;
 pub mod raw;

@@ -4,6 +4,7 @@
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
 use crate::look::{optics, LookOptions};
+use crate::scene::{warn, SceneFiles};
 use crate::volume::Volume;
 use endocast_core::flight::{Flight, FlightOptions, Layout, Route, ShotSettings};
 use endocast_core::study::LOOK_AHEAD_MM;
@@ -28,8 +29,8 @@ use std::path::PathBuf;
 /// `iso_opacity`, `tf`, `step`, `jitter`, `skip_empty`, `shade_dvr`, `background`, `peel`,
 /// `peel_threshold`, `peel_falling`, `peel_keep`, `unpeeled`, `tf_after`, `look`,
 /// `secretion`, `secretion_iso`, `wetness`, `texture`, `texture_scale`, `attenuation`, `fov`,
-/// `near`, `lens`, `distortion`, `vignetting`, `lumen_threshold`, `bright_lumen`, `threads`
-/// (see `help(endocast.render)`). The volume may be a nibabel or SimpleITK image.
+/// `near`, `lens`, `distortion`, `vignetting`, `lumen_threshold`, `bright_lumen`, `threads`,
+/// `meshes`, `overlays` (see `help(endocast.render)`). The volume may be a nibabel or SimpleITK image.
 #[pyfunction]
 #[pyo3(signature = (volume, route, out = None, **options))]
 pub fn fly<'py>(
@@ -55,7 +56,15 @@ pub fn fly<'py>(
         .pose;
     let look = options.resolve(py, volume.volume(), Some(first), fov)?;
     let optics = optics(&kw, look.study.preset(), volume.volume(), fov)?;
+    let files = SceneFiles::take(&kw)?;
     kw.finish()?;
+    if look.look.is_some() && !files.is_empty() {
+        return Err(error(
+            "the clinical and realistic looks draw no geometry yet; use look=\"plain\"",
+        ));
+    }
+    let (scene, partial) = py.detach(|| files.read())?;
+    warn(py, &partial)?;
     let options = FlightOptions {
         size,
         optics,
@@ -65,6 +74,7 @@ pub fn fly<'py>(
     };
     let mut flight = Flight::new(volume.renderer().clone(), options);
     flight.set_look(look.look.clone());
+    flight.set_scene(scene);
     let mut looks = ShotSettings::new(look.settings.clone(), transfer_function);
     let mut frame = |n: usize| {
         py.detach(|| {

@@ -15,6 +15,7 @@ mod kwargs;
 mod look;
 mod navigate;
 mod render;
+mod scene;
 mod volume;
 
 use pyo3::prelude::*;

@@ -3,6 +3,7 @@
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
 use crate::look::{camera, LookOptions, Placed};
+use crate::scene::{warn, SceneFiles};
 use crate::volume::Volume;
 use endocast_core::camera::StereoRig;
 use endocast_core::look::{still_view, MAX_STILL_FRAMES};
@@ -61,7 +62,10 @@ struct View {
 ///   `secretion` (off, on, accumulate), `secretion_iso`, `wetness` (0–1), `texture`
 ///   (mucosa, grid, none or a PNG file), `texture_scale` (mm), `attenuation` (mm, 0: none),
 ///   `still` (average this many jittered frames, 1–256);
-/// - lumen: `lumen_threshold`, `bright_lumen`.
+/// - lumen: `lumen_threshold`, `bright_lumen`;
+/// - geometry: `meshes` (STL, OBJ or PLY files, world mm), `overlays` (DICOM segmentations,
+///   each segment a surface in its colour, and dose grids, isodose surfaces at `FILE:LEVELS`
+///   or 50, 80 and 95 % of the maximum), as `--mesh` and `--overlay` draw them.
 #[pyfunction]
 #[pyo3(signature = (volume, **options))]
 pub fn render<'py>(
@@ -77,15 +81,17 @@ pub fn render<'py>(
     let camera = camera(&kw, &look, volume.volume(), &placed)?;
     let stereo = stereo_options(&kw)?;
     let still = kw.take::<usize>("still")?.unwrap_or(1);
+    let files = SceneFiles::take(&kw)?;
     kw.finish()?;
     if !(1..=MAX_STILL_FRAMES).contains(&still) {
         return Err(error(format!(
             "still must be between 1 and {MAX_STILL_FRAMES} frames, not {still}"
         )));
     }
-    if look.look.is_some() && stereo.is_some() {
+    if look.look.is_some() && (stereo.is_some() || !files.is_empty()) {
         return Err(error(
-            "the clinical and realistic looks draw no stereo pair yet; use look=\"plain\"",
+            "the clinical and realistic looks draw no geometry and no stereo pair yet; use \
+             look=\"plain\"",
         ));
     }
     let kind = RenderKind::of(look.look.as_ref(), stereo.is_some());
@@ -93,18 +99,24 @@ pub fn render<'py>(
         .check_frames(Path::new("size"), camera.size(), kind, 1)
         .map_err(to_py)?;
     let renderer = volume.renderer().clone();
-    let view = py.detach(|| -> PyResult<View> {
-        let prepared = renderer.prepare(&look.settings).map_err(to_py)?;
+    let (view, partial) = py.detach(|| -> PyResult<(View, Vec<String>)> {
+        let mut prepared = renderer.prepare(&look.settings).map_err(to_py)?;
+        let (scene, partial) = files.read()?;
+        prepared.set_scene(scene);
         match &stereo {
             None => {
                 let frame = look
                     .in_pool(|| still_view(&prepared, look.look.as_ref(), &camera, still))
                     .map_err(to_py)?;
-                Ok(single(&frame, look.settings.background))
+                Ok((single(&frame, look.settings.background), partial))
             }
-            Some(stereo) => look.in_pool(|| render_stereo(&prepared, &camera, stereo)),
+            Some(stereo) => {
+                let view = look.in_pool(|| render_stereo(&prepared, &camera, stereo))?;
+                Ok((view, partial))
+            }
         }
     })?;
+    warn(py, &partial)?;
     let (rgba_dims, depth_dims) = (rgba_dims(&view), depth_dims(&view));
     let rgba = Array::from_shape_vec(IxDyn(&rgba_dims), view.rgba).map_err(to_py)?;
     let depth = Array::from_shape_vec(IxDyn(&depth_dims), view.depth).map_err(to_py)?;

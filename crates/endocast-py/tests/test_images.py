@@ -106,7 +106,8 @@ def test_bad_look_values_name_the_keyword(colon):
 def test_help_documents_every_option():
     render_doc = endocast.render.__doc__
     for option in ["preset", "eye", "look_at", "lens", "stereo", "peel_threshold", "tf_after",
-                   "look", "secretion", "wetness", "texture", "still", "lumen_threshold"]:
+                   "look", "secretion", "wetness", "texture", "still", "lumen_threshold",
+                   "meshes", "overlays"]:
         assert option in render_doc, option
     assert "nibabel" in endocast.as_volume.__doc__
     for function in [endocast.fly, endocast.path, endocast.default_view]:
@@ -127,3 +128,23 @@ def test_save_png_takes_a_view_of_the_image(colon, tmp_path):
     np.testing.assert_array_equal(read_png_rgb(out), rgba[..., :3])
     endocast.save_png(out, rgba[::-1, :, :3])
     np.testing.assert_array_equal(read_png_rgb(out), rgba[::-1, :, :3])
+
+
+def test_meshes_and_overlays_are_the_clis(cli, colon, tmp_path):
+    volume = endocast.open(colon)
+    eye, look_at, up = (np.asarray(v) for v in endocast.default_view(volume, preset="colonoscopy"))
+    forward = (look_at - eye) / np.linalg.norm(look_at - eye)
+    right = np.cross(forward, up)
+    ahead = eye + 3.0 * forward
+    corners = [ahead - right - up, ahead + right - up, ahead + up]
+    stl = tmp_path / "triangle.stl"
+    facet = "\n".join(f"vertex {x} {y} {z}" for x, y, z in corners)
+    stl.write_text(f"solid t\nfacet normal 0 0 0\nouter loop\n{facet}\nendloop\nendfacet\n"
+                   "endsolid t\n")
+    rgba, _ = endocast.render(volume, preset="colonoscopy", size=(40, 32), meshes=[stl])
+    theirs = cli_image(cli, tmp_path, colon, "--preset", "colonoscopy", "--mesh", stl)
+    np.testing.assert_array_equal(rgba[..., :3], theirs)
+    bare, _ = endocast.render(volume, preset="colonoscopy", size=(40, 32))
+    assert (rgba != bare).any(), "the mesh is not in view"
+    with pytest.raises(endocast.EndocastError, match="gone.dcm"):
+        endocast.render(volume, size=(8, 8), overlays=[tmp_path / "gone.dcm"])

@@ -4,6 +4,9 @@
 //! only when they (or the points they mark) change, and meshes are read off the UI thread.
 
 use endocast_core::scene::{Endoscope, GridPlane, Marker, Material, Scene};
+use endocast_io::mesh::MeshFormat;
+use endocast_io::overlay_scene::add_overlay;
+use endocast_io::Limits;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -127,11 +130,47 @@ impl Geometry {
     }
 }
 
-/// `meshes` with the mesh at `path` (STL, OBJ or PLY, world mm) added, its hierarchy built:
-/// slow for large meshes, so run it off the UI thread. The error names the file.
+/// `meshes` with the geometry in `path` added, its hierarchy built: a mesh (STL, OBJ or PLY,
+/// world mm), or else a DICOM overlay (`FILE[:LEVELS]`: a segmentation's segments or a dose grid's isodose
+/// surfaces, as `--overlay` draws them). Slow for large meshes, so run it off the UI thread.
+/// The error names the file.
 pub fn with_mesh(mut meshes: Scene, path: &Path) -> Result<Scene, String> {
+    if MeshFormat::of(path).is_err() {
+        let spec = path.to_string_lossy();
+        add_overlay(&mut meshes, &spec, &Limits::default()).map_err(|e| e.to_string())?;
+        return Ok(meshes);
+    }
     let mesh =
         endocast_io::mesh::read_mesh(path).map_err(|e| format!("cannot read the mesh: {e}"))?;
     meshes.add_mesh(&mesh, Material::MESH);
     Ok(meshes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use endocast_testdata::overlays::{write_segmentation, Grid, SegFrame};
+
+    #[test]
+    fn a_dicom_segmentation_is_added_as_its_surfaces() {
+        let dir = tempfile::tempdir().unwrap();
+        let seg = dir.path().join("seg.dcm");
+        let grid = Grid {
+            origin: [0.0, 0.0, 0.0],
+            spacing: [1.0, 1.0],
+            size: [4, 4],
+        };
+        let frames: Vec<SegFrame> = (0..3)
+            .map(|z| SegFrame {
+                segment: 1,
+                z: f64::from(z),
+                pixels: vec![(1, 1), (1, 2), (2, 1), (2, 2)],
+            })
+            .collect();
+        write_segmentation(&seg, &grid, &[(1, "node", [34865, 53485, 50171])], &frames);
+        assert!(!with_mesh(Scene::new(), &seg).unwrap().is_empty());
+        let missing = dir.path().join("gone.dcm");
+        let error = with_mesh(Scene::new(), &missing).unwrap_err();
+        assert!(error.contains("gone.dcm"), "{error}");
+    }
 }

@@ -47,7 +47,7 @@ impl MeshLoader {
         ui.horizontal(|ui| {
             ui.add(
                 egui::TextEdit::singleline(&mut self.path)
-                    .hint_text("mesh .stl .obj .ply")
+                    .hint_text("mesh .stl .obj .ply, or DICOM SEG/RTDOSE")
                     .desired_width(170.0),
             );
             if ui.button("Add mesh").clicked() {

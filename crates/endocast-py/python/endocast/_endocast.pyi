@@ -123,6 +123,8 @@ def render(
     lumen_threshold: Optional[float] = None,
     bright_lumen: bool = False,
     threads: Optional[int] = None,
+    meshes: Sequence[_Path] = (),
+    overlays: Sequence[_Path] = (),
 ) -> Tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32]]:
     """Render one view as ``endocast render`` does: (rgba, depth).
 
@@ -132,7 +134,9 @@ def render(
     (2, height, width). Without ``eye``/``look_at`` the camera is ``default_view``'s.
     ``mode="peel"`` with the ``peel*`` options peels (Borland et al.); ``look`` "clinical" or
     "realistic" draws the endoscope's look (Krüger et al.) with ``secretion``, ``wetness``,
-    ``texture``, ``attenuation``; ``still`` averages that many jittered frames."""
+    ``texture``, ``attenuation``; ``still`` averages that many jittered frames. ``meshes``
+    (STL, OBJ, PLY) and ``overlays`` (DICOM SEG; RTDOSE as ``FILE`` or ``FILE:LEVEL,...``)
+    are drawn with the scan as ``--mesh`` and ``--overlay`` draw them."""
 
 def default_view(
     volume: _VolumeLike,
@@ -210,6 +214,8 @@ def fly(
     look_ahead: float = 10.0,
     fps: float = 25.0,
     threads: Optional[int] = None,
+    meshes: Sequence[_Path] = (),
+    overlays: Sequence[_Path] = (),
 ) -> npt.NDArray[np.uint8]:
     """Fly along ``route`` (an (N, 3) array of LPS points or a path file) as ``endocast fly``
     films the endoscopic view: without ``out`` the frames, RGB uint8 (frames, height, width, 3)."""
