@@ -4,6 +4,7 @@
 //! with synthetic input; [`run`] puts it in a native window (eframe, OpenGL).
 
 use crate::case::Autosave;
+use crate::case_choice::{choose_case, default_case_path, CaseChoice};
 use crate::flight_ui::FlightTools;
 use crate::geometry_ui::MeshLoader;
 use crate::jobs::Polled;
@@ -64,6 +65,8 @@ pub struct ViewerApp {
     /// The path typed in "Open".
     open_path: String,
     screenshot_requested: bool,
+    /// Where the session being loaded will save, and what to say about it.
+    case_choice: Option<CaseChoice>,
 }
 
 impl ViewerApp {
@@ -76,22 +79,26 @@ impl ViewerApp {
             ready: None,
             message: String::new(),
             screenshot_requested: false,
+            case_choice: None,
             options: options.clone(),
         };
         app.start_loading(options.source, options.case);
         app
     }
 
-    /// Starts reading `source` (or the scan of the case file `case`) in the background; the
-    /// current session stays usable meanwhile and if it fails.
+    /// Starts reading `source` (or the scan of the case file `case`, or the case already saved
+    /// beside the scan: see [`choose_case`]) in the background; the current session stays
+    /// usable meanwhile and if it fails.
     pub fn start_loading(&mut self, source: ScanSource, case: Option<PathBuf>) {
+        let choice = choose_case(&source, case);
         let request = Request {
             source,
-            case,
+            case: choice.open.clone(),
             preset: self.options.preset,
             pose: self.options.pose,
         };
         self.loading = Some(Loading::start(request, &self.ctx));
+        self.case_choice = Some(choice);
     }
 
     /// The open session, once loaded.
@@ -174,7 +181,21 @@ impl ViewerApp {
                 for problem in problems {
                     self.message += &format!("; mesh not read: {problem}");
                 }
-                let path = case.unwrap_or_else(|| default_case_path(&session.scene().source));
+                let choice = self.case_choice.take();
+                if let Some(note) = choice.as_ref().and_then(|c| c.note.as_ref()) {
+                    self.message += &format!("; {note}");
+                }
+                let path = match (case, choice) {
+                    (Some(path), _) => path,
+                    (None, Some(choice)) => choice.save_to,
+                    (None, None) => default_case_path(&session.scene().source),
+                };
+                // A --screenshot run only looks: it never writes a case.
+                let autosave = if self.options.screenshot.is_some() {
+                    Autosave::never(path)
+                } else {
+                    Autosave::opened(path, AUTOSAVE_INTERVAL, &session)
+                };
                 self.ready = Some(Ready {
                     session,
                     slices: SlicesView::default(),
@@ -182,7 +203,7 @@ impl ViewerApp {
                     tools: FlightTools::default(),
                     meshes: MeshLoader::default(),
                     tasks: Vec::new(),
-                    autosave: Autosave::new(path, AUTOSAVE_INTERVAL),
+                    autosave,
                     view_texture: None,
                     shown: None,
                     marks: MarkTool::default(),
@@ -386,34 +407,6 @@ fn frame_status(ready: &Ready) -> String {
         eye.y,
         eye.z
     )
-}
-
-/// Where a scan's case is saved until the user saves elsewhere: beside the scan for a file,
-/// in the temporary folder for a phantom.
-pub fn default_case_path(source: &ScanSource) -> PathBuf {
-    match source {
-        ScanSource::File { path, .. } => {
-            let name = path
-                .file_name()
-                .map_or_else(|| "scan".into(), |n| n.to_string_lossy().into_owned());
-            let dir = path.parent().map(PathBuf::from).unwrap_or_default();
-            let candidate = dir.join(format!("{name}.endocast-case.json"));
-            // A read-only data folder: fall back to the working directory.
-            if dir.as_os_str().is_empty() || writable(&dir) {
-                candidate
-            } else {
-                PathBuf::from(format!("{name}.endocast-case.json"))
-            }
-        }
-        ScanSource::Phantom { name, .. } => {
-            std::env::temp_dir().join(format!("endocast-{name}.endocast-case.json"))
-        }
-    }
-}
-
-fn writable(dir: &std::path::Path) -> bool {
-    std::fs::metadata(dir).is_ok_and(|m| !m.permissions().readonly())
-        && tempfile::tempfile_in(dir).is_ok()
 }
 
 /// Opens the window and runs until it is closed.

@@ -213,6 +213,8 @@ pub struct Autosave {
     last_time: Option<Instant>,
     /// The revision of the file as last read or written (`None`: there was none).
     revision: Option<u64>,
+    /// Whether it saves at all ([`Autosave::never`] does not).
+    saves: bool,
 }
 
 impl Autosave {
@@ -224,7 +226,31 @@ impl Autosave {
             interval,
             last_saved: None,
             last_time: None,
+            saves: true,
         }
+    }
+
+    /// [`Autosave::new`] for a session just opened (on its case, or on a scan without one):
+    /// nothing is written until the session changes, so opening and closing a case leaves
+    /// its file as it was, byte for byte.
+    pub fn opened(path: PathBuf, interval: Duration, session: &Session) -> Self {
+        Self {
+            last_saved: Some(Case::of(session, 0)),
+            ..Self::new(path, interval)
+        }
+    }
+
+    /// An autosave that never writes (a `--screenshot` run, which only looks).
+    pub fn never(path: PathBuf) -> Self {
+        Self {
+            saves: false,
+            ..Self::new(path, Duration::MAX)
+        }
+    }
+
+    /// Whether it writes the case at all.
+    pub fn saves(&self) -> bool {
+        self.saves
     }
 
     /// Where it saves.
@@ -243,6 +269,9 @@ impl Autosave {
     /// `force`); returns whether it wrote. Refused when another program saved the file since
     /// it was opened or last saved here.
     pub fn tick(&mut self, session: &Session, force: bool) -> Result<bool, CaseError> {
+        if !self.saves {
+            return Ok(false);
+        }
         let due = self.last_time.is_none_or(|t| t.elapsed() >= self.interval);
         if !(force || due) {
             return Ok(false);

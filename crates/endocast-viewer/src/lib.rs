@@ -12,6 +12,7 @@
 //! - [`session`]: the state of one open scan — every user action is a method, so tests drive it
 //!   without a window;
 //! - [`case`]: case files, written atomically and autosaved;
+//! - [`case_choice`]: which case a session reopens and saves to (never one it would replace);
 //! - [`planner`]: the centred path between two points (or to the farthest) as key frames;
 //! - [`export`]: the flight filmed (GIF, MP4, PNGs) and its path files (ours, Slicer Markups);
 //! - [`geometry`]: the grid, the endoscope's instrument, marker spheres and meshes drawn;
@@ -39,6 +40,7 @@
 #[cfg(feature = "window")]
 pub mod app;
 pub mod case;
+pub mod case_choice;
 pub mod controller;
 pub mod export;
 #[cfg(feature = "window")]

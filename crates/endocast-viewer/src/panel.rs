@@ -79,7 +79,12 @@ pub(crate) fn controls_ui(
     egui::CollapsingHeader::new("Case")
         .default_open(true)
         .show(ui, |ui| {
-            ui.label(format!("autosaved to {}", ready.autosave.path().display()));
+            let path = ready.autosave.path().display();
+            ui.label(if ready.autosave.saves() {
+                format!("autosaved to {path}")
+            } else {
+                format!("not saved (a --screenshot run): {path}")
+            });
             ui.horizontal(|ui| {
                 if ui.button("Save case").clicked() {
                     action = Some(Action::SaveCase);

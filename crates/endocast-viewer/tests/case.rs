@@ -352,3 +352,71 @@ fn an_autosave_never_overwrites_what_another_program_saved_meanwhile() {
     assert!(reopened.tick(&session, true).unwrap());
     assert_eq!(Case::read(&path).unwrap().revision, 3);
 }
+
+#[test]
+fn opening_a_scan_again_reopens_its_case_and_never_replaces_one_it_cannot_use() {
+    use endocast_io::case::ScanSource;
+    use endocast_viewer::case_choice::{choose_case, default_case_path};
+    let dir = tempfile::tempdir().unwrap();
+    let scan = dir.path().join("chest.nii.gz");
+    std::fs::write(&scan, b"voxels").unwrap();
+    let source = ScanSource::File {
+        path: scan.clone(),
+        series: None,
+        orientation: None,
+    };
+    let default = default_case_path(&source);
+    assert_eq!(default, dir.path().join("chest.nii.gz.endocast-case.json"));
+    // None yet: the session will save to the default.
+    let first = choose_case(&source, None);
+    assert_eq!((first.open, &first.save_to), (None, &default));
+    // This scan's case is reopened.
+    Case::new(source.clone(), None).write(&default).unwrap();
+    let again = choose_case(&source, None);
+    assert_eq!(again.open.as_ref(), Some(&default));
+    assert_eq!(again.save_to, default);
+    // Another scan's case, or a damaged file, is left alone byte for byte.
+    let other = ScanSource::Phantom {
+        name: "colon".into(),
+        size: 64,
+    };
+    Case::new(other, None).write(&default).unwrap();
+    let others = std::fs::read(&default).unwrap();
+    for content in [others, b"{ not a case".to_vec()] {
+        std::fs::write(&default, &content).unwrap();
+        let choice = choose_case(&source, None);
+        assert_eq!(choice.open, None);
+        assert_eq!(
+            choice.save_to,
+            dir.path().join("chest.nii.gz-2.endocast-case.json")
+        );
+        let note = choice.note.unwrap();
+        assert!(note.contains("left as it is"), "{note}");
+        assert_eq!(std::fs::read(&default).unwrap(), content);
+    }
+}
+
+#[test]
+fn a_reopened_case_is_not_rewritten_until_the_session_changes_and_keeps_its_last_version() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tube.endocast-case.json");
+    let (mut session, _) = tube_session();
+    session.record_key_frame().unwrap();
+    Autosave::new(path.clone(), Duration::ZERO)
+        .tick(&session, true)
+        .unwrap();
+    let saved = std::fs::read(&path).unwrap();
+    // Relaunched on its case: nothing written, however often it ticks.
+    let mut reopened = reopen(&path);
+    let mut autosave = Autosave::opened(path.clone(), Duration::ZERO, &reopened);
+    assert!(!autosave.tick(&reopened, true).unwrap());
+    assert_eq!(std::fs::read(&path).unwrap(), saved);
+    // A --screenshot run never writes.
+    reopened.turn(0.3, 0.0);
+    assert!(!Autosave::never(path.clone()).tick(&reopened, true).unwrap());
+    assert_eq!(std::fs::read(&path).unwrap(), saved);
+    // A change is saved, and the version it replaced is kept beside it.
+    assert!(autosave.tick(&reopened, true).unwrap());
+    assert_ne!(std::fs::read(&path).unwrap(), saved);
+    assert_eq!(std::fs::read(Case::previous_path(&path)).unwrap(), saved);
+}

@@ -39,7 +39,7 @@ fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_pic
     };
     let mut window = Window::open(ViewerOptions {
         pose: Some(pose),
-        ..options(source)
+        ..options(source.clone())
     });
     window.settle();
     let unmarked = window.view.clone().expect("the view's picture");
@@ -97,4 +97,14 @@ fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_pic
     let (size_again, again) = reopened.view.clone().unwrap();
     assert_eq!(size_again, size);
     assert!(again == marked, "the reopened case shows another picture");
+
+    // Opening the scan again without --case reopens its case and leaves the file as it is.
+    let bytes = std::fs::read(&path).unwrap();
+    let mut relaunched = Window::open(options(source));
+    relaunched.settle();
+    assert_eq!(relaunched.app.case_path().unwrap(), path);
+    assert_eq!(relaunched.app.session().unwrap().marks(), before.marks());
+    let message = relaunched.app.message();
+    assert!(message.contains("reopened the saved case"), "{message}");
+    assert_eq!(std::fs::read(&path).unwrap(), bytes);
 }

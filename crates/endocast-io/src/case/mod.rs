@@ -37,6 +37,7 @@ pub use scan::{IdentityRecord, ScanFacts, ScanSource};
 use endocast_core::annotate::{Annotations, ScanIdentity};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// The `"format"` value of case files.
@@ -114,13 +115,8 @@ impl Case {
 
     /// Reads `path`; the error names the file and the problem.
     pub fn read(path: &Path) -> Result<Self, CaseError> {
-        let size = std::fs::metadata(path)
-            .map_err(|e| CaseError::new(path, e))?
-            .len();
-        if size > MAX_BYTES {
-            return Err(CaseError::new(path, format!("{size} bytes is too large")));
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| CaseError::new(path, e))?;
+        let bytes = Self::read_bytes(path)?;
+        let text = String::from_utf8(bytes).map_err(|e| CaseError::new(path, e))?;
         let case: Self = serde_json::from_str(&text).map_err(|e| CaseError::new(path, e))?;
         if case.format != FORMAT || !(1..=VERSION).contains(&case.version) {
             return Err(CaseError::new(
@@ -133,6 +129,22 @@ impl Case {
         }
         case.annotations(path)?;
         Ok(case)
+    }
+
+    /// The file's bytes, refused beyond [`MAX_BYTES`] (read no further).
+    fn read_bytes(path: &Path) -> Result<Vec<u8>, CaseError> {
+        let file = File::open(path).map_err(|e| CaseError::new(path, e))?;
+        let mut bytes = Vec::new();
+        file.take(MAX_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(|e| CaseError::new(path, e))?;
+        if bytes.len() as u64 > MAX_BYTES {
+            return Err(CaseError::new(
+                path,
+                format!("more than {MAX_BYTES} bytes is too large"),
+            ));
+        }
+        Ok(bytes)
     }
 
     /// Writes the case to `path` atomically, as the current [`VERSION`], under the case's
@@ -199,8 +211,22 @@ impl Case {
         Self::read(path).map(|case| Some(case.revision))
     }
 
-    /// [`Case::write`] with the case's lock held by the caller.
+    /// Where a save keeps the version it replaces: `NAME.prev` beside the case.
+    pub fn previous_path(path: &Path) -> PathBuf {
+        let mut name = path.as_os_str().to_owned();
+        name.push(".prev");
+        PathBuf::from(name)
+    }
+
+    /// [`Case::write`] with the case's lock held by the caller; the version it replaces is kept
+    /// at [`Case::previous_path`].
     fn write_locked(&self, path: &Path) -> Result<(), CaseError> {
+        if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+            let old = Self::read_bytes(path)?;
+            let previous = Self::previous_path(path);
+            crate::atomic::write_file(&previous, |w| w.write_all(&old))
+                .map_err(|e| CaseError::new(&previous, e))?;
+        }
         let current = Self {
             version: VERSION,
             ..self.clone()
