@@ -22,7 +22,10 @@ use endocast_core::presets::Preset;
 use endocast_core::render::progressive::Stage;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
+
+/// How long a status message is shown as new.
+const STALE_MESSAGE: Duration = Duration::from_secs(15);
 
 /// How often the case is autosaved when it changed.
 pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(10);
@@ -62,6 +65,8 @@ pub struct ViewerApp {
     ready: Option<Ready>,
     /// One line for the status bar: the last error or what was saved.
     message: String,
+    /// The message as last drawn and when it first was (older ones are greyed).
+    message_since: (String, Instant),
     /// The path typed in "Open".
     open_path: String,
     screenshot_requested: bool,
@@ -78,6 +83,7 @@ impl ViewerApp {
             loading: None,
             ready: None,
             message: String::new(),
+            message_since: (String::new(), Instant::now()),
             screenshot_requested: false,
             case_choice: None,
             options: options.clone(),
@@ -236,7 +242,9 @@ impl ViewerApp {
         });
     }
 
-    fn status_ui(&self, ui: &mut egui::Ui) {
+    /// The frame's status on one line, and below it the last message, wrapped, greyed once it
+    /// is [`STALE_MESSAGE`] old.
+    fn status_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             if let Some(loading) = &self.loading {
                 loading.ui(ui);
@@ -244,9 +252,16 @@ impl ViewerApp {
             if let Some(ready) = &self.ready {
                 ui.label(frame_status(ready));
             }
-            ui.separator();
-            ui.label(&self.message);
         });
+        if self.message.is_empty() {
+            return;
+        }
+        if self.message_since.0 != self.message {
+            self.message_since = (self.message.clone(), Instant::now());
+        }
+        let text = egui::RichText::new(&self.message);
+        let stale = self.message_since.1.elapsed() > STALE_MESSAGE;
+        ui.add(egui::Label::new(if stale { text.weak() } else { text }).wrap());
     }
 
     fn act(&mut self, action: Action) {
@@ -372,7 +387,8 @@ fn side_ui(ui: &mut egui::Ui, ready: &mut Ready) {
 }
 
 /// "frame 12.3 ms · quarter · 41 ms after the request · eye (…) mm · wall 4.1 mm" (a still's
-/// frame time is its frames' mean).
+/// frame time is its frames' mean); "not in a lumen" instead of the wall's distance where the
+/// eye is in tissue or outside the scan.
 fn frame_status(ready: &Ready) -> String {
     let session = &ready.session;
     let frame = session.worker().with_latest(|f| {
@@ -395,10 +411,11 @@ fn frame_status(ready: &Ready) -> String {
         })
     });
     let eye = session.fly_camera().eye_mm();
-    let wall = match session.navigation() {
-        Some(n) => format!(" · wall {:.1} mm", n.distance_mm(eye)),
-        None if session.finding_lumen() => " · finding the lumen…".into(),
-        None => String::new(),
+    let wall = match session.navigation().map(|n| n.distance_mm(eye)) {
+        Some(d) if d > 0.0 => format!(" · wall {d:.1} mm"),
+        _ if session.finding_lumen() => " · finding the lumen…".into(),
+        _ if session.lumen_threshold().is_none() => " · no lumen for this wall".into(),
+        _ => " · not in a lumen".into(),
     };
     format!(
         "{} · eye ({:.1}, {:.1}, {:.1}) mm{wall}",

@@ -8,6 +8,7 @@ use crate::session::{Session, NO_PRESET};
 use crate::state::{Action, Ready};
 use crate::tf_editor::histogram_ui;
 use endocast_core::camera::Projection;
+use endocast_core::navigate::LumenSide;
 use endocast_core::presets;
 use endocast_core::render::{Mode, PeelLayer, PeelSettings, Unpeeled};
 use endocast_io::SeriesSummary;
@@ -39,6 +40,7 @@ pub(crate) fn controls_ui(
     if let Some(code) = orientation_ui(ui, &ready.session) {
         action = Some(Action::Reorient(code));
     }
+    warnings_ui(ui, &ready.session.scene().warnings);
     ui.separator();
     view_controls_ui(ui, &mut ready.session);
     ui.separator();
@@ -143,6 +145,21 @@ fn series_ui(ui: &mut egui::Ui, session: &Session) -> Option<String> {
             }
         });
     chosen.filter(|uid| Some(uid) != current.as_ref())
+}
+
+/// The reader's warnings, folded under a header that counts them.
+fn warnings_ui(ui: &mut egui::Ui, warnings: &[String]) {
+    if warnings.is_empty() {
+        return;
+    }
+    let header = format!("⚠ {} reader warning(s)", warnings.len());
+    egui::CollapsingHeader::new(header)
+        .default_open(false)
+        .show(ui, |ui| {
+            for warning in warnings {
+                ui.add(egui::Label::new(warning.as_str()).wrap());
+            }
+        });
 }
 
 /// For a file that declares no orientation: the one in force (guessed from the anatomy or
@@ -268,8 +285,22 @@ fn peel_ui(ui: &mut egui::Ui, peel: &mut PeelSettings, iso_hu: f64, (lo, hi): (f
 }
 
 fn flight_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
+    let lumen = session.lumen_threshold();
     let c = &mut session.controls;
     ui.checkbox(&mut c.collision, "collision (slide along the wall)");
+    if c.collision {
+        ui.label(match lumen {
+            Some((value, side)) => format!(
+                "  lumen {} {value:.0} (moves with the wall)",
+                if side == LumenSide::Below {
+                    "below"
+                } else {
+                    "above"
+                }
+            ),
+            None => "  no lumen for this wall: collision is off".into(),
+        });
+    }
     ui.add(
         egui::Slider::new(&mut c.speed_mm_s, 0.5..=400.0)
             .logarithmic(true)

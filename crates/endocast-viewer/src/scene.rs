@@ -114,6 +114,8 @@ pub struct Scene {
     /// Whether the file declared its orientation (else it was guessed or given: the panel
     /// offers to flip it).
     pub orientation_declared: bool,
+    /// What the reader warned of, shown in the panel.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -130,14 +132,16 @@ impl Scene {
             value_range,
             series_found: Vec::new(),
             orientation_declared: true,
+            warnings: Vec::new(),
         }
     }
 
     /// The scene, knowing what its reader found: the series its DICOM folder holds, whether
-    /// the file declared its orientation.
+    /// the file declared its orientation, its warnings.
     pub fn with_facts(mut self, facts: ScanFacts) -> Self {
         self.series_found = facts.series_found;
         self.orientation_declared = facts.orientation_declared;
+        self.warnings = facts.warnings;
         self
     }
 

@@ -155,6 +155,8 @@ pub struct Session {
     view_size: [usize; 2],
     worker: RenderWorker,
     last_view: Option<View>,
+    /// The stereo focus and the pose it was measured at (see [`Session::focus_mm`]).
+    stereo_focus: Option<(FlyCamera, f64)>,
     last_submit: Option<(u64, Instant)>,
     key_frames: Vec<KeyFrame>,
     playback: Option<Playback>,
@@ -203,6 +205,7 @@ impl Session {
             view_size: DEFAULT_VIEW_SIZE,
             worker,
             last_view: None,
+            stereo_focus: None,
             last_submit: None,
             key_frames: Vec::new(),
             playback: None,
@@ -257,10 +260,11 @@ impl Session {
     /// The view to render now; `None` when the controls make no camera.
     fn view(&mut self, moving: bool) -> Option<View> {
         let camera = self.camera().ok()?;
-        let stereo = self
-            .controls
-            .stereo
-            .then(|| StereoRig::focused_at(self.focus_mm()));
+        let stereo = if self.controls.stereo {
+            Some(StereoRig::focused_at(self.focus_mm()))
+        } else {
+            None
+        };
         let marks = self.marks.items().iter().filter_map(|a| match a.shape {
             Shape::Point(p) => Some(p),
             _ => None,
@@ -330,18 +334,29 @@ impl Session {
         shown < generation && at.elapsed() < MAX_WAIT_FOR_FRAME
     }
 
-    /// The stereo focus: the distance to the wall ahead in the last frame (its centre pixel),
-    /// else 10 mm.
-    fn focus_mm(&self) -> f64 {
-        self.worker
-            .with_latest(|f| {
-                f.and_then(|f| {
-                    let [w, h] = f.camera.size();
-                    let d = *f.depth_mm.get(w / 2 + w * (h / 2))?;
-                    (d.is_finite() && d > 1.0).then_some(f64::from(d))
-                })
+    /// The stereo focus: the distance to the wall ahead (the last frame's centre pixel, else
+    /// 10 mm), measured once per pose and kept while the camera stays, so that the frames
+    /// delivered at a pose (preview, full, still) do not move the focus and the view settles.
+    fn focus_mm(&mut self) -> f64 {
+        match self.stereo_focus {
+            Some((pose, focus)) if pose == self.camera => focus,
+            _ => {
+                let focus = self.last_centre_depth_mm().unwrap_or(10.0);
+                self.stereo_focus = Some((self.camera, focus));
+                focus
+            }
+        }
+    }
+
+    /// The depth of the last frame's centre pixel, when it saw a wall more than 1 mm away.
+    fn last_centre_depth_mm(&self) -> Option<f64> {
+        self.worker.with_latest(|f| {
+            f.and_then(|f| {
+                let [w, h] = f.camera.size();
+                let d = *f.depth_mm.get(w / 2 + w * (h / 2))?;
+                (d.is_finite() && d > 1.0).then_some(f64::from(d))
             })
-            .unwrap_or(10.0)
+        })
     }
 
     /// Flies by `step` (sliding along the wall when collision is on); returns the distance
@@ -589,12 +604,16 @@ impl Session {
     }
 
     /// Advances a playing flight by `dt_s` seconds at the flying speed and puts the camera
-    /// there; true while it is playing.
+    /// there; true while it is playing. A paused or finished flight leaves the camera to the
+    /// user (mouse-look, keys, reset) until it is played or scrubbed again (`dt_s` 0).
     pub fn advance_playback(&mut self, dt_s: f64) -> bool {
         let speed = self.controls.speed_mm_s;
         let Some(p) = &mut self.playback else {
             return false;
         };
+        if !p.playing && dt_s > 0.0 {
+            return false;
+        }
         if p.playing {
             p.s_mm = (p.s_mm + dt_s * speed).min(p.len_mm());
         }

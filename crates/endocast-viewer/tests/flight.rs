@@ -148,6 +148,22 @@ fn stereo_shows_an_anaglyph_of_two_shifted_eyes() {
         channel_differs(0) && channel_differs(1),
         "not two shifted eyes"
     );
+    // The focus stays with the pose: once the pair is at full quality no new view follows.
+    session.sync(false);
+    let g = session.worker().generation();
+    let full = |f: &endocast_viewer::worker::Delivered| f.stage == Stage::Full;
+    session
+        .worker()
+        .wait_for(g, Duration::from_secs(30), full)
+        .unwrap();
+    for _ in 0..3 {
+        assert_eq!(
+            session.sync(false),
+            None,
+            "a delivered frame moved the focus"
+        );
+    }
+    assert_eq!(session.worker().generation(), g);
 }
 
 #[test]
@@ -179,6 +195,14 @@ fn two_key_frames_play_from_the_first_to_the_second() {
     assert!((session.fly_camera().eye_mm() - end.eye_mm()).length() < 1e-6);
     assert!((session.fly_camera().forward() - end.forward()).length() < 1e-6);
     assert!(session.playback().unwrap().finished());
+    // The finished flight releases the camera: looking around and going home stay done.
+    session.turn(0.3, 0.0);
+    let looked = *session.fly_camera();
+    assert!(!session.advance_playback(0.05));
+    assert_eq!(*session.fly_camera(), looked);
+    session.reset();
+    assert!(!session.advance_playback(0.05));
+    assert_ne!(*session.fly_camera(), looked);
     assert!(
         mean_difference(&first, &last) > 1.0,
         "the flight shows the same picture"

@@ -39,6 +39,8 @@ pub struct ScanFacts {
     /// Whether the file declared its patient orientation (a phantom's is known); when it did
     /// not, the orientation was guessed from the anatomy or given, and may be flipped.
     pub orientation_declared: bool,
+    /// The reader's warnings (a guessed orientation, slices moved onto a grid, …).
+    pub warnings: Vec<String>,
 }
 
 impl ScanSource {
@@ -67,6 +69,7 @@ impl ScanSource {
                 let facts = ScanFacts {
                     series_found: loaded.source.series_found,
                     orientation_declared: loaded.source.orientation_declared,
+                    warnings: loaded.warnings,
                 };
                 Ok((loaded.volume, facts))
             }
@@ -80,6 +83,7 @@ impl ScanSource {
                 let facts = ScanFacts {
                     series_found: Vec::new(),
                     orientation_declared: true,
+                    warnings: Vec::new(),
                 };
                 Ok((phantom.build(&options), facts))
             }
