@@ -1,11 +1,11 @@
 //! The panel's flight tools: planning the centred path between two points picked in the slices
 //! (or from the eye, or to the farthest point) into key frames, and exporting the flight (a
-//! film with progress and cancel; a path file, ours or 3D Slicer Markups). Every long task runs
-//! off the UI thread.
+//! film with progress and cancel; a path file, ours or 3D Slicer Markups, also read back as key
+//! frames). Every long task runs off the UI thread.
 
 use crate::export::{write_flight_path, ExportEnd, FilmExport};
 use crate::jobs::{Job, Notify, Polled};
-use crate::planner::{start_planning, PlannedFlight};
+use crate::planner::{key_look, read_key_frames, start_planning, PlannedFlight};
 use crate::session::Session;
 use endocast_core::navigate::PathEnd;
 use glam::DVec3;
@@ -147,8 +147,9 @@ impl FlightTools {
         }
     }
 
-    /// The export section: the film (progress, cancel) and the path file.
-    pub(crate) fn export_ui(&mut self, ui: &mut egui::Ui, session: &Session) -> Option<String> {
+    /// The export section: the film (progress, cancel) and the path file, written or read
+    /// back.
+    pub(crate) fn export_ui(&mut self, ui: &mut egui::Ui, session: &mut Session) -> Option<String> {
         let mut message = None;
         if let Some(export) = &self.export {
             let (done, total) = export.progress();
@@ -187,6 +188,9 @@ impl FlightTools {
                     Err(e) => e,
                 });
             }
+            if ui.button("Read path").clicked() {
+                message = Some(read_flight_path(session, Path::new(self.path_file.trim())));
+            }
         });
         message
     }
@@ -201,6 +205,20 @@ fn load_flight(session: &mut Session, flight: PlannedFlight) -> String {
         "planned {:.0} mm (narrowest {:.1} mm from the wall): {keys} key frames, P plays",
         flight.length_mm, flight.min_radius_mm
     )
+}
+
+/// Replaces the key frames by the path in `file` (ours or 3D Slicer Markups) and goes to the
+/// first; says what was read, or why not.
+pub(crate) fn read_flight_path(session: &mut Session, file: &Path) -> String {
+    match read_key_frames(file, key_look(session)) {
+        Ok(keys) => {
+            let count = keys.len();
+            session.set_key_frames(keys);
+            session.go_to_key_frame(0);
+            format!("read {}: {count} key frames, P plays", file.display())
+        }
+        Err(e) => e,
+    }
 }
 
 /// Asks `ui`'s window to repaint (from a job's thread).

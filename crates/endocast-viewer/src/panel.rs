@@ -69,7 +69,7 @@ pub(crate) fn controls_ui(
     egui::CollapsingHeader::new("Export the flight")
         .default_open(false)
         .show(ui, |ui| {
-            if let Some(m) = ready.tools.export_ui(ui, &ready.session) {
+            if let Some(m) = ready.tools.export_ui(ui, &mut ready.session) {
                 action = Some(Action::Message(m));
             }
         });

@@ -1,13 +1,16 @@
 //! Planned flights: the centred path through the lumen between two points (or from one to the
 //! farthest point), found off the UI thread with the navigation library's planner (as
-//! `endocast path` does), and turned into key frames the session plays, edits and exports.
+//! `endocast path` does), and turned into key frames the session plays, edits and exports;
+//! and paths read back from files (ours, 3D Slicer Markups) as key frames.
 
 use crate::jobs::{Job, Notify};
 use crate::session::Session;
 use endocast_core::animation::KeyFrame;
+use endocast_core::flight::Route;
 use endocast_core::navigate::{plan_path, LumenSide, PathEnd};
-use endocast_core::path::SmoothOptions;
+use endocast_core::path::{Path, SmoothOptions};
 use endocast_core::Volume;
+use endocast_io::route_file::read_route;
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -50,22 +53,46 @@ pub fn plan_flight(
     let options = SmoothOptions::default();
     let (_, _, planned) = plan_path(volume, threshold, side, start_mm, end, &options)
         .map_err(|e| format!("no path in the lumen {side} {threshold}: {e}"))?;
-    let path = &planned.path;
+    Ok(PlannedFlight {
+        key_frames: key_frames_along(&planned.path, look)?,
+        length_mm: planned.path.len_mm(),
+        min_radius_mm: planned.min_radius_mm,
+    })
+}
+
+/// Key frames every [`KEY_STEP_MM`] along `path`, each looking [`LOOK_AHEAD_MM`] ahead on it,
+/// with `look`.
+fn key_frames_along(path: &Path, look: KeyLook) -> Result<Vec<KeyFrame>, String> {
     let length_mm = path.len_mm();
     let count = (length_mm / KEY_STEP_MM).ceil().max(1.0) as usize;
-    let key_frames = (0..=count)
+    (0..=count)
         .map(|k| {
             let s = (k as f64 * KEY_STEP_MM).min(length_mm);
             let pose = path.pose_at(s, LOOK_AHEAD_MM).map_err(|e| e.to_string())?;
             KeyFrame::from_pose(&pose, look.fov_deg, look.iso_hu, look.iso_opacity)
                 .map_err(|e| e.to_string())
         })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(PlannedFlight {
-        key_frames,
-        length_mm,
-        min_radius_mm: planned.min_radius_mm,
-    })
+        .collect()
+}
+
+/// The key frames of the route in `file`, read as `endocast fly --path` reads it (endocast's
+/// path file, or a 3D Slicer Markups curve or point list, LPS or RAS): its own key frames when
+/// it has them, else key frames along its points with `look`. The error names the file.
+pub fn read_key_frames(file: &std::path::Path, look: KeyLook) -> Result<Vec<KeyFrame>, String> {
+    match read_route(file).map_err(|e| e.to_string())? {
+        Route::Keys(animation) => Ok(animation.keys().to_vec()),
+        Route::Path(path) => key_frames_along(&path, look),
+    }
+}
+
+/// The field of view and wall of `session` now, for new key frames.
+pub fn key_look(session: &Session) -> KeyLook {
+    let c = &session.controls;
+    KeyLook {
+        fov_deg: c.fov_deg,
+        iso_hu: c.iso_hu,
+        iso_opacity: f64::from(c.iso_opacity),
+    }
 }
 
 /// Starts planning the flight from `start_mm` to `end` in `session`'s lumen (the preset's
@@ -80,12 +107,7 @@ pub fn start_planning(
     let lumen = session
         .lumen_threshold()
         .ok_or("this preset and isovalue name no lumen")?;
-    let c = &session.controls;
-    let look = KeyLook {
-        fov_deg: c.fov_deg,
-        iso_hu: c.iso_hu,
-        iso_opacity: f64::from(c.iso_opacity),
-    };
+    let look = key_look(session);
     let renderer = Arc::clone(&session.scene().renderer);
     Ok(Job::spawn("path", notify, move || {
         plan_flight(renderer.volume(), lumen, start_mm, end, look)

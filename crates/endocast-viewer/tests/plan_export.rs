@@ -142,3 +142,31 @@ fn the_flight_writes_path_files_that_the_cli_reads_back() {
         curve.len_mm()
     );
 }
+
+#[test]
+fn path_files_read_back_as_the_key_frames_the_cli_flies() {
+    use endocast_viewer::planner::{key_look, read_key_frames};
+    let session = flight_session();
+    let dir = tempfile::tempdir().unwrap();
+    let (json, markups) = (dir.path().join("keys.json"), dir.path().join("c.mrk.json"));
+    write_flight_path(&session, &json).unwrap();
+    write_flight_path(&session, &markups).unwrap();
+    // Our key frames come back as they were.
+    let keys = read_key_frames(&json, key_look(&session)).unwrap();
+    assert_eq!(keys.len(), session.key_frames().len());
+    for (read, recorded) in keys.iter().zip(session.key_frames()) {
+        assert!((read.eye_mm - recorded.eye_mm).length() < 1e-6);
+    }
+    // A Slicer curve becomes key frames along the route the CLI reads, end to end.
+    let curve = read_route(&markups).unwrap();
+    let along = read_key_frames(&markups, key_look(&session)).unwrap();
+    assert!(along.len() >= 2);
+    let first = session.key_frames()[0].eye_mm;
+    let last = session.key_frames()[1].eye_mm;
+    assert!((along[0].eye_mm - first).length() < 0.1);
+    assert!((along.last().unwrap().eye_mm - last).length() < 0.1);
+    assert!((curve.len_mm() - 6.0).abs() < 0.5);
+    // A missing file is named.
+    let gone = read_key_frames(&dir.path().join("gone.mrk.json"), key_look(&session));
+    assert!(gone.unwrap_err().contains("gone.mrk.json"));
+}
