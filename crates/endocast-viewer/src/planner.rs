@@ -9,6 +9,7 @@ use endocast_core::animation::KeyFrame;
 use endocast_core::flight::Route;
 use endocast_core::navigate::{plan_path, LumenSide, PathEnd};
 use endocast_core::path::{Path, SmoothOptions};
+use endocast_core::study::Study;
 use endocast_core::Volume;
 use endocast_io::route_file::read_route;
 use glam::DVec3;
@@ -41,18 +42,40 @@ pub struct KeyLook {
     pub iso_opacity: f64,
 }
 
-/// Plans the flight through the lumen on `side` of `threshold` around `start_mm` to `end`.
-/// The error says why in one line (the start is in the wall, the end in another lumen, …).
+/// Where a flight is planned: in the study's structure (or the lumen at its threshold), as
+/// `endocast path` plans, while the wall is the study's; else in the lumen of the wall as moved.
+pub enum Lumen {
+    /// The study's own (see [`Study::plan`]).
+    Study(Arc<Study>),
+    /// The lumen on `side` of a threshold grown from the start.
+    Threshold(f64, LumenSide),
+}
+
+/// Plans the flight through `lumen` from `start_mm` to `end`. The error says why in one line
+/// (the start is in the wall, the end in another lumen, …).
 pub fn plan_flight(
     volume: &Volume,
-    (threshold, side): (f64, LumenSide),
+    lumen: &Lumen,
     start_mm: DVec3,
     end: PathEnd,
     look: KeyLook,
 ) -> Result<PlannedFlight, String> {
     let options = SmoothOptions::default();
-    let (_, _, planned) = plan_path(volume, threshold, side, start_mm, end, &options)
-        .map_err(|e| format!("no path in the lumen {side} {threshold}: {e}"))?;
+    let planned = match lumen {
+        Lumen::Study(study) => {
+            let to = match end {
+                PathEnd::Point(p) => Some(p),
+                PathEnd::Farthest => None,
+            };
+            let path = study.plan(volume, Some(start_mm), to, &options);
+            path.map_err(|e| e.to_string())?.planned
+        }
+        Lumen::Threshold(threshold, side) => {
+            let planned = plan_path(volume, *threshold, *side, start_mm, end, &options);
+            let failed = |e| format!("no path in the lumen {side} {threshold}: {e}");
+            planned.map_err(failed)?.2
+        }
+    };
     Ok(PlannedFlight {
         key_frames: key_frames_along(&planned.path, look)?,
         length_mm: planned.path.len_mm(),
@@ -95,21 +118,28 @@ pub fn key_look(session: &Session) -> KeyLook {
     }
 }
 
-/// Starts planning the flight from `start_mm` to `end` in `session`'s lumen (the preset's
-/// lumen threshold, else the wall isovalue) on its own thread, with the current field of view
-/// and wall; `notify` is called when it is done.
+/// Starts planning the flight from `start_mm` to `end` in `session`'s lumen (the study's, as
+/// `endocast path` plans, while the wall is the study's; else the lumen of the wall as set) on
+/// its own thread, with the current field of view and wall; `notify` is called when it is
+/// done.
 pub fn start_planning(
     session: &Session,
     start_mm: DVec3,
     end: PathEnd,
     notify: Notify,
 ) -> Result<Job<Result<PlannedFlight, String>>, String> {
-    let lumen = session
+    let (threshold, side) = session
         .lumen_threshold()
         .ok_or("this preset and isovalue name no lumen")?;
+    let study = session.shared_study();
+    let lumen = if session.controls.iso_hu == study.settings().iso_hu {
+        Lumen::Study(study)
+    } else {
+        Lumen::Threshold(threshold, side)
+    };
     let look = key_look(session);
     let renderer = Arc::clone(&session.scene().renderer);
     Ok(Job::spawn("path", notify, move || {
-        plan_flight(renderer.volume(), lumen, start_mm, end, look)
+        plan_flight(renderer.volume(), &lumen, start_mm, end, look)
     }))
 }

@@ -144,7 +144,7 @@ impl Playback {
 pub struct Session {
     scene: Arc<Scene>,
     /// The scan understood for the preset: what the controls started from.
-    study: Study,
+    study: Arc<Study>,
     navigation: Option<Navigation>,
     /// The lumen being found around a new eye position.
     finding: Option<Job<Option<Navigation>>>,
@@ -185,7 +185,7 @@ impl Session {
             pose,
             ..StudyRequest::default()
         };
-        let study = Study::resolve(scene.volume(), &request);
+        let study = Arc::new(Study::resolve(scene.volume(), &request));
         let controls = Controls::of_study(&study);
         let pose = study.start_pose();
         let camera = FlyCamera::from_pose(&pose)
@@ -448,7 +448,7 @@ impl Session {
     /// Applies `preset`'s clinical defaults (mode, wall, lens, window), keeping the pose.
     pub fn apply_preset(&mut self, preset: Option<&'static Preset>) {
         let kept = (self.controls.collision, self.controls.speed_mm_s);
-        self.study = self.study_here(preset);
+        self.study = Arc::new(self.study_here(preset));
         self.controls = Controls::of_study(&self.study);
         (self.controls.collision, self.controls.speed_mm_s) = kept;
         self.find_lumen();
@@ -467,6 +467,11 @@ impl Session {
     /// The scan understood for the preset (its values, structure and start).
     pub fn study(&self) -> &Study {
         &self.study
+    }
+
+    /// The study, shared (for work off the UI thread).
+    pub fn shared_study(&self) -> Arc<Study> {
+        Arc::clone(&self.study)
     }
 
     /// Finds the lumen around the eye for the preset's lumen threshold (the wall isovalue for a

@@ -170,3 +170,42 @@ fn path_files_read_back_as_the_key_frames_the_cli_flies() {
     let gone = read_key_frames(&dir.path().join("gone.mrk.json"), key_look(&session));
     assert!(gone.unwrap_err().contains("gone.mrk.json"));
 }
+
+#[test]
+fn the_window_plans_through_the_stent_as_endocast_path_does() {
+    use endocast_core::navigate::PathEnd;
+    use endocast_core::path::SmoothOptions;
+    use endocast_core::presets::Preset;
+    use endocast_viewer::planner::start_planning;
+    use endocast_viewer::scene::{ScanSource, Scene};
+    use endocast_viewer::session::Session;
+    let Some(stent) = endocast_testdata::shared_data("aorta-stent-cta/stent.nrrd") else {
+        return;
+    };
+    let source = ScanSource::File {
+        path: stent,
+        series: None,
+        orientation: None,
+    };
+    let (volume, facts) = source.load_with_facts(&Default::default()).unwrap();
+    let scene = Arc::new(Scene::new(source, volume).with_facts(facts));
+    let session = Session::new(scene, Preset::find("angioscopy"), None, || {});
+    // The thin contrast-filled tree leaks out at the study's threshold grown from the start;
+    // the study's structure (the aorta) does not.
+    let eye = session.fly_camera().eye_mm();
+    let cli = session.study().plan(
+        session.scene().volume(),
+        Some(eye),
+        None,
+        &SmoothOptions::default(),
+    );
+    let cli_mm = cli.unwrap().planned.path.len_mm();
+    let job = start_planning(&session, eye, PathEnd::Farthest, quiet()).unwrap();
+    let planned = job.wait().unwrap().unwrap();
+    assert!(cli_mm > 150.0, "{cli_mm}");
+    assert!(
+        (planned.length_mm - cli_mm).abs() < 1e-9,
+        "{} vs {cli_mm}",
+        planned.length_mm
+    );
+}
