@@ -14,13 +14,50 @@ use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
-/// Distance between the film's frames along the flight, mm (as `endocast fly`'s default).
-pub const FRAME_STEP_MM: f64 = 1.0;
 /// Spacing of the points of an exported Markups curve, mm (as `endocast path`'s default).
 pub const CURVE_STEP_MM: f64 = 2.0;
-/// Size of the film's frames, pixels.
-pub const FILM_SIZE: [usize; 2] = [384, 384];
+
+/// How a film is made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilmOptions {
+    /// Size of the frames, pixels (16–4096 each). Default 384 × 384.
+    pub size: [usize; 2],
+    /// Frames per second, 1–120. Default 25.
+    pub fps: f64,
+    /// Distance between frames along the flight, mm, 0.05–100. Default 1 (as `endocast fly`).
+    pub step_mm: f64,
+}
+
+impl Default for FilmOptions {
+    fn default() -> Self {
+        Self {
+            size: [384, 384],
+            fps: 25.0,
+            step_mm: 1.0,
+        }
+    }
+}
+
+impl FilmOptions {
+    /// Refuses sizes, rates and steps outside their ranges, naming the one.
+    fn check(&self) -> Result<(), String> {
+        if !self.size.iter().all(|n| (16..=4096).contains(n)) {
+            return Err(format!(
+                "film size {:?}: each side must be 16–4096 pixels",
+                self.size
+            ));
+        }
+        if !(1.0..=120.0).contains(&self.fps) {
+            return Err(format!("film rate {} fps: must be 1–120", self.fps));
+        }
+        if !(0.05..=100.0).contains(&self.step_mm) {
+            return Err(format!("film step {} mm: must be 0.05–100", self.step_mm));
+        }
+        Ok(())
+    }
+}
 
 /// A film being rendered and written.
 #[derive(Debug)]
@@ -29,6 +66,7 @@ pub struct FilmExport {
     done: Arc<AtomicUsize>,
     total: usize,
     cancel: Arc<AtomicBool>,
+    started: Instant,
     job: Job<Result<PathBuf, String>>,
 }
 
@@ -44,33 +82,37 @@ pub enum ExportEnd {
 }
 
 impl FilmExport {
-    /// Starts filming `session`'s key frames (as they are now, at the current controls) into
-    /// `output` (`.gif`, `.mp4`, or a folder of PNGs) at `fps`; `notify` is called after every
-    /// frame. Errors (fewer than two key frames, a bad output) come at once.
+    /// Starts filming `session`'s key frames (as they are now, at the current controls, with
+    /// the geometry and the marks the view draws) into `output` (`.gif`, `.mp4`, or a folder
+    /// of PNGs) as `film` says; `notify` is called after every frame. Errors (fewer than two
+    /// key frames, a bad output or option) come at once.
     pub fn start(
-        session: &Session,
+        session: &mut Session,
         output: &Path,
-        fps: f64,
+        film: &FilmOptions,
         notify: Notify,
     ) -> Result<Self, String> {
+        film.check()?;
         let route = Route::from_key_frames(session.key_frames().to_vec())
             .map_err(|e| format!("cannot film the key frames: {e}"))?;
         let shots = route
-            .shots(FRAME_STEP_MM, 1.0)
+            .shots(film.step_mm, 1.0)
             .map_err(|e| format!("cannot sample the flight: {e}"))?;
         let mut video = VideoOptions::default();
-        video.fps = fps;
+        video.fps = film.fps;
         // A bad ending is said at once; the sink itself is made on the export's thread.
         SinkKind::for_path(output).map_err(|e| e.to_string())?;
         let path = output.to_owned();
         let options = FlightOptions {
-            size: FILM_SIZE,
+            size: film.size,
             optics: session.controls.optics(),
             stereo: None,
             layout: Layout::Endoscope,
             window: Window::AIR_TISSUE,
         };
         let mut flight = Flight::new(Arc::clone(&session.scene().renderer), options);
+        flight.set_scene(session.drawn_scene().0);
+        flight.set_annotations(Some(session.marks().clone()));
         let settings = session.controls.settings();
         let (done, cancel) = (
             Arc::new(AtomicUsize::new(0)),
@@ -103,6 +145,7 @@ impl FilmExport {
             done,
             total,
             cancel,
+            started: Instant::now(),
             job,
         })
     }
@@ -110,6 +153,13 @@ impl FilmExport {
     /// Frames written so far and in all.
     pub fn progress(&self) -> (usize, usize) {
         (self.done.load(Ordering::Acquire), self.total)
+    }
+
+    /// The time the frames left will take at the pace of those written so far (`None` before
+    /// the first).
+    pub fn time_left(&self) -> Option<Duration> {
+        let (done, total) = self.progress();
+        (done > 0).then(|| self.started.elapsed() * (total - done) as u32 / done as u32)
     }
 
     /// Where the film goes.

@@ -3,7 +3,7 @@
 //! film with progress and cancel; a path file, ours or 3D Slicer Markups, also read back as key
 //! frames). Every long task runs off the UI thread.
 
-use crate::export::{write_flight_path, ExportEnd, FilmExport};
+use crate::export::{write_flight_path, ExportEnd, FilmExport, FilmOptions};
 use crate::jobs::{Job, Notify, Polled};
 use crate::planner::{key_look, read_key_frames, start_planning, PlannedFlight};
 use crate::session::Session;
@@ -11,9 +11,6 @@ use endocast_core::navigate::PathEnd;
 use glam::DVec3;
 use std::path::Path;
 use std::sync::Arc;
-
-/// Frames per second of exported films.
-const FILM_FPS: f64 = 25.0;
 
 /// What a click in a slice does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -36,6 +33,7 @@ pub(crate) struct FlightTools {
     planning: Option<Job<Result<PlannedFlight, String>>>,
     export: Option<FilmExport>,
     film_path: String,
+    film: FilmOptions,
     path_file: String,
 }
 
@@ -48,6 +46,7 @@ impl Default for FlightTools {
             planning: None,
             export: None,
             film_path: "endocast-flight.mp4".into(),
+            film: FilmOptions::default(),
             path_file: "endocast-flight.mrk.json".into(),
         }
     }
@@ -147,37 +146,51 @@ impl FlightTools {
         }
     }
 
-    /// The export section: the film (progress, cancel) and the path file, written or read
-    /// back.
+    /// The export section: the film (its file, size, rate and step; progress, time left and
+    /// cancel) and the path file, written or read back. The rows stay where they are whether a
+    /// film is being made or not, so that a click never lands on a row that moved.
     pub(crate) fn export_ui(&mut self, ui: &mut egui::Ui, session: &mut Session) -> Option<String> {
         let mut message = None;
-        if let Some(export) = &self.export {
-            let (done, total) = export.progress();
-            ui.label(format!("filming {}", export.output().display()));
-            ui.horizontal(|ui| {
-                let share = done as f32 / total.max(1) as f32;
-                ui.add(
-                    egui::ProgressBar::new(share)
-                        .text(format!("{done} / {total} frames"))
-                        .desired_width(180.0),
-                );
-                if ui.button("Cancel").clicked() {
+        let filming = self.export.is_some();
+        ui.horizontal(|ui| {
+            ui.add(egui::TextEdit::singleline(&mut self.film_path).desired_width(170.0))
+                .on_hover_text(".mp4, .gif, or a folder for PNG frames");
+            if ui
+                .add_enabled(!filming, egui::Button::new("Film"))
+                .clicked()
+            {
+                let path = Path::new(self.film_path.trim());
+                match FilmExport::start(session, path, &self.film, repaint(ui)) {
+                    Ok(export) => self.export = Some(export),
+                    Err(e) => message = Some(e),
+                }
+            }
+        });
+        film_options_ui(ui, &mut self.film);
+        ui.horizontal(|ui| {
+            let (done, total) = self.export.as_ref().map_or((0, 0), FilmExport::progress);
+            let share = done as f32 / total.max(1) as f32;
+            let text = match &self.export {
+                Some(export) => match export.time_left() {
+                    Some(left) => format!("{done} / {total} · {:.0} s left", left.as_secs_f64()),
+                    None => format!("{done} / {total} frames"),
+                },
+                None => "no film being made".into(),
+            };
+            ui.add(
+                egui::ProgressBar::new(share)
+                    .text(text)
+                    .desired_width(180.0),
+            );
+            if ui
+                .add_enabled(filming, egui::Button::new("Cancel"))
+                .clicked()
+            {
+                if let Some(export) = &self.export {
                     export.cancel();
                 }
-            });
-        } else {
-            ui.horizontal(|ui| {
-                ui.add(egui::TextEdit::singleline(&mut self.film_path).desired_width(170.0))
-                    .on_hover_text(".mp4, .gif, or a folder for PNG frames");
-                if ui.button("Film").clicked() {
-                    let path = Path::new(self.film_path.trim());
-                    match FilmExport::start(session, path, FILM_FPS, repaint(ui)) {
-                        Ok(export) => self.export = Some(export),
-                        Err(e) => message = Some(e),
-                    }
-                }
-            });
-        }
+            }
+        });
         ui.horizontal(|ui| {
             ui.add(egui::TextEdit::singleline(&mut self.path_file).desired_width(170.0))
                 .on_hover_text(".mrk.json: a 3D Slicer curve; .json: the key frames");
@@ -205,6 +218,33 @@ fn load_flight(session: &mut Session, flight: PlannedFlight) -> String {
         "planned {:.0} mm (narrowest {:.1} mm from the wall): {keys} key frames, P plays",
         flight.length_mm, flight.min_radius_mm
     )
+}
+
+/// The film's size, rate and step.
+fn film_options_ui(ui: &mut egui::Ui, film: &mut FilmOptions) {
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::DragValue::new(&mut film.size[0])
+                .range(16..=4096)
+                .suffix(" w"),
+        );
+        ui.add(
+            egui::DragValue::new(&mut film.size[1])
+                .range(16..=4096)
+                .suffix(" h"),
+        );
+        ui.add(
+            egui::DragValue::new(&mut film.fps)
+                .range(1.0..=120.0)
+                .suffix(" fps"),
+        );
+        ui.add(
+            egui::DragValue::new(&mut film.step_mm)
+                .range(0.05..=100.0)
+                .speed(0.05)
+                .suffix(" mm/frame"),
+        );
+    });
 }
 
 /// Replaces the key frames by the path in `file` (ours or 3D Slicer Markups) and goes to the

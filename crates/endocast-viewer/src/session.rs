@@ -4,7 +4,7 @@
 //! tests drive a session exactly as the window does.
 
 use crate::controller::{FlyCamera, LocalMove};
-use crate::geometry::{Geometry, Toggles};
+use crate::geometry::{Geometry, SceneRef, Toggles};
 use crate::jobs::{Job, Polled};
 use crate::scene::{Navigation, Scene};
 use crate::worker::{RenderWorker, View};
@@ -265,15 +265,7 @@ impl Session {
         } else {
             None
         };
-        let marks = self.marks.items().iter().filter_map(|a| match a.shape {
-            Shape::Point(p) => Some(p),
-            _ => None,
-        });
-        let marks = marks.collect();
-        let (lo, hi) = self.scene.volume().geometry().world_bounds();
-        let scene = self
-            .geometry
-            .scene(self.controls.geometry, marks, (lo + hi) / 2.0);
+        let scene = self.drawn_scene();
         Some(View {
             camera,
             settings: self.controls.settings(),
@@ -281,6 +273,18 @@ impl Session {
             moving,
             scene,
         })
+    }
+
+    /// The geometry the view draws now (the toggles' grid, instrument, mark spheres, meshes).
+    pub fn drawn_scene(&mut self) -> SceneRef {
+        let marks = self.marks.items().iter().filter_map(|a| match a.shape {
+            Shape::Point(p) => Some(p),
+            _ => None,
+        });
+        let marks = marks.collect();
+        let (lo, hi) = self.scene.volume().geometry().world_bounds();
+        self.geometry
+            .scene(self.controls.geometry, marks, (lo + hi) / 2.0)
     }
 
     /// The meshes read and the scene last built from the geometry toggles.

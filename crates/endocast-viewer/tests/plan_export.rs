@@ -1,10 +1,10 @@
 //! Planned paths as key frames, and the flight exported: the film with progress and cancel,
 //! and the path files `endocast fly --path` reads.
 
-use crate::common::{off_axis_mm, tube_session};
+use crate::common::{off_axis_mm, settled, tube_session};
 use endocast_core::navigate::PathEnd;
 use endocast_io::route_file::read_route;
-use endocast_viewer::export::{write_flight_path, ExportEnd, FilmExport};
+use endocast_viewer::export::{write_flight_path, ExportEnd, FilmExport, FilmOptions};
 use endocast_viewer::jobs::Notify;
 use endocast_viewer::planner::{start_planning, KEY_STEP_MM};
 use std::sync::Arc;
@@ -97,10 +97,14 @@ fn flight_session() -> endocast_viewer::session::Session {
 
 #[test]
 fn the_flight_films_to_a_gif_with_progress_and_a_cancelled_film_leaves_nothing() {
-    let session = flight_session();
+    let mut session = flight_session();
     let dir = tempfile::tempdir().unwrap();
     let gif = dir.path().join("flight.gif");
-    let export = FilmExport::start(&session, &gif, 10.0, quiet()).unwrap();
+    let film = FilmOptions {
+        fps: 10.0,
+        ..FilmOptions::default()
+    };
+    let export = FilmExport::start(&mut session, &gif, &film, quiet()).unwrap();
     let (_, total) = export.progress();
     assert!(total >= 5, "{total} frames for 6 mm");
     assert_eq!(finish(&export), ExportEnd::Written(gif.clone()));
@@ -109,7 +113,7 @@ fn the_flight_films_to_a_gif_with_progress_and_a_cancelled_film_leaves_nothing()
     assert!(bytes.starts_with(b"GIF89a"), "not a GIF");
 
     let cancelled = dir.path().join("cancelled.gif");
-    let export = FilmExport::start(&session, &cancelled, 10.0, quiet()).unwrap();
+    let export = FilmExport::start(&mut session, &cancelled, &film, quiet()).unwrap();
     export.cancel();
     assert_eq!(finish(&export), ExportEnd::Cancelled);
     assert!(!cancelled.exists());
@@ -117,9 +121,54 @@ fn the_flight_films_to_a_gif_with_progress_and_a_cancelled_film_leaves_nothing()
     assert_eq!(leftovers, 1, "a cancelled film left files");
 
     // Fewer than two key frames: said at once.
-    let (alone, _) = tube_session();
-    let error = FilmExport::start(&alone, &gif, 10.0, quiet()).unwrap_err();
+    let (mut alone, _) = tube_session();
+    let error = FilmExport::start(&mut alone, &gif, &film, quiet()).unwrap_err();
     assert!(error.contains("key frames"), "{error}");
+    // A size out of range: named at once.
+    let huge = FilmOptions {
+        size: [10_000, 64],
+        ..film
+    };
+    let error = FilmExport::start(&mut session, &gif, &huge, quiet()).unwrap_err();
+    assert!(error.contains("film size"), "{error}");
+}
+
+#[test]
+fn films_show_the_marks_and_geometry_the_view_shows_at_the_chosen_size() {
+    let mut session = flight_session();
+    session.go_to_key_frame(0);
+    settled(&mut session);
+    let dir = tempfile::tempdir().unwrap();
+    let film = FilmOptions {
+        size: [48, 40],
+        step_mm: 3.0,
+        ..FilmOptions::default()
+    };
+    let first_frame = |session: &mut endocast_viewer::session::Session, name: &str| {
+        let folder = dir.path().join(name);
+        let export = FilmExport::start(session, &folder, &film, quiet()).unwrap();
+        assert_eq!(finish(&export), ExportEnd::Written(folder.clone()));
+        let mut frames: Vec<_> = std::fs::read_dir(&folder)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        frames.sort();
+        let png = std::fs::read(&frames[0]).unwrap();
+        // The header's width and height (IHDR, big-endian, after the signature).
+        let side = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
+        assert_eq!((side(16), side(20)), (48, 40));
+        png
+    };
+    let plain = first_frame(&mut session, "plain");
+    // A label on the wall near the view's left edge (the middle looks down the tube): its
+    // decal is in the film.
+    assert!(session.annotate_pixel(6, 32, "polyp"));
+    let marked = first_frame(&mut session, "marked");
+    assert!(plain != marked, "the mark is not in the film");
+    // The endoscope's instrument toggled on: in the film too.
+    session.controls.geometry.endoscope = true;
+    let instrument = first_frame(&mut session, "instrument");
+    assert!(marked != instrument, "the instrument is not in the film");
 }
 
 #[test]
