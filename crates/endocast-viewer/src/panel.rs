@@ -222,9 +222,9 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
             }
         });
     let (lo, hi) = scene.value_range;
-    histogram_ui(ui, &scene.histogram, (lo, hi), &mut c.iso_hu, &mut c.tf).on_hover_text(
-        "click: isovalue · drag a dot: transfer function · double-click: add · right-click: remove",
-    );
+    histogram_ui(ui, &scene.histogram, (lo, hi), &mut c.iso_hu, &mut c.tf);
+    // A line under the histogram, not a tooltip over the sliders below it.
+    ui.small("click: isovalue · drag a dot: opacity · double-click: add · right-click: remove");
     ui.add(egui::Slider::new(&mut c.iso_hu, lo..=hi).text("isovalue"));
     ui.add(egui::Slider::new(&mut c.iso_opacity, 0.0..=1.0).text("surface opacity"));
     egui::ComboBox::from_label("lens")

@@ -1,8 +1,9 @@
 //! The value histogram with the isovalue and a simple transfer-function editor on it: the
 //! opacity curve (0 at the bottom, 1 per mm at the top) drawn over the log counts. Click sets
 //! the isovalue; drag a handle to move a point; double-click adds one; right-click removes one.
+//! The axis' ends are labelled with their values, and the pointer's value and opacity shown.
 
-use egui::{Color32, Painter, Pos2, Rect, Sense, Stroke, Vec2};
+use egui::{Align2, Color32, Painter, Pos2, Rect, Sense, Stroke, Vec2};
 use endocast_core::render::TransferFunction;
 
 /// How near (points) the pointer must be to a handle to grab it.
@@ -12,6 +13,7 @@ const HEIGHT: f32 = 72.0;
 
 const ISO_COLOR: Color32 = Color32::from_rgb(255, 120, 80);
 const CURVE_COLOR: Color32 = Color32::from_rgb(120, 220, 255);
+const LABEL_COLOR: Color32 = Color32::from_gray(200);
 
 /// The value axis and the opacity axis of the histogram's rectangle.
 #[derive(Clone, Copy)]
@@ -76,11 +78,15 @@ pub(crate) fn histogram_ui(
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(i, _)| i)
     };
+    draw_labels(&painter, &axes, response.hover_pos());
     let Some(pos) = response.interact_pointer_pos() else {
         return response;
     };
     let changed = if response.drag_started() {
-        ui.data_mut(|d| d.insert_temp(grabbed, nearest(&points, pos)));
+        // The handle under the press, not under the pointer once the drag threshold is passed:
+        // a quick drag would otherwise start beside the handle and miss it.
+        let pressed = ui.input(|i| i.pointer.press_origin()).unwrap_or(pos);
+        ui.data_mut(|d| d.insert_temp(grabbed, nearest(&points, pressed)));
         false
     } else if response.dragged() {
         match ui.data(|d| d.get_temp::<Option<usize>>(grabbed)).flatten() {
@@ -126,6 +132,24 @@ fn move_point(points: &mut [(f64, f32)], i: usize, (value, opacity): (f64, f32))
 fn insert_point(points: &mut Vec<(f64, f32)>, point: (f64, f32)) {
     let at = points.partition_point(|p| p.0 <= point.0);
     points.insert(at, point);
+}
+
+/// The value range at the axis' ends and, under the pointer, its value and opacity.
+fn draw_labels(painter: &Painter, axes: &Axes, hover: Option<Pos2>) {
+    let font = egui::FontId::proportional(11.0);
+    let r = axes.rect;
+    let ends = [
+        (r.left_bottom(), Align2::LEFT_BOTTOM, axes.lo),
+        (r.right_bottom(), Align2::RIGHT_BOTTOM, axes.lo + axes.span),
+    ];
+    for (at, align, value) in ends {
+        painter.text(at, align, format!("{value:.0}"), font.clone(), LABEL_COLOR);
+    }
+    if let Some(pos) = hover.filter(|p| r.contains(*p)) {
+        let (value, opacity) = axes.value(pos);
+        let text = format!("{value:.0} · opacity {opacity:.2}");
+        painter.text(r.center_top(), Align2::CENTER_TOP, text, font, LABEL_COLOR);
+    }
 }
 
 /// The log counts as grey bars.
