@@ -35,6 +35,8 @@ pub(crate) struct FlightTools {
     film_path: String,
     film: FilmOptions,
     path_file: String,
+    /// What the last jump did, for the status line.
+    said: Option<String>,
 }
 
 impl Default for FlightTools {
@@ -48,15 +50,17 @@ impl Default for FlightTools {
             film_path: "endocast-flight.mp4".into(),
             film: FilmOptions::default(),
             path_file: "endocast-flight.mrk.json".into(),
+            said: None,
         }
     }
 }
 
 impl FlightTools {
-    /// A click at `p_mm` in a slice: a jump, or the path's start or end.
+    /// A click at `p_mm` in a slice: a jump (into the nearest lumen; what happened is said by
+    /// the next [`FlightTools::poll`]), or the path's start or end.
     pub(crate) fn slice_clicked(&mut self, session: &mut Session, p_mm: DVec3) {
         match self.slice_click {
-            SliceClick::Jump => session.jump_to(p_mm),
+            SliceClick::Jump => self.said = session.jump_to(p_mm),
             SliceClick::Start => self.start_mm = Some(p_mm),
             SliceClick::End => self.end_mm = Some(p_mm),
         }
@@ -70,6 +74,9 @@ impl FlightTools {
     /// Picks up finished jobs: a planned flight becomes the key frames (the camera goes to the
     /// first); returns a line for the status bar when something ended.
     pub(crate) fn poll(&mut self, session: &mut Session) -> Option<String> {
+        if let Some(said) = self.said.take() {
+            return Some(said);
+        }
         if let Some(job) = &self.planning {
             let planned = match job.poll() {
                 Polled::Running => None,

@@ -11,7 +11,7 @@ use crate::worker::{RenderWorker, View};
 use endocast_core::animation::{Animation, KeyFrame};
 use endocast_core::annotate::{self, Annotation, Annotations, DrawOptions, Shape, SurfaceView};
 use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
-use endocast_core::navigate::LumenSide;
+use endocast_core::navigate::{nearest_lumen_point, snap_radius_mm, LumenSide};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, PeelSettings, RenderSettings, TransferFunction};
@@ -418,11 +418,34 @@ impl Session {
         })
     }
 
-    /// Jumps the eye to `p_mm` (a click in a slice), keeping the view direction, and finds the
-    /// lumen there for collision.
-    pub fn jump_to(&mut self, p_mm: DVec3) {
-        self.camera.jump_to(p_mm);
+    /// Jumps the eye to `p_mm` (a click in a slice), keeping the view direction, moved to the
+    /// nearest voxel of the lumen within the planner's snap radius (the study's structure
+    /// while the wall is the study's), and finds the lumen there for collision. Returns what
+    /// happened in words when the point was moved, or when no lumen lies that near.
+    pub fn jump_to(&mut self, p_mm: DVec3) -> Option<String> {
+        let volume = self.scene.volume();
+        let radius = snap_radius_mm(volume.geometry().spacing_mm());
+        let structure = self
+            .study
+            .structure()
+            .filter(|_| self.controls.iso_hu == self.study.settings().iso_hu);
+        let snapped = self
+            .lumen_threshold()
+            .and_then(|lumen| nearest_lumen_point(volume, p_mm, lumen, structure, radius));
+        let half_voxel = 0.5 * volume.geometry().spacing_mm().max_element();
+        let said = match snapped {
+            Some(q) if q.distance(p_mm) > half_voxel => Some(format!(
+                "moved {:.1} mm from the click into the lumen",
+                q.distance(p_mm)
+            )),
+            Some(_) => None,
+            None => Some(format!(
+                "not in a lumen: none within {radius:.0} mm of the click"
+            )),
+        };
+        self.camera.jump_to(snapped.unwrap_or(p_mm));
         self.find_lumen();
+        said
     }
 
     /// Moves the eye, within the plane across the view, to the middle of the lumen around it

@@ -267,3 +267,18 @@ fn centring_moves_the_eye_to_the_tube_axis_across_the_view() {
     assert!(moved.dot(before.forward()).abs() < 0.3, "{moved:?}");
     assert_eq!(after.forward(), before.forward());
 }
+
+#[test]
+fn a_click_beside_the_lumen_jumps_into_it_and_one_far_from_any_says_so() {
+    let (mut session, truth) = tube_session();
+    let across = truth.axis.any_orthonormal_vector();
+    let beside = truth.centre_mm + across * (truth.radius_mm + 1.5);
+    let said = session.jump_to(beside).unwrap();
+    assert!(said.starts_with("moved"), "{said}");
+    let eye = session.fly_camera().eye_mm();
+    assert!(off_axis_mm(&truth, eye) < truth.radius_mm, "{eye}");
+    let far = truth.centre_mm + across * (truth.radius_mm + 40.0);
+    let said = session.jump_to(far).unwrap();
+    assert!(said.starts_with("not in a lumen"), "{said}");
+    assert!(session.jump_to(truth.centre_mm).is_none());
+}

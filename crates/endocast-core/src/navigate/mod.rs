@@ -35,6 +35,7 @@ mod plan;
 mod preset;
 mod section;
 mod side;
+mod snap;
 #[cfg(test)]
 mod test_util;
 mod trachea;
@@ -59,6 +60,7 @@ pub use nasal::{
 };
 pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
+pub use snap::nearest_lumen_point;
 pub use trachea::find_trachea;
 pub use upright::{guess_head_orientation, UprightGuess};
 pub(crate) use viewpoint::looking_along;
