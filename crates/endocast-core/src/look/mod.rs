@@ -51,6 +51,7 @@
 
 mod deferred;
 mod gbuffer;
+mod geometry;
 mod kind;
 mod lanes;
 mod reduced;
@@ -64,10 +65,13 @@ mod texture;
 #[cfg(test)]
 mod deferred_tests;
 #[cfg(test)]
+mod geometry_tests;
+#[cfg(test)]
 mod tests;
 
 pub use deferred::shade;
 pub use gbuffer::{GBuffer, RayPass};
+pub use geometry::shade_with_scene;
 pub use kind::{Look, LookKind, PresetLook};
 pub use reduced::shade_reduced;
 pub use settings::{RayPassSettings, SecretionMode};
