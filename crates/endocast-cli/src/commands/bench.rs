@@ -16,12 +16,12 @@ use endocast_core::camera::StereoRig;
 use endocast_core::look::{self, Look, RayPass, RayPassSettings, Shading};
 use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
-use endocast_core::scene::Scene;
 use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{
     Camera, Frame, Layers, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings,
     Renderer, StereoFrames,
 };
+use endocast_core::scene::Scene;
 use endocast_core::Volume;
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::{Limits, OpenOptions, RenderKind};

@@ -36,7 +36,7 @@ const BLOCK: usize = 8;
 const _: () = assert!(BLOCK * BLOCK <= PACKET);
 
 /// [`shade`] with `scene` (placed for `camera`) composited by depth, as the module says;
-/// without a scene, [`shade`] alone. Fails as [`shade`] does.
+/// without a scene (or an empty one), [`shade`] alone. Fails as [`shade`] does.
 pub fn shade_with_scene(
     gbuffer: &GBuffer,
     camera: &Camera,
@@ -44,7 +44,7 @@ pub fn shade_with_scene(
     scene: Option<&Scene>,
 ) -> Result<Frame, LookError> {
     let mut frame = shade(gbuffer, camera, shading)?;
-    if let Some(scene) = scene {
+    if let Some(scene) = scene.filter(|s| !s.is_empty()) {
         let compositor = Compositor {
             shading,
             camera,
@@ -58,7 +58,7 @@ pub fn shade_with_scene(
 
 /// Whether pixel `(x, y)` shows the geometry behind the tissue: the stipple, a checkerboard.
 pub(super) fn shows_behind(x: usize, y: usize) -> bool {
-    (x + y) % 2 == 0
+    (x + y).is_multiple_of(2)
 }
 
 /// What compositing the geometry into a shaded frame needs.
