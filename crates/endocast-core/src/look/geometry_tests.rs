@@ -194,4 +194,11 @@ fn geometry_where_no_ray_meets_tissue_is_drawn_solid_and_sets_the_depth() {
     assert!((f64::from(frame.depth_mm[i]) - sphere_mm).abs() < 1e-3);
     assert_eq!(frame.color[i].transmittance, 0.0);
     assert!(frame.depth_mm[0].is_nan() && frame.color[0].transmittance == 1.0);
+    // Half opaque: both of its surfaces composited, and no opaque surface to give a depth.
+    let mut glass = Scene::new();
+    let half = Material::new([0.0, 0.0, 1.0], 0.5).unwrap();
+    glass.add_marker(Marker::new(centre, radius).unwrap(), half);
+    let frame = shade_with_scene(&empty, &camera, &red_and_green(), Some(&glass)).unwrap();
+    assert_eq!(frame.color[i].transmittance, 0.25);
+    assert!(frame.depth_mm[i].is_nan());
 }
