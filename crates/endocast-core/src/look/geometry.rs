@@ -13,10 +13,14 @@
 //! - surfaces behind the tissue show through a stipple: on every other pixel (a 2×2
 //!   checkerboard fixed on the screen) they are composited over the tissue, unveiled, so a
 //!   vessel behind the wall shows without hiding the wall;
-//! - where the ray meets no tissue, the geometry is drawn solid.
+//! - where the ray meets no tissue, the geometry is drawn solid;
+//! - a closed mesh around the eye is not drawn (its inside would hide the view) but tints the
+//!   whole view with its colour (the paper's "colour overlay ... if one is inside a polygonal
+//!   mesh").
 //!
 //! The frame's depth becomes the nearest opaque surface's (the geometry's or the tissue's);
-//! pixels whose ray meets no geometry keep their colour and depth, bit for bit.
+//! pixels whose ray meets no geometry keep their colour and depth, bit for bit (but for the
+//! tint of a mesh around the eye).
 //!
 //! [`SecretionMode::On`]: super::SecretionMode::On
 
@@ -45,15 +49,34 @@ pub fn shade_with_scene(
 ) -> Result<Frame, LookError> {
     let mut frame = shade(gbuffer, camera, shading)?;
     if let Some(scene) = scene.filter(|s| !s.is_empty()) {
+        let (outside, around) = scene.without_enclosing(camera.eye_mm());
         let compositor = Compositor {
             shading,
             camera,
             tip: camera.eye_mm().as_vec3(),
             secretion_mm: &gbuffer.secretion_mm,
         };
-        compositor.run(&scene.placed(camera), &mut frame);
+        compositor.run(&outside.placed(camera), &mut frame);
+        for material in around {
+            tint(&mut frame, material.color, INSIDE_TINT * material.opacity);
+        }
     }
     Ok(frame)
+}
+
+/// Share of the colour a mesh around the eye takes in the tint it lays over the view (times
+/// the mesh's opacity).
+const INSIDE_TINT: f32 = 0.3;
+
+/// Blends everything drawn in `frame` toward `color` by `share`: the colour overlay of a mesh
+/// around the eye, whose inside is not drawn (it would hide the view).
+fn tint(frame: &mut Frame, color: [f32; 3], share: f32) {
+    frame.color.par_iter_mut().for_each(|p| {
+        let drawn = 1.0 - p.transmittance;
+        for (c, tinted) in p.rgb.iter_mut().zip(color) {
+            *c += share * (tinted * drawn - *c);
+        }
+    });
 }
 
 /// Whether pixel `(x, y)` shows the geometry behind the tissue: the stipple, a checkerboard.

@@ -7,7 +7,7 @@ use crate::camera::Ray;
 use crate::phantom::profile::{paint, ramp, AIR_HU, TISSUE_HU};
 use crate::phantom::{rasterize, PhantomOptions, SECRETION_HU};
 use crate::render::{Camera, Quality, RenderSettings, Renderer};
-use crate::scene::{Marker, Material, Scene};
+use crate::scene::{Marker, Material, Scene, TriangleMesh};
 use crate::Volume;
 use glam::DVec3;
 use std::sync::Arc;
@@ -201,4 +201,48 @@ fn geometry_where_no_ray_meets_tissue_is_drawn_solid_and_sets_the_depth() {
     let frame = shade_with_scene(&empty, &camera, &red_and_green(), Some(&glass)).unwrap();
     assert_eq!(frame.color[i].transmittance, 0.25);
     assert!(frame.depth_mm[i].is_nan());
+}
+
+/// A closed octahedron of half-diagonal `r` mm around `centre` (its triangles wound either way).
+fn octahedron(centre: DVec3, r: f64) -> TriangleMesh {
+    let corners = [
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ];
+    let vertices = corners.iter().map(|c| centre + *c * r).collect();
+    let mut triangles = Vec::new();
+    for (a, b) in [(0, 2), (2, 1), (1, 3), (3, 0)] {
+        triangles.extend([[a, b, 4], [a, b, 5]]);
+    }
+    TriangleMesh::new(vertices, triangles).unwrap()
+}
+
+#[test]
+fn a_mesh_around_the_eye_tints_the_view_instead_of_hiding_it() {
+    let (gbuffer, camera, _) = traced(wall(false), SecretionMode::Off);
+    let shading = red_and_green();
+    let plain = shade(&gbuffer, &camera, &shading).unwrap();
+    let blue = Material::new([0.0, 0.0, 1.0], 1.0).unwrap();
+    let mut scene = Scene::new();
+    // Around the eye (the wall 18 mm ahead lies outside it), and one behind the eye.
+    scene.add_mesh(&octahedron(camera.eye_mm(), 6.0), blue);
+    scene.add_mesh(
+        &octahedron(camera.eye_mm() - DVec3::new(0.0, 0.0, 30.0), 1.5),
+        blue,
+    );
+    let (outside, around) = scene.without_enclosing(camera.eye_mm());
+    assert_eq!(around, [blue]);
+    assert!(!outside.is_empty());
+    let tinted = shade_with_scene(&gbuffer, &camera, &shading, Some(&scene)).unwrap();
+    assert_eq!(tinted.depth_mm, plain.depth_mm);
+    for (t, p) in tinted.color.iter().zip(&plain.color) {
+        let expected = [0.7 * p.rgb[0], 0.0, 0.3 * (1.0 - p.transmittance)];
+        for (t, e) in t.rgb.iter().zip(expected) {
+            assert!((t - e).abs() < 1e-6, "{t} ≠ {e}");
+        }
+    }
 }

@@ -19,7 +19,8 @@
 //! [`shade_with_scene`] composites scene geometry (meshes, overlays, markers, the grid, the
 //! instruments) into the shaded frame by depth, as the paper's composition does its polygonal
 //! data: solid in front of the tissue, through a stipple behind it, veiled only by the
-//! secretion in front of it; [`still()`] and the flights take the scene.
+//! secretion in front of it, a closed mesh around the eye as a tint; [`still()`] and the
+//! flights take the scene.
 //!
 //! Below full quality, [`shade_reduced`] runs the deferred stage at the reduced size of a
 //! G-buffer traced there and upsamples the shaded frame.
