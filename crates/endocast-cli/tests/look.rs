@@ -116,6 +116,55 @@ fn looks_secretion_wetness_texture_and_attenuation_change_the_image() {
     assert_ne!(still, realistic);
 }
 
+/// A closed octahedron of half-diagonal 1 mm around `(0, 0, z)` (world mm), as OBJ text.
+fn octahedron_obj(z: f64) -> String {
+    let corners = [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let mut obj: String = corners
+        .iter()
+        .map(|[x, y, dz]| format!("v {x} {y} {}\n", z + dz))
+        .collect();
+    for (a, b) in [(1, 3), (3, 2), (2, 4), (4, 1)] {
+        obj += &format!("f {a} {b} 5\nf {b} {a} 6\n");
+    }
+    obj
+}
+
+#[test]
+fn geometry_is_drawn_in_the_realistic_look_in_front_and_behind_the_tissue() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = layered(dir.path());
+    let png = dir.path().join("view.png");
+    let (depth, mesh) = (dir.path().join("depth.npy"), dir.path().join("tip.obj"));
+    // In the air 5.5 mm ahead of the eye, its corner toward it: 4.5 mm before the secretion.
+    std::fs::write(&mesh, octahedron_obj(-11.0)).unwrap();
+    let [depth_arg, mesh_arg] = [&depth, &mesh].map(|p| p.to_str().unwrap());
+    let look = ["--look", "realistic", "--depth-out", depth_arg];
+    let without = render(&volume, &png, &look);
+    let tissue = read_npy(&depth).1[16 * 32 + 16];
+    let with = render(&volume, &png, &[&look[..], &["--mesh", mesh_arg]].concat());
+    assert_ne!(with, without);
+    let nearest = read_npy(&depth).1[16 * 32 + 16];
+    // Its corner 5.5 mm away, the centre pixel's ray passing half a pixel beside it.
+    assert!((5.5..6.0).contains(&nearest), "the mesh at {nearest} mm");
+    // A marker inside the tissue shows through its stipple; the depth stays the tissue's.
+    let marker = ["--marker", "0,0,8:4"];
+    let behind = render(&volume, &png, &[&look[..], &marker].concat());
+    assert_ne!(behind, without);
+    assert_eq!(read_npy(&depth).1[16 * 32 + 16], tissue);
+    // A stereo pair is not drawn in a look yet.
+    let stereo = ["--look", "realistic", "--stereo", "anaglyph"];
+    let mut args = vec!["render", volume.to_str().unwrap(), "-o", "/tmp/never.png"];
+    args.extend_from_slice(&stereo);
+    fails_with(&args, "no stereo pair yet");
+}
+
 #[test]
 fn bad_look_values_are_refused_with_a_clear_message() {
     let dir = tempfile::tempdir().unwrap();

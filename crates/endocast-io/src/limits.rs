@@ -212,7 +212,8 @@ impl RenderKind {
     ///   still's mean, or the last frame, the mean and the copy handed out;
     /// - look: beside the still's mean, a pass's frame being rendered, or that frame with the
     ///   hit positions, normals and secretion the search beyond secretion adds, or the
-    ///   G-buffer and its shaded frame;
+    ///   G-buffer and its shaded frame (scene geometry is composited into that frame in place,
+    ///   with a block of rays per thread);
     /// - stereo: the left eye's frame beside the right one being rendered and the start-up
     ///   the right eye reuses, or both frames, their 8-bit images and the combined image (side
     ///   by side: two) with the encoder's copies;

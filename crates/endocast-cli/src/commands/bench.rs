@@ -21,6 +21,7 @@ use endocast_core::render::{
     Camera, Frame, Layers, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings,
     Renderer, StereoFrames,
 };
+use endocast_core::scene::Scene;
 use endocast_core::Volume;
 use endocast_io::route_file::{read_camera_path, CameraPath};
 use endocast_io::{Limits, OpenOptions, RenderKind};
@@ -76,7 +77,8 @@ pub struct BenchArgs {
     #[arg(long, value_name = "TEXT")]
     rows: Vec<String>,
     /// Geometry drawn in every frame (the cost of meshes, a grid, the endoscope): each camera
-    /// is also rendered without it, and each setting reports the per-frame ratio.
+    /// is also rendered without it, and each setting reports the per-frame ratio; a look's
+    /// deferred stage is also timed with the geometry composited (at full quality).
     #[command(flatten)]
     scene: SceneArgs,
     /// Also append one JSON line per measured setting to this file.
@@ -150,12 +152,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         if let Some(look) = &cell.look {
             let pass =
                 RayPass::new(&renderer, &cell.settings, &look.ray).context("invalid look")?;
-            let (whole, deferred) = in_pool(args.look.threads, || {
-                measure_look(&pass, &look.shading, args.quality, &cameras)
+            let stages = (&pass, &look.shading, scene.as_deref());
+            let timed = in_pool(args.look.threads, || {
+                measure_look(stages, args.quality, &cameras)
             })??;
-            report(args, optics.field, &cell.name, &whole, None)?;
+            report(args, optics.field, &cell.name, &timed.whole, None)?;
             let name = format!("{}: its deferred stage alone", cell.name);
-            report(args, optics.field, &name, &deferred, None)?;
+            report(args, optics.field, &name, &timed.deferred, None)?;
+            if let Some(geometry) = &timed.geometry {
+                let name = format!("{}: its deferred stage with the geometry", cell.name);
+                report(args, optics.field, &name, geometry, None)?;
+            }
             continue;
         }
         let mut prepared = renderer
@@ -289,16 +296,27 @@ fn measure(
     }
 }
 
-/// Renders every camera with a look's ray `pass` at `quality` and shades it (below full
-/// quality both stages at the reduced size, the shaded frame upsampled); returns the timings of
-/// the whole frame and of the deferred stage (smoothing, shading, upsampling) alone.
+/// The timings of a look along the path: whole frames, their deferred stage alone, and with
+/// geometry that deferred stage with the geometry composited.
+struct LookTimed {
+    whole: Measured,
+    deferred: Measured,
+    geometry: Option<Measured>,
+}
+
+/// Renders every camera with a look's ray `pass` at `quality` and shades it as `shading` says
+/// (below full quality both stages at the reduced size, the shaded frame upsampled); with a
+/// `scene` (full quality only) also shades each G-buffer again with the scene composited.
 fn measure_look(
-    pass: &RayPass,
-    shading: &Shading,
+    (pass, shading, scene): (&RayPass, &Shading, Option<&Scene>),
     quality: Quality,
     cameras: &[Camera],
-) -> Result<(Measured, Measured)> {
+) -> Result<LookTimed> {
+    if scene.is_some() && quality != Quality::Full {
+        bail!("bench times a look's geometry at --quality full only");
+    }
     let (mut whole, mut deferred) = (Measured::default(), Measured::default());
+    let mut geometry = scene.map(|_| Measured::default());
     for camera in cameras {
         let start = Instant::now();
         let small = reduced_camera(camera, quality.reduced_size(camera.size()));
@@ -309,8 +327,17 @@ fn measure_look(
         whole.ms.push((end - start).as_secs_f64() * 1e3);
         whole.samples += gbuffer.stats.samples;
         deferred.ms.push((end - shaded).as_secs_f64() * 1e3);
+        if let Some(measured) = &mut geometry {
+            let start = Instant::now();
+            look::shade_with_scene(&gbuffer, camera, shading, scene).context("invalid look")?;
+            measured.ms.push(start.elapsed().as_secs_f64() * 1e3);
+        }
     }
-    Ok((whole, deferred))
+    Ok(LookTimed {
+        whole,
+        deferred,
+        geometry,
+    })
 }
 
 /// A `--quality` level by name.

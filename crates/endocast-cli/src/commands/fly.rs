@@ -168,8 +168,8 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
     let scene = args.scene.scene()?;
-    if look.is_some() && (scene.is_some() || stereo.is_some()) {
-        bail!("--look clinical and realistic draw no geometry and no stereo pair yet; use --look plain");
+    if look.is_some() && stereo.is_some() {
+        bail!("--look clinical and realistic draw no stereo pair yet; use --look plain");
     }
     flight.set_scene(scene);
     flight.set_look(look);

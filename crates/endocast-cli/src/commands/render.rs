@@ -116,8 +116,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .prepare(settings)
         .context("invalid render settings")?;
     let scene = args.scene.scene()?;
-    if look.look.is_some() && (scene.is_some() || args.stereo.stereo.is_some()) {
-        bail!("--look clinical and realistic draw no geometry and no stereo pair yet; use --look plain");
+    if look.look.is_some() && args.stereo.stereo.is_some() {
+        bail!("--look clinical and realistic draw no stereo pair yet; use --look plain");
     }
     prepared.set_scene(scene);
     if let Some([x, y]) = args.debug_pixel {

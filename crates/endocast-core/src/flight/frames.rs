@@ -6,7 +6,7 @@ use super::Shot;
 use crate::annotate::{self, Annotations, DrawOptions, SurfaceView};
 use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
-use crate::look::{shade, Look, RayPass};
+use crate::look::{shade_with_scene, Look, RayPass};
 use crate::render::{
     Camera, Frame, Prepared, Quality, RenderSettings, RenderStats, Renderer, StereoFrames,
 };
@@ -108,8 +108,8 @@ impl Flight {
     }
 
     /// Shows the endoscope frames in `look` (clinical or realistic; `None`: the renderer's own
-    /// image) from now on. A look draws no scene geometry and no stereo pair: those frames
-    /// stay plain.
+    /// image) from now on, the scene composited into them by depth. A look draws no stereo
+    /// pair: those frames stay plain.
     pub fn set_look(&mut self, look: Option<Look>) {
         self.look = look;
         self.look_pass = None;
@@ -243,7 +243,9 @@ impl Flight {
                         let slot = &mut self.look_pass;
                         let pass = look_pass(slot, &self.renderer, settings, look)?;
                         let gbuffer = pass.trace(&camera, Quality::Full);
-                        self.frames.eyes[0] = shade(&gbuffer, &camera, &look.shading)?;
+                        let scene = self.scene.as_deref();
+                        self.frames.eyes[0] =
+                            shade_with_scene(&gbuffer, &camera, &look.shading, scene)?;
                     }
                     None => prepared.render_into(&camera, &mut self.frames.eyes[0]),
                 }

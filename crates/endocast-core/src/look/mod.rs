@@ -16,6 +16,12 @@
 //!    texture ([`Texture`]) and secretion fog. Changing any of it never marches a ray again:
 //!    [`shade`] takes a `&GBuffer` and no renderer.
 //!
+//! [`shade_with_scene`] composites scene geometry (meshes, overlays, markers, the grid, the
+//! instruments) into the shaded frame by depth, as the paper's composition does its polygonal
+//! data: solid in front of the tissue, through a stipple behind it, veiled only by the
+//! secretion in front of it, a closed mesh around the eye as a tint; [`still()`] and the
+//! flights take the scene.
+//!
 //! Below full quality, [`shade_reduced`] runs the deferred stage at the reduced size of a
 //! G-buffer traced there and upsamples the shaded frame.
 //!
@@ -51,6 +57,7 @@
 
 mod deferred;
 mod gbuffer;
+mod geometry;
 mod kind;
 mod lanes;
 mod reduced;
@@ -64,10 +71,13 @@ mod texture;
 #[cfg(test)]
 mod deferred_tests;
 #[cfg(test)]
+mod geometry_tests;
+#[cfg(test)]
 mod tests;
 
 pub use deferred::shade;
 pub use gbuffer::{GBuffer, RayPass};
+pub use geometry::shade_with_scene;
 pub use kind::{Look, LookKind, PresetLook};
 pub use reduced::shade_reduced;
 pub use settings::{RayPassSettings, SecretionMode};

@@ -112,7 +112,7 @@ impl Shading {
 
     /// The tip's light at `depth_mm`, 0–1.
     #[inline(always)]
-    fn falloff(&self, depth_mm: f32) -> f32 {
+    pub(super) fn falloff(&self, depth_mm: f32) -> f32 {
         self.attenuation_mm.map_or(1.0, |half| {
             let r = depth_mm / half;
             1.0 / (1.0 + r * r)

@@ -2,19 +2,22 @@
 //! pixel, the interleaved sample grid shifted along the ray), each shaded and averaged — the
 //! library's still mode ([`crate::render::Still`]) for the two-stage look.
 
-use super::deferred::shade;
 use super::gbuffer::RayPass;
+use super::geometry::shade_with_scene;
 use super::shading::Shading;
 use super::{Look, LookError};
 use crate::camera::Camera;
 use crate::render::{Frame, Jitter, Prepared, Quality, RenderOptions, Still};
+use crate::scene::Scene;
 
-/// The average of `frames` (at least one) shaded ray passes of `camera` by `pass`, frame `k`
-/// jittered as [`Jitter::of_frame`]`(k)` says (frame 0 is the plain pass).
+/// The average of `frames` (at least one) shaded ray passes of `camera` by `pass`, with `scene`
+/// composited ([`shade_with_scene`]), frame `k` jittered as [`Jitter::of_frame`]`(k)` says
+/// (frame 0 is the plain pass).
 pub fn still(
     pass: &RayPass,
     camera: &Camera,
     shading: &Shading,
+    scene: Option<&Scene>,
     frames: usize,
 ) -> Result<Frame, LookError> {
     let mut still = Still::new();
@@ -23,7 +26,7 @@ pub fn still(
         let (dx, dy) = jitter.pixel_offset;
         let jittered = camera.with_pixel_offset(dx, dy);
         let gbuffer = pass.trace_shifted(&jittered, Quality::Full, jitter.grid_shift);
-        still.add(&shade(&gbuffer, &jittered, shading)?);
+        still.add(&shade_with_scene(&gbuffer, &jittered, shading, scene)?);
     }
     Ok(still.frame().clone())
 }
@@ -32,8 +35,8 @@ pub fn still(
 pub const MAX_STILL_FRAMES: usize = 256;
 
 /// A converged still of `camera`: the average of `frames` (at least one) jittered frames, drawn
-/// as `look` says over `prepared`'s settings, or `prepared`'s own image without a look (the
-/// plain look, its geometry included).
+/// as `look` says over `prepared`'s settings with `prepared`'s scene composited, or
+/// `prepared`'s own image without a look (the plain look, its geometry included).
 pub fn still_view(
     prepared: &Prepared,
     look: Option<&Look>,
@@ -42,7 +45,8 @@ pub fn still_view(
 ) -> Result<Frame, LookError> {
     if let Some(look) = look {
         let pass = RayPass::new(prepared.renderer(), prepared.settings(), &look.ray)?;
-        return still(&pass, camera, &look.shading, frames);
+        let scene = prepared.scene().map(|s| &**s);
+        return still(&pass, camera, &look.shading, scene, frames);
     }
     let mut still = Still::new();
     for _ in 0..frames.max(1) {

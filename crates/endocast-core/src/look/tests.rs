@@ -367,7 +367,7 @@ fn half_quality_and_stills_give_the_camera_s_size() {
     let shading = Look::of_kind(LookKind::Realistic, &PresetLook::CT)
         .unwrap()
         .shading;
-    let converged = still(&pass, &camera, &shading, 4).unwrap();
+    let converged = still(&pass, &camera, &shading, None, 4).unwrap();
     let single = shade(&full, &camera, &shading).unwrap();
     assert_eq!([converged.width, converged.height], [20, 20]);
     assert_ne!(converged.color, single.color);

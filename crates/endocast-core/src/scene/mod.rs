@@ -189,6 +189,25 @@ impl Scene {
         }
     }
 
+    /// The scene without the meshes that enclose `point_mm`, and those meshes' materials. A
+    /// mesh encloses the point when rays from it cross the mesh an odd number of times (two of
+    /// three rays in fixed directions, so a ray through an edge does not decide): closed
+    /// meshes only, whatever the winding of their triangles.
+    pub fn without_enclosing(&self, point_mm: DVec3) -> (Scene, Vec<Material>) {
+        let mut outside = Scene {
+            objects: Vec::new(),
+            endoscope: self.endoscope,
+        };
+        let mut around = Vec::new();
+        for object in &self.objects {
+            match &object.shape {
+                Shape::Mesh(bvh) if encloses(bvh, point_mm) => around.push(object.material),
+                _ => outside.objects.push(object.clone()),
+            }
+        }
+        (outside, around)
+    }
+
     /// [`PlacedScene::trace`] for a scene without an endoscope (the instruments need a camera).
     pub fn trace(&self, ray: &Ray, t_min: f64, t_max: f64, hits: &mut Vec<Hit>) {
         let placed = PlacedScene {
@@ -362,6 +381,26 @@ impl PlacedScene<'_> {
             hits.extend(*opaque);
         }
     }
+}
+
+/// Whether the mesh of `bvh` encloses `point_mm`: an odd number of crossings along two of
+/// three rays from it (directions along no axis or diagonal of a voxel grid).
+fn encloses(bvh: &Bvh, point_mm: DVec3) -> bool {
+    const DIRECTIONS: [Vec3; 3] = [
+        Vec3::new(0.31, 0.52, 0.79),
+        Vec3::new(-0.67, 0.21, -0.71),
+        Vec3::new(0.11, -0.88, 0.46),
+    ];
+    let origin = point_mm.as_vec3();
+    let odd = DIRECTIONS.iter().filter(|&&dir| {
+        let mut crossings = 0usize;
+        bvh.traverse(origin, dir, 0.0, f32::INFINITY, |_, _| {
+            crossings += 1;
+            f32::INFINITY
+        });
+        crossings % 2 == 1
+    });
+    odd.count() >= 2
 }
 
 thread_local! {
