@@ -58,11 +58,6 @@ pub fn fly<'py>(
     let optics = optics(&kw, look.study.preset(), volume.volume(), fov)?;
     let files = SceneFiles::take(&kw)?;
     kw.finish()?;
-    if look.look.is_some() && !files.is_empty() {
-        return Err(error(
-            "the clinical and realistic looks draw no geometry yet; use look=\"plain\"",
-        ));
-    }
     let (scene, partial) = py.detach(|| files.read())?;
     warn(py, &partial)?;
     let options = FlightOptions {

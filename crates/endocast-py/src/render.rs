@@ -88,10 +88,9 @@ pub fn render<'py>(
             "still must be between 1 and {MAX_STILL_FRAMES} frames, not {still}"
         )));
     }
-    if look.look.is_some() && (stereo.is_some() || !files.is_empty()) {
+    if look.look.is_some() && stereo.is_some() {
         return Err(error(
-            "the clinical and realistic looks draw no geometry and no stereo pair yet; use \
-             look=\"plain\"",
+            "the clinical and realistic looks draw no stereo pair yet; use look=\"plain\"",
         ));
     }
     let kind = RenderKind::of(look.look.as_ref(), stereo.is_some());

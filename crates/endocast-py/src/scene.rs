@@ -26,11 +26,6 @@ impl SceneFiles {
         })
     }
 
-    /// Whether the call names no geometry.
-    pub fn is_empty(&self) -> bool {
-        self.meshes.is_empty() && self.overlays.is_empty()
-    }
-
     /// The scene of the files (slow for large meshes: call it without the GIL), `None` when
     /// there are none; with a line for each overlay not drawn whole (a segment too thin, a dose
     /// level outside the grid's range), for a Python warning.

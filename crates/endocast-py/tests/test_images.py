@@ -146,5 +146,10 @@ def test_meshes_and_overlays_are_the_clis(cli, colon, tmp_path):
     np.testing.assert_array_equal(rgba[..., :3], theirs)
     bare, _ = endocast.render(volume, preset="colonoscopy", size=(40, 32))
     assert (rgba != bare).any(), "the mesh is not in view"
+    looked, _ = endocast.render(volume, preset="colonoscopy", size=(40, 32), look="clinical",
+                                meshes=[stl])
+    theirs = cli_image(cli, tmp_path, colon, "--preset", "colonoscopy", "--look", "clinical",
+                       "--mesh", stl)
+    np.testing.assert_array_equal(looked[..., :3], theirs)
     with pytest.raises(endocast.EndocastError, match="gone.dcm"):
         endocast.render(volume, size=(8, 8), overlays=[tmp_path / "gone.dcm"])
