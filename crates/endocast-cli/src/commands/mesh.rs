@@ -7,7 +7,10 @@ use crate::parse::parse_vec3;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::isosurface::{isosurface, lumen_surface};
-use endocast_core::navigate::{Lumen, LumenSide};
+use crate::study_report;
+use endocast_core::navigate::{seed_voxel, Lumen, LumenSide};
+use endocast_core::pose::Pose;
+use endocast_core::study::{Study, StudyRequest};
 use glam::DVec3;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -20,14 +23,16 @@ pub struct MeshArgs {
     /// Output mesh: .stl (binary), .obj or .ply (binary), written atomically.
     #[arg(short, long)]
     output: PathBuf,
-    /// Isovalue of the wall, physical units (HU for CT).
+    /// Isovalue of the wall, physical units (HU for CT); default: the preset's in the scan's
+    /// units, else the scan's own wall (as `render`).
     #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
     iso: Option<f64>,
     /// Take the isovalue (and which side is the lumen) from a procedure preset.
     #[arg(long)]
     preset: Option<String>,
     /// A point in the lumen (world mm): only the surface of the connected lumen around it (a
-    /// closed lumen gives a watertight mesh). Without it, the isosurface of the whole volume.
+    /// closed lumen gives a watertight mesh). Without it, the structure the preset finds (the
+    /// airways, the aorta, …; with no --iso), else the isosurface of the whole volume.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     from: Option<[f64; 3]>,
     /// The lumen is brighter than the wall (contrast); default: the preset's, else darker.
@@ -37,40 +42,46 @@ pub struct MeshArgs {
 
 /// Runs `endocast mesh`.
 pub fn run(args: &MeshArgs) -> Result<()> {
-    let preset = args.preset.as_deref().map(find_preset).transpose()?;
-    let Some(iso) = args.iso.or(preset.map(|p| p.iso)) else {
-        bail!("give --iso or --preset");
-    };
-    if !iso.is_finite() {
-        bail!("--iso {iso} is not a finite number");
+    if args.iso.is_some_and(|iso| !iso.is_finite()) {
+        bail!("--iso must be a finite number");
     }
-    let side = match (args.bright_lumen, preset.and_then(|p| p.lumen)) {
-        (true, _) => LumenSide::Above,
-        (false, Some(lumen)) => lumen.side,
-        (false, None) => LumenSide::Below,
-    };
+    let preset = args.preset.as_deref().map(find_preset).transpose()?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
     let volume = &loaded.volume;
+    // The scan understood as `render` and `path` understand it: the preset in the scan's own
+    // units, the wall and the lumen's side, the structure it names.
+    let request = StudyRequest {
+        preset,
+        iso: args.iso,
+        bright_lumen: args.bright_lumen,
+        // With --from no structure is searched: the pose only says so.
+        pose: args.from.map(|p| Pose {
+            eye_mm: DVec3::from(p),
+            look_at_mm: DVec3::from(p) + DVec3::Z,
+            up: DVec3::Y,
+        }),
+        ..StudyRequest::default()
+    };
+    let study = Study::resolve(volume, &request);
+    study_report::say(&study);
+    let iso = study.settings().iso_hu;
+    let side = study.lumen().map_or(LumenSide::Below, |(_, side)| side);
     let start = Instant::now();
-    let mesh = match args.from {
-        Some(point) => {
-            let g = volume.geometry();
-            let v = g
-                .voxel_from_world()
-                .transform_point3(DVec3::from(point))
-                .round();
-            let dims = volume.dims();
-            if v.cmplt(DVec3::ZERO).any() || (0..3).any(|a| v[a] >= dims[a] as f64) {
-                bail!("--from {point:?} lies outside the volume");
-            }
-            let seed = [v.x as usize, v.y as usize, v.z as usize];
+    let mesh = match (args.from, study.structure()) {
+        (Some(point), _) => {
+            let seed = seed_voxel(volume, DVec3::from(point))
+                .map_err(|_| anyhow::anyhow!("--from {point:?} lies outside the volume"))?;
             let lumen = Lumen::from_seed(volume, seed, iso, side).context("no lumen at --from")?;
             lumen_surface(volume, &lumen)
         }
-        None => isosurface(volume, iso, side),
+        (None, Some(structure)) if args.iso.is_none() => {
+            eprintln!("the surface of the {} the preset found", study.structure_name().unwrap_or("structure"));
+            lumen_surface(volume, structure)
+        }
+        _ => isosurface(volume, iso, side),
     }
     .context("no surface at this isovalue")?;
     let extract_ms = start.elapsed().as_secs_f64() * 1e3;
