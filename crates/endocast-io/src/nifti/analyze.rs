@@ -139,37 +139,49 @@ fn zooms(path: &Path, header: &Header, warnings: &mut Vec<String>) -> DVec3 {
 }
 
 /// The affine of the `.mat` file `mat` beside the header `path` (RAS mm from voxel index), and
-/// whether x was negated by convention (its `M`); `None` when there is none, or none usable
-/// (with a warning).
+/// whether x was negated by convention (its `M`); `None` when there is none (or it is empty,
+/// which nibabel skips too), or none usable (with a warning).
 fn mat_affine(path: &Path, mat: &Path, warnings: &mut Vec<String>) -> Option<(DAffine3, bool)> {
     if !mat.exists() {
         return None;
     }
-    let matrices = match read_mat(path, mat) {
-        Ok(matrices) => matrices,
+    match read_mat(path, mat).and_then(|matrices| spm_affine(&matrices)) {
+        Ok(found) => found,
         Err(why) => {
             warnings.push(format!(
-                "{}: not read ({why}); the geometry comes from the Analyze header, where SPM and \
+                "{}: not used ({why}); the geometry comes from the Analyze header, where SPM and \
                  nibabel would take it from this file",
                 mat.display()
             ));
-            return None;
+            None
         }
-    };
+    }
+}
+
+/// nibabel's reading of SPM's matrices: `mat`, else `M` with x negated (and `true`), each moved
+/// from MATLAB's first voxel (1, 1, 1) to 0; `None` for a file without matrices.
+fn spm_affine(matrices: &[Matrix]) -> std::result::Result<Option<(DAffine3, bool)>, String> {
+    if matrices.is_empty() {
+        return Ok(None);
+    }
     let find = |name: &str| matrices.iter().find(|m| m.name == name);
-    let (affine, flip_assumed) = match (find("mat"), find("M")) {
-        (Some(mat), _) => (affine_4x4(mat)?, false),
-        (None, Some(m)) => (
-            DAffine3::from_scale(DVec3::new(-1.0, 1.0, 1.0)) * affine_4x4(m)?,
-            true,
-        ),
-        (None, None) => return None,
+    let (matrix, flip_assumed) = match (find("mat"), find("M")) {
+        (Some(mat), _) => (mat, false),
+        (None, Some(m)) => (m, true),
+        (None, None) => return Err("it holds neither a mat nor an M matrix".into()),
     };
-    // MATLAB's first voxel is (1, 1, 1).
-    Some((
-        affine * DAffine3::from_translation(DVec3::ONE),
-        flip_assumed,
-    ))
+    if (matrix.rows, matrix.cols) != (4, 4) {
+        return Err(format!(
+            "its {} is {}×{}, not 4×4",
+            matrix.name, matrix.rows, matrix.cols
+        ));
+    }
+    let values: [f64; 16] = matrix.values.clone().try_into().unwrap_or_default();
+    let flip = if flip_assumed { -1.0 } else { 1.0 };
+    let affine = DAffine3::from_scale(DVec3::new(flip, 1.0, 1.0))
+        * DAffine3::from_mat4(DMat4::from_cols_array(&values))
+        * DAffine3::from_translation(DVec3::ONE);
+    Ok(Some((affine, flip_assumed)))
 }
 
 /// The matrices of the `.mat` file (plain or gzip) beside the header `path`, or why they could
@@ -188,15 +200,6 @@ fn read_mat(path: &Path, mat: &Path) -> std::result::Result<Vec<Matrix>, String>
         return Err(format!("larger than {MAX_MAT_BYTES} bytes"));
     }
     mat4::parse(&bytes)
-}
-
-/// A 4×4 matrix as an affine (its last row dropped), or `None` for another size.
-fn affine_4x4(matrix: &Matrix) -> Option<DAffine3> {
-    if (matrix.rows, matrix.cols) != (4, 4) {
-        return None;
-    }
-    let values: [f64; 16] = matrix.values.clone().try_into().ok()?;
-    Some(DAffine3::from_mat4(DMat4::from_cols_array(&values)))
 }
 
 #[cfg(test)]
@@ -269,5 +272,28 @@ mod tests {
         h.scl_inter = f64::NAN;
         let r = rescale(p, &h, &s, &mut w);
         assert_eq!((r.slope, r.intercept), (2.0, 0.0));
+    }
+
+    #[test]
+    fn spm_matrices_are_mat_else_m_flipped_from_one_based_voxels() {
+        let matrix = |name: &str, rows: usize, cols: usize| Matrix {
+            name: name.into(),
+            rows,
+            cols,
+            values: DMat4::from_diagonal(glam::DVec4::new(2.0, 3.0, 4.0, 1.0)).to_cols_array()
+                [..rows * cols]
+                .to_vec(),
+        };
+        let (mat, flipped) = spm_affine(&[matrix("M", 4, 4), matrix("mat", 4, 4)])
+            .unwrap()
+            .unwrap();
+        assert!(!flipped);
+        assert_eq!(mat.translation, DVec3::new(2.0, 3.0, 4.0));
+        let (m, flipped) = spm_affine(&[matrix("M", 4, 4)]).unwrap().unwrap();
+        assert!(flipped);
+        assert_eq!(m.translation, DVec3::new(-2.0, 3.0, 4.0));
+        assert_eq!(spm_affine(&[]), Ok(None));
+        assert!(spm_affine(&[matrix("x", 4, 4)]).is_err());
+        assert!(spm_affine(&[matrix("mat", 3, 4)]).is_err());
     }
 }
