@@ -78,9 +78,9 @@ fn spm_scale_intercept_and_origin_apply() {
     assert_eq!(v.physical(2, 1, 1), Some(11.0));
     // Voxel origin − 1 = (1, 0, 0) at 0 mm, the product taken in float32 as nibabel does.
     let ras = ras_of(&loaded);
-    let zooms = DVec3::new(-0.7f32 as f64, 0.9f32 as f64, 1.3f32 as f64);
+    let zooms = DVec3::from([-0.7f32, 0.9, 1.3].map(f64::from));
     assert_eq!(ras.matrix3, DMat3::from_diagonal(zooms));
-    assert_eq!(ras.translation, DVec3::new(0.7f32 as f64, 0.0, 0.0));
+    assert_eq!(ras.translation, DVec3::new(f64::from(0.7f32), 0.0, 0.0));
 }
 
 #[test]
