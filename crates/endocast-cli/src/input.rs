@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 /// How to read the input scan.
 #[derive(Args, Debug)]
 pub struct InputArgs {
-    /// The scan: a DICOM directory or file, .nii/.nii.gz, .nrrd/.nhdr, .mha/.mhd, or a raw file.
+    /// The scan: a DICOM directory or file, .nii/.nii.gz, .hdr with its .img (NIfTI or Analyze
+    /// 7.5), .nrrd/.nhdr, .mha/.mhd, or a raw file.
     pub path: PathBuf,
     /// DICOM: load this SeriesInstanceUID instead of the largest series.
     #[arg(long, value_name = "UID")]

@@ -15,6 +15,8 @@ pub enum Format {
     Dicom,
     /// NIfTI-1 or NIfTI-2, optionally gzip-compressed.
     Nifti,
+    /// An Analyze 7.5 header (`.hdr`) and its voxels (`.img`), each optionally gzip-compressed.
+    Analyze,
     /// NRRD, attached (`.nrrd`) or detached (`.nhdr`).
     Nrrd,
     /// MetaImage (`.mha`, or `.mhd` with a separate data file).
@@ -29,6 +31,7 @@ impl Format {
         match self {
             Self::Dicom => "DICOM",
             Self::Nifti => "NIfTI",
+            Self::Analyze => "Analyze 7.5",
             Self::Nrrd => "NRRD",
             Self::MetaImage => "MetaImage",
             Self::Raw => "raw",

@@ -29,7 +29,7 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     };
     let loaded = match format {
         Format::Dicom => dicom::read(path, options),
-        Format::Nifti => nifti::read(path, options),
+        Format::Nifti | Format::Analyze => nifti::read(path, options),
         Format::Nrrd => nrrd::read(path, options),
         Format::MetaImage => metaimage::read(path, options),
         Format::Raw => raw::read(path, options),
@@ -136,12 +136,19 @@ fn sniff(path: &Path) -> Result<Format> {
     {
         // A gzip stream without a telling name is most likely a .nii.gz.
         Ok(Format::Nifti)
+    } else if head.len() >= 348
+        && [348i32.to_le_bytes(), 348i32.to_be_bytes()]
+            .iter()
+            .any(|sizeof_hdr| head.starts_with(sizeof_hdr))
+    {
+        // Analyze 7.5 has no magic: sizeof_hdr is all there is to go by.
+        Ok(Format::Analyze)
     } else if head.starts_with(b"ObjectType") || head.starts_with(b"NDims") {
         Ok(Format::MetaImage)
     } else {
         Err(ReadError::unsupported(
             path,
-            "file format: not DICOM, NIfTI, NRRD or MetaImage by name or content \
+            "file format: not DICOM, NIfTI, Analyze, NRRD or MetaImage by name or content \
              (for a headerless file give --raw-dims, --raw-type and --raw-spacing)",
         ))
     }

@@ -160,8 +160,8 @@ fn scaled_values_round_trip_exactly_as_uint16_with_slope() {
 }
 
 /// A NIfTI header written field by field, in either byte order.
-struct Hdr {
-    bytes: Vec<u8>,
+pub(crate) struct Hdr {
+    pub(crate) bytes: Vec<u8>,
     big: bool,
 }
 
@@ -174,28 +174,28 @@ impl Hdr {
         self.bytes[at..at + raw.len()].copy_from_slice(&raw);
         self
     }
-    fn i16(self, at: usize, v: i16) -> Self {
+    pub(crate) fn i16(self, at: usize, v: i16) -> Self {
         self.put(at, &v.to_le_bytes())
     }
-    fn i32(self, at: usize, v: i32) -> Self {
+    pub(crate) fn i32(self, at: usize, v: i32) -> Self {
         self.put(at, &v.to_le_bytes())
     }
-    fn i64(self, at: usize, v: i64) -> Self {
+    pub(crate) fn i64(self, at: usize, v: i64) -> Self {
         self.put(at, &v.to_le_bytes())
     }
-    fn f32(self, at: usize, v: f32) -> Self {
+    pub(crate) fn f32(self, at: usize, v: f32) -> Self {
         self.put(at, &v.to_le_bytes())
     }
-    fn f64(self, at: usize, v: f64) -> Self {
+    pub(crate) fn f64(self, at: usize, v: f64) -> Self {
         self.put(at, &v.to_le_bytes())
     }
-    fn magic(mut self, at: usize, magic: &[u8]) -> Self {
+    pub(crate) fn magic(mut self, at: usize, magic: &[u8]) -> Self {
         self.bytes[at..at + magic.len()].copy_from_slice(magic);
         self
     }
 
     /// A 3×2×2 int16 NIfTI-1 header with unit pixdim, vox_offset 352, no transform.
-    fn nifti1(big: bool) -> Self {
+    pub(crate) fn nifti1(big: bool) -> Self {
         let h = Hdr {
             bytes: vec![0; 352],
             big,
@@ -210,7 +210,7 @@ impl Hdr {
     }
 
     /// The same as a NIfTI-2 header (540 bytes + 4 extension bytes, vox_offset 544).
-    fn nifti2(big: bool) -> Self {
+    pub(crate) fn nifti2(big: bool) -> Self {
         let h = Hdr {
             bytes: vec![0; 544],
             big,
@@ -229,7 +229,7 @@ impl Hdr {
     }
 
     /// Appends twelve int16 samples -6, -5, ... 5 in the header's byte order.
-    fn with_samples(self) -> Vec<u8> {
+    pub(crate) fn with_samples(self) -> Vec<u8> {
         let mut out = self.bytes;
         for v in -6i16..6 {
             let b = if self.big {
@@ -244,17 +244,17 @@ impl Hdr {
 }
 
 /// A scratch directory for the files one test writes.
-fn scratch() -> TempDir {
+pub(crate) fn scratch() -> TempDir {
     tempfile::tempdir().unwrap()
 }
 
-fn write_temp(dir: &TempDir, name: &str, bytes: &[u8]) -> PathBuf {
+pub(crate) fn write_temp(dir: &TempDir, name: &str, bytes: &[u8]) -> PathBuf {
     let path = dir.path().join(name);
     std::fs::write(&path, bytes).unwrap();
     path
 }
 
-fn assert_samples(loaded: &endocast_io::Loaded) {
+pub(crate) fn assert_samples(loaded: &endocast_io::Loaded) {
     let v = &loaded.volume;
     assert_eq!(v.dims(), [3, 2, 2]);
     assert_eq!(v.physical(0, 0, 0), Some(-6.0));
@@ -365,7 +365,7 @@ fn assert_fails(dir: &TempDir, name: &str, bytes: &[u8]) -> ReadError {
     }
 }
 
-fn gzip(bytes: &[u8]) -> Vec<u8> {
+pub(crate) fn gzip(bytes: &[u8]) -> Vec<u8> {
     let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
     gz.write_all(bytes).unwrap();
     gz.finish().unwrap()

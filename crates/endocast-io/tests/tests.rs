@@ -2,6 +2,7 @@
 
 #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
+mod analyze;
 mod case;
 mod corruption;
 mod cross_format;

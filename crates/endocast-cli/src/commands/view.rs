@@ -14,7 +14,8 @@ use std::sync::Arc;
 /// Arguments of `endocast view`.
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// The scan: a DICOM directory or file, .nii/.nii.gz, .nrrd/.nhdr, .mha/.mhd.
+    /// The scan: a DICOM directory or file, .nii/.nii.gz, .hdr with its .img (NIfTI or Analyze
+    /// 7.5), .nrrd/.nhdr, .mha/.mhd.
     scan: Option<PathBuf>,
     /// DICOM: load this SeriesInstanceUID instead of the largest series.
     #[arg(long, value_name = "UID")]

@@ -19,24 +19,6 @@ fn flip_xy() -> DAffine3 {
     DAffine3::from_scale(FLIP_XY)
 }
 
-/// Where the geometry came from, for messages.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Source {
-    Sform,
-    Qform,
-    Pixdim,
-}
-
-impl Source {
-    fn name(self) -> &'static str {
-        match self {
-            Self::Sform => "sform",
-            Self::Qform => "qform",
-            Self::Pixdim => "pixdim",
-        }
-    }
-}
-
 /// The volume's LPS geometry from the header: the sform when `sform_code > 0`, else the qform
 /// when `qform_code > 0`, else the voxel sizes alone (as ITK and nibabel do: RAS axes through
 /// the origin, with a warning). Spatial units in metres or microns are converted to mm.
@@ -53,9 +35,9 @@ pub(super) fn geometry(
         ));
     }
     let (ras, source) = if header.sform_code > 0 {
-        (sform(header), Source::Sform)
+        (sform(header), "sform")
     } else if header.qform_code > 0 {
-        (qform(path, header)?, Source::Qform)
+        (qform(path, header)?, "qform")
     } else {
         warnings.push(format!(
             "{}: neither sform nor qform is set; the voxel sizes are used with RAS axes \
@@ -63,10 +45,21 @@ pub(super) fn geometry(
             path.display()
         ));
         let spacing = DVec3::from_slice(&header.pixdim[1..4]).abs();
-        (DAffine3::from_scale(spacing), Source::Pixdim)
+        (DAffine3::from_scale(spacing), "pixdim")
     };
-    let lps = DAffine3::from_scale(DVec3::splat(mm_per_unit(header.xyzt_units))) * flip_xy() * ras;
-    decompose(path, dims, lps, source)
+    let ras_mm = DAffine3::from_scale(DVec3::splat(mm_per_unit(header.xyzt_units))) * ras;
+    geometry_from_ras(path, dims, ras_mm, source)
+}
+
+/// The LPS geometry of `ras` (RAS mm from voxel index); `source` names where it came from in
+/// errors (`sform`, `SPM origin`).
+pub(super) fn geometry_from_ras(
+    path: &Path,
+    dims: [usize; 3],
+    ras: DAffine3,
+    source: &str,
+) -> Result<Geometry> {
+    decompose(path, dims, flip_xy() * ras, source)
 }
 
 /// Millimetres per spatial unit of `xyzt_units`: metres (1) and microns (3) are scaled, mm (2)
@@ -120,17 +113,14 @@ fn qform(path: &Path, header: &Header) -> Result<DAffine3> {
 }
 
 /// Spacing (column lengths), direction (unit columns) and origin (translation) of an affine.
-fn decompose(path: &Path, dims: [usize; 3], lps: DAffine3, source: Source) -> Result<Geometry> {
+fn decompose(path: &Path, dims: [usize; 3], lps: DAffine3, source: &str) -> Result<Geometry> {
     let m = lps.matrix3;
     let cols = [m.x_axis, m.y_axis, m.z_axis];
     let spacing = DVec3::new(cols[0].length(), cols[1].length(), cols[2].length());
     let bad = |why: String| {
         ReadError::format(
             path,
-            format!(
-                "the {} does not describe a voxel grid: {why}",
-                source.name()
-            ),
+            format!("the {source} does not describe a voxel grid: {why}"),
         )
     };
     if !spacing.is_finite() || !lps.translation.is_finite() {

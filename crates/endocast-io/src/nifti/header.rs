@@ -1,29 +1,48 @@
-//! The NIfTI-1 (348-byte) and NIfTI-2 (540-byte) headers: decoding either version in either
-//! byte order, checking the fields a volume is built from, and encoding the little-endian
-//! NIfTI-1 header the writer emits.
+//! The NIfTI-1 (348-byte) and NIfTI-2 (540-byte) headers, and the Analyze 7.5 header NIfTI-1
+//! grew from: decoding each in either byte order, checking the fields a volume is built from,
+//! and encoding the little-endian NIfTI-1 header the writer emits.
 //!
 //! Field offsets follow `nifti1.h` and `nifti2.h`. NIfTI-2 widens most fields (dims to i64,
-//! floats to f64) and reorders them; [`Header`] holds the widened types for both.
+//! floats to f64) and reorders them; [`Header`] holds the widened types for all three. A
+//! 348-byte header without NIfTI-1's magic is Analyze 7.5 with SPM's reading of its spare
+//! fields (`funused1` the scale factor, `funused2` the intercept, `originator` the origin), as
+//! nibabel's `Spm2AnalyzeHeader` reads it.
 
 use crate::error::{ReadError, Result};
 use crate::samples::{ElementType, Endian};
 use std::io::{ErrorKind, Read};
 use std::path::Path;
 
-/// Which NIfTI header a file carries; `sizeof_hdr` (the first four bytes) tells them apart.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which header a file carries; `sizeof_hdr` (the first four bytes) and the magic tell them
+/// apart.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum Version {
     /// 348-byte header, 16-bit dims, 32-bit floats.
     One,
     /// 540-byte header, 64-bit dims and floats.
     Two,
+    /// 348 bytes laid out as NIfTI-1 up to `funused3`, without the magic: always a `.hdr` whose
+    /// voxels are in the `.img` beside it; no transform, SPM's fields instead.
+    Analyze(SpmFields),
+}
+
+/// The fields SPM reads from an Analyze 7.5 header beyond those NIfTI-1 kept.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct SpmFields {
+    /// `originator` read as five int16: the first three are the 1-based voxel at the world
+    /// origin (SPM99), or zeros.
+    pub origin: [i16; 3],
+    /// `cal_min`, `cal_max`: the scaled range, SPM2's fallback scaling with `glmin`, `glmax`.
+    pub cal: [f32; 2],
+    /// `glmin`, `glmax`: the stored range.
+    pub gl: [i32; 2],
 }
 
 impl Version {
     /// `sizeof_hdr`: the header's length in bytes.
     pub(super) fn header_size(self) -> usize {
         match self {
-            Self::One => 348,
+            Self::One | Self::Analyze(_) => 348,
             Self::Two => 540,
         }
     }
@@ -33,6 +52,7 @@ impl Version {
         match self {
             Self::One => "NIfTI-1",
             Self::Two => "NIfTI-2",
+            Self::Analyze(_) => "Analyze 7.5",
         }
     }
 }
@@ -47,7 +67,8 @@ pub(super) const NIFTI1_VOX_OFFSET: usize = 352;
 pub(super) struct Header {
     pub version: Version,
     pub endian: Endian,
-    /// A `.hdr` whose voxels are in the `.img` beside it (magic `ni1`/`ni2`), not after it.
+    /// A `.hdr` whose voxels are in the `.img` beside it (magic `ni1`/`ni2`, or Analyze), not
+    /// after it.
     pub paired: bool,
     /// `dim[0]` is the number of dimensions, `dim[1..=dim[0]]` their sizes.
     pub dim: [i64; 8],
@@ -83,8 +104,12 @@ pub(super) fn read_header(path: &Path, reader: &mut dyn Read) -> Result<Header> 
         endian,
     };
     match version {
-        Version::One => decode_nifti1(path, &fields),
         Version::Two => decode_nifti2(path, &fields),
+        _ if matches!(&bytes[344..348], b"n+1\0" | b"ni1\0") => Ok(decode_nifti1(&fields)),
+        _ => Ok(decode_analyze(&Fields {
+            endian: analyze_endian(&fields),
+            ..fields
+        })),
     }
 }
 
@@ -115,6 +140,7 @@ fn detect(path: &Path, first: [u8; 4]) -> Result<(Version, Endian)> {
 }
 
 /// Typed reads at fixed offsets of a complete header buffer.
+#[derive(Clone, Copy)]
 struct Fields<'a> {
     bytes: &'a [u8],
     endian: Endian,
@@ -182,12 +208,11 @@ fn check_magic(
     }
 }
 
-fn decode_nifti1(path: &Path, f: &Fields) -> Result<Header> {
-    let paired = check_magic(path, &f.bytes[344..348], b"n+1\0", b"ni1\0", "NIfTI-1")?;
-    Ok(Header {
+fn decode_nifti1(f: &Fields) -> Header {
+    Header {
         version: Version::One,
         endian: f.endian,
-        paired,
+        paired: &f.bytes[344..348] == b"ni1\0",
         dim: f.array(40, 2, Fields::i16_wide),
         datatype: f.i16(70),
         bitpix: f.i16(72),
@@ -201,7 +226,36 @@ fn decode_nifti1(path: &Path, f: &Fields) -> Result<Header> {
         quatern: f.array(256, 4, Fields::f32_wide),
         qoffset: f.array(268, 4, Fields::f32_wide),
         srow: [280, 296, 312].map(|at| f.array(at, 4, Fields::f32_wide)),
-    })
+    }
+}
+
+/// The NIfTI-1 fields Analyze shares (`funused1` and `funused2` are SPM's `scl_slope` and
+/// `scl_inter`); the units (a string nibabel ignores) are taken as mm, and no transform is set.
+fn decode_analyze(f: &Fields) -> Header {
+    Header {
+        version: Version::Analyze(SpmFields {
+            origin: f.array(253, 2, Fields::i16),
+            cal: [f.f32(128), f.f32(124)],
+            gl: [f.i32(144), f.i32(140)],
+        }),
+        paired: true,
+        xyzt_units: UNITS_MM,
+        qform_code: 0,
+        sform_code: 0,
+        quatern: [0.0; 3],
+        qoffset: [0.0; 3],
+        srow: [[0.0; 4]; 3],
+        ..decode_nifti1(f)
+    }
+}
+
+/// Analyze's byte order as nibabel guesses it: the one in which `dim[0]` is 1 to 7, else the
+/// one in which `sizeof_hdr` is 348 (`f.endian`).
+fn analyze_endian(f: &Fields) -> Endian {
+    [Endian::Little, Endian::Big]
+        .into_iter()
+        .find(|&endian| (1..=7).contains(&Fields { endian, ..*f }.i16(40)))
+        .unwrap_or(f.endian)
 }
 
 fn decode_nifti2(path: &Path, f: &Fields) -> Result<Header> {
@@ -268,7 +322,10 @@ impl Header {
         };
         Err(ReadError::unsupported(
             path,
-            format!("NIfTI datatype {code}{name}: only scalar integer and float voxels are read"),
+            format!(
+                "{} datatype {code}{name}: only scalar integer and float voxels are read",
+                self.version.name()
+            ),
         ))
     }
 
@@ -290,7 +347,7 @@ impl Header {
         if rank < 2 {
             return Err(ReadError::unsupported(
                 path,
-                "a 1-D NIfTI image (dim[0] = 1)",
+                format!("a 1-D {} image (dim[0] = 1)", self.version.name()),
             ));
         }
         let mut sizes = [1u64; 7];

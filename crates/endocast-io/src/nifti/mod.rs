@@ -1,11 +1,13 @@
 //! NIfTI-1 and NIfTI-2 images: single files (`.nii`, `.nii.gz`) and header/image pairs
-//! (`.hdr` + `.img`, read only): reader and NIfTI-1 writer.
+//! (`.hdr` + `.img`, read only), and the Analyze 7.5 pairs NIfTI-1 grew from (read only, as
+//! nibabel reads them: [`analyze`]): reader and NIfTI-1 writer.
 //!
 //! Reading streams the file (through a gzip decoder when it starts with the gzip magic, whatever
 //! its name) and keeps no more than the header and the first 3-D volume's voxels; a gzip stream
 //! is then read to its end (the other volumes of a 4-D image are inflated and dropped) so that
-//! its CRC and length are checked, and inflated bytes beyond the header's volumes are refused. The version and byte order come from `sizeof_hdr` (348 or 540 in the
-//! file's byte order). Geometry comes from the sform when `sform_code > 0`, else the qform
+//! //! its CRC and length are checked, and inflated bytes beyond the header's volumes are refused.
+//! The version and byte order come from `sizeof_hdr` (348 or 540 in the file's byte order); a
+//! 348-byte header without NIfTI-1's magic is Analyze 7.5. Geometry comes from the sform when `sform_code > 0`, else the qform
 //! when `qform_code > 0`, else the voxel sizes alone (with a warning); NIfTI's RAS world
 //! becomes endocast's LPS by negating x and y, and the 3×4 affine splits into spacing (column
 //! lengths), direction (unit columns) and origin. Spatial units in metres or microns are
@@ -17,7 +19,9 @@
 //! see [`write()`] for the sample type chosen.
 
 mod affine;
+mod analyze;
 mod header;
+mod mat4;
 mod write;
 
 pub use write::write;
@@ -29,16 +33,17 @@ use crate::loaded::{Format, Loaded, OpenOptions, SourceInfo};
 use crate::samples::{read_voxels, Endian, Rescale};
 use endocast_core::{Modality, Volume};
 use flate2::read::MultiGzDecoder;
-use header::Header;
+use header::{Header, Version};
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 /// Reads a NIfTI-1 or NIfTI-2 file, plain or gzip-compressed: a single file (`.nii`), or a
-/// header (`.hdr`) whose voxels are in the `.img` beside it (each plain or gzip).
+/// header (`.hdr`) whose voxels are in the `.img` beside it (each plain or gzip); an Analyze
+/// 7.5 `.hdr` likewise.
 ///
 /// Only the first volume of a 4-D series is read (with a warning). Errors: a header that is
-/// neither NIfTI version, RGB or complex voxels (unsupported), bad dims, pixdim or
+/// neither NIfTI version nor Analyze (`sizeof_hdr` not 348 or 540), RGB or complex voxels (unsupported), bad dims, pixdim or
 /// `vox_offset`, a missing `.img`, a transform that is not a voxel grid, more voxels than
 /// `options.limits` allow, and data that ends early.
 pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
@@ -60,7 +65,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     let count = options.limits.check_dims(path, &dims)?;
     let vox_offset = header.data_offset(path)?;
     let mut data = if header.paired {
-        let image = image_file(path)?;
+        let image = pair_file(path, "img")?;
         detached::data_file_len(path, &image)?;
         Stream::open(&image)?
     } else {
@@ -75,7 +80,7 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         element,
         header.endian,
         count,
-        rescale(path, &header, &mut warnings),
+        values_rescale(path, &header, &mut warnings),
         &mut warnings,
     )
     .map_err(|e| {
@@ -92,22 +97,36 @@ pub fn read(path: &Path, options: &OpenOptions) -> Result<Loaded> {
 
     // check_dims proved the product fits usize, so each factor does.
     let dims = dims.map(|d| d as usize);
-    let geometry = affine::geometry(path, &header, dims, &mut warnings)?;
+    let (geometry, format) = match &header.version {
+        Version::Analyze(spm) => (
+            analyze::geometry(path, &header, spm, dims, &mut warnings)?,
+            Format::Analyze,
+        ),
+        _ => (
+            affine::geometry(path, &header, dims, &mut warnings)?,
+            Format::Nifti,
+        ),
+    };
     let volume = Volume::new(geometry, voxels, map, Modality::Unknown)
         .map_err(|e| ReadError::format(path, e.to_string()))?;
     Ok(Loaded {
         volume,
-        source: SourceInfo::new(
-            Format::Nifti,
-            stored_type(&header, element.name(), data.gzip),
-        ),
+        source: SourceInfo::new(format, stored_type(&header, element.name(), data.gzip)),
         warnings,
     })
 }
 
-/// The `.img` of the pair whose header is `path` (`x.hdr` → `x.img`, `x.hdr.gz` → `x.img.gz`,
-/// in the header's case).
-fn image_file(path: &Path) -> Result<PathBuf> {
+/// The values' scaling by the header's version: NIfTI's `scl_slope`, or SPM's for Analyze.
+fn values_rescale(path: &Path, header: &Header, warnings: &mut Vec<String>) -> Rescale {
+    match &header.version {
+        Version::Analyze(spm) => analyze::rescale(path, header, spm, warnings),
+        _ => rescale(path, header, warnings),
+    }
+}
+
+/// The file beside the pair's header `path` with the extension `ext` (`img`, `mat`): `x.hdr` →
+/// `x.img`, `x.hdr.gz` → `x.img.gz`, in the header's case.
+fn pair_file(path: &Path, ext: &str) -> Result<PathBuf> {
     let name = path
         .file_name()
         .and_then(|n| n.to_str())
@@ -119,15 +138,16 @@ fn image_file(path: &Path) -> Result<PathBuf> {
     else {
         return Err(ReadError::format(
             path,
-            "the header of a .hdr/.img pair (magic ni1 or ni2) must be named .hdr or .hdr.gz",
+            "the header of a .hdr/.img pair (NIfTI magic ni1 or ni2, or an Analyze 7.5 header, \
+             which has no magic) must be named .hdr or .hdr.gz",
         ));
     };
-    let img = if &name[at + 1..at + 4] == "HDR" {
-        "IMG"
+    let ext = if &name[at + 1..at + 4] == "HDR" {
+        ext.to_ascii_uppercase()
     } else {
-        "img"
+        ext.to_owned()
     };
-    Ok(path.with_file_name(format!("{}.{img}{}", &name[..at], &name[at + 4..])))
+    Ok(path.with_file_name(format!("{}.{ext}{}", &name[..at], &name[at + 4..])))
 }
 
 /// A NIfTI file being read: its bytes, inflated when it starts with the gzip magic.
@@ -194,7 +214,7 @@ impl Stream {
     }
 }
 
-/// E.g. `uint8 (NIfTI-1, gzip)` or `int16 (NIfTI-2, big-endian)`.
+/// E.g. `uint8 (NIfTI-1, gzip)`, `int16 (NIfTI-2, big-endian)` or `int16 (Analyze 7.5)`.
 fn stored_type(header: &Header, element: &str, gzip: bool) -> String {
     let mut parts = vec![header.version.name()];
     if header.endian == Endian::Big {
