@@ -141,3 +141,37 @@ fn a_segmentation_overlay_is_drawn_where_its_voxels_are() {
     let centre = depths[16 * 33 + 16];
     assert!((centre - 4.5).abs() < 0.1, "{centre}");
 }
+
+#[test]
+fn the_airway_tree_meshes_from_a_point_in_the_trachea_with_the_preset_alone() {
+    let Some(chest) = endocast_testdata::shared_data("chest-ct-airways-dicom") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("airways.stl");
+    let out = endocast(&[
+        "mesh",
+        chest.to_str().unwrap(),
+        "--preset",
+        "bronchoscopy",
+        "--from",
+        "-18.55,72.33,11.5",
+        "-o",
+        mesh.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The tree grown at the preset's lumen threshold (some ten thousand triangles), not the
+    // lungs joined to it at the wall's isovalue (about a million).
+    let triangles: usize = stdout
+        .split(": ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!((5_000..200_000).contains(&triangles), "{stdout}");
+}

@@ -4,10 +4,10 @@
 use crate::input::InputArgs;
 use crate::look::find_preset;
 use crate::parse::parse_vec3;
+use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::isosurface::{isosurface, lumen_surface};
-use crate::study_report;
 use endocast_core::navigate::{seed_voxel, Lumen, LumenSide};
 use endocast_core::pose::Pose;
 use endocast_core::study::{Study, StudyRequest};
@@ -30,9 +30,9 @@ pub struct MeshArgs {
     /// Take the isovalue (and which side is the lumen) from a procedure preset.
     #[arg(long)]
     preset: Option<String>,
-    /// A point in the lumen (world mm): only the surface of the connected lumen around it (a
-    /// closed lumen gives a watertight mesh). Without it, the structure the preset finds (the
-    /// airways, the aorta, …; with no --iso), else the isosurface of the whole volume.
+    /// A point in the lumen (world mm): only the surface of the connected lumen around it,
+    /// grown at the preset's lumen threshold as `path` grows it (a closed lumen gives a
+    /// watertight mesh). Without it, the isosurface of the whole volume.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     from: Option<[f64; 3]>,
     /// The lumen is brighter than the wall (contrast); default: the preset's, else darker.
@@ -52,15 +52,17 @@ pub fn run(args: &MeshArgs) -> Result<()> {
     }
     let volume = &loaded.volume;
     // The scan understood as `render` and `path` understand it: the preset in the scan's own
-    // units, the wall and the lumen's side, the structure it names.
+    // units, the wall and the lumen's side. A mesh needs no start, so no structure is searched
+    // (the pose only says so).
+    let (lo, hi) = volume.geometry().world_bounds();
+    let centre = (lo + hi) / 2.0;
     let request = StudyRequest {
         preset,
         iso: args.iso,
         bright_lumen: args.bright_lumen,
-        // With --from no structure is searched: the pose only says so.
-        pose: args.from.map(|p| Pose {
-            eye_mm: DVec3::from(p),
-            look_at_mm: DVec3::from(p) + DVec3::Z,
+        pose: Some(Pose {
+            eye_mm: centre,
+            look_at_mm: centre + DVec3::Z,
             up: DVec3::Y,
         }),
         ..StudyRequest::default()
@@ -70,18 +72,17 @@ pub fn run(args: &MeshArgs) -> Result<()> {
     let iso = study.settings().iso_hu;
     let side = study.lumen().map_or(LumenSide::Below, |(_, side)| side);
     let start = Instant::now();
-    let mesh = match (args.from, study.structure()) {
-        (Some(point), _) => {
+    let mesh = match args.from {
+        Some(point) => {
             let seed = seed_voxel(volume, DVec3::from(point))
                 .map_err(|_| anyhow::anyhow!("--from {point:?} lies outside the volume"))?;
-            let lumen = Lumen::from_seed(volume, seed, iso, side).context("no lumen at --from")?;
+            // Grown at the lumen's threshold, as `path` and collision grow it.
+            let threshold = study.lumen().map_or(iso, |(threshold, _)| threshold);
+            let lumen =
+                Lumen::from_seed(volume, seed, threshold, side).context("no lumen at --from")?;
             lumen_surface(volume, &lumen)
         }
-        (None, Some(structure)) if args.iso.is_none() => {
-            eprintln!("the surface of the {} the preset found", study.structure_name().unwrap_or("structure"));
-            lumen_surface(volume, structure)
-        }
-        _ => isosurface(volume, iso, side),
+        None => isosurface(volume, iso, side),
     }
     .context("no surface at this isovalue")?;
     let extract_ms = start.elapsed().as_secs_f64() * 1e3;
