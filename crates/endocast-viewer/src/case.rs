@@ -8,6 +8,7 @@ use crate::geometry::{with_mesh, Toggles};
 use crate::session::{Controls, Session, NO_PRESET};
 use endocast_core::animation::KeyFrame;
 use endocast_core::camera::Projection;
+use endocast_core::look::LookKind;
 use endocast_core::presets::Preset;
 use endocast_core::render::Mode;
 use endocast_core::views::slices::Window;
@@ -60,6 +61,7 @@ fn controls_of(c: &Controls, mesh_files: &[PathBuf]) -> CaseControls {
         tf: Some(CaseTransfer::from(&c.tf)),
         peel: Some(CasePeel::of(&c.peel)),
         geometry: Some(geometry_of(c.geometry, mesh_files)),
+        look: Some(c.look.name().into()),
     }
 }
 
@@ -107,7 +109,8 @@ impl SessionCase for Case {
         let window = Window::new(c.window_level_hu, c.window_width_hu)
             .map_err(|e| CaseError::new(path, e))?;
         // Cases before version 3 keep none of these: the preset's apply.
-        let defaults = session.study_here(preset).settings().clone();
+        let here = session.study_here(preset);
+        let defaults = here.settings().clone();
         let tf = match &c.tf {
             Some(tf) => tf.transfer_function(),
             None => Ok(defaults.tf.clone()),
@@ -117,6 +120,10 @@ impl SessionCase for Case {
             None => Ok(defaults.peel.clone()),
         };
         let to_case_error = |e| CaseError::new(path, e);
+        let look = match &c.look {
+            Some(name) => LookKind::from_name(name).ok_or_else(|| bad("look", name))?,
+            None => here.look().kind,
+        };
         Ok(Some(Controls {
             preset,
             base: defaults.clone(),
@@ -132,6 +139,7 @@ impl SessionCase for Case {
             tf: tf.map_err(to_case_error)?,
             peel: peel.map_err(to_case_error)?,
             geometry: c.geometry.as_ref().map(toggles).unwrap_or_default(),
+            look,
         }))
     }
 

@@ -8,6 +8,7 @@ use crate::session::{Session, NO_PRESET};
 use crate::state::{Action, Ready};
 use crate::tf_editor::histogram_ui;
 use endocast_core::camera::Projection;
+use endocast_core::look::LookKind;
 use endocast_core::navigate::LumenSide;
 use endocast_core::presets;
 use endocast_core::render::{Mode, PeelLayer, PeelSettings, Unpeeled};
@@ -242,7 +243,19 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     // A pinhole cannot take a fisheye's field.
     c.fov_deg = c.fov_deg.clamp(fov_lo, fov_hi);
     ui.add(egui::Slider::new(&mut c.fov_deg, fov_lo..=fov_hi.min(220.0)).text("field of view °"));
-    ui.checkbox(&mut c.stereo, "stereo (red/cyan anaglyph)");
+    egui::ComboBox::from_label("look")
+        .selected_text(c.look.name())
+        .show_ui(ui, |ui| {
+            for kind in LookKind::ALL {
+                ui.selectable_value(&mut c.look, kind, kind.name());
+            }
+        });
+    let stereo = if c.look == LookKind::Plain {
+        "stereo (red/cyan anaglyph)"
+    } else {
+        "stereo (red/cyan; not with this look)"
+    };
+    ui.checkbox(&mut c.stereo, stereo);
     if c.mode == Mode::Peel {
         peel_ui(ui, &mut c.peel, c.iso_hu, (lo, hi));
     }

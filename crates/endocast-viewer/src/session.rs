@@ -11,6 +11,7 @@ use crate::worker::{RenderWorker, View};
 use endocast_core::animation::{Animation, KeyFrame};
 use endocast_core::annotate::{self, Annotation, Annotations, DrawOptions, Shape, SurfaceView};
 use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
+use endocast_core::look::{Look, LookKind};
 use endocast_core::navigate::{nearest_lumen_point, snap_radius_mm, LumenSide};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
@@ -61,6 +62,9 @@ pub struct Controls {
     pub peel: PeelSettings,
     /// The geometry shown with the scan.
     pub geometry: Toggles,
+    /// The endoscope's look: the renderer's own image (plain), or the clinical or realistic
+    /// look of the preset.
+    pub look: LookKind,
 }
 
 impl Controls {
@@ -84,6 +88,7 @@ impl Controls {
             tf: base.tf.clone(),
             peel: base.peel.clone(),
             geometry: Toggles::default(),
+            look: study.look().kind,
             base,
         }
     }
@@ -266,13 +271,25 @@ impl Session {
             None
         };
         let scene = self.drawn_scene();
+        let look = self.look();
         Some(View {
             camera,
             settings: self.controls.settings(),
             stereo,
             moving,
             scene,
+            look,
         })
+    }
+
+    /// The clinical or realistic look as set (`None`: plain), the preset's in the scan's units;
+    /// its tissue follows the wall once the wall is moved off the preset's.
+    fn look(&self) -> Option<Look> {
+        let mut look = Look::of_kind(self.controls.look, &self.study.look())?;
+        if self.controls.iso_hu != self.study.settings().iso_hu {
+            look.ray.tissue_hu = self.controls.iso_hu;
+        }
+        Some(look)
     }
 
     /// The geometry the view draws now (the toggles' grid, instrument, mark spheres, meshes).

@@ -10,7 +10,9 @@
 
 use crate::geometry::SceneRef;
 use crate::jobs::Notify;
+use crate::look_frames::{render_look, LookPass};
 use endocast_core::camera::StereoRig;
+use endocast_core::look::Look;
 use endocast_core::render::progressive::{progressive, PreviewPlanner, ProgressiveOptions, Stage};
 use endocast_core::render::{
     Camera, Cancelled, Frame, Layers, Prepared, Progress, Quality, RenderOptions, RenderSettings,
@@ -46,6 +48,9 @@ pub struct View {
     pub moving: bool,
     /// Geometry drawn with the scan.
     pub scene: SceneRef,
+    /// The endoscope's clinical or realistic look instead of the renderer's own image (one
+    /// image: with stereo on, the look is drawn for the centre eye).
+    pub look: Option<Look>,
 }
 
 /// A finished frame of some view.
@@ -215,7 +220,19 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
     let mut prepared: Option<Prepared> = None;
     let mut scene = SceneRef::default();
     let mut planner = PreviewPlanner::default();
+    let mut look_pass = LookPass::default();
     while let Some(request) = next_request(shared) {
+        if let Some(look) = &request.view.look {
+            let superseded = || shared.generation.load(Ordering::Acquire) != request.generation;
+            let deliver = deliverer(shared, &request);
+            let view = &request.view;
+            if let Err(e) = render_look(&mut look_pass, renderer, view, look, &superseded, &deliver)
+            {
+                lock(&shared.latest).error = Some(e);
+                (shared.on_frame)();
+            }
+            continue;
+        }
         let settings = &request.view.settings;
         let ready = match prepared.as_mut() {
             Some(p) if p.settings() == settings => Ok(()),
@@ -257,20 +274,18 @@ fn next_request(shared: &Shared) -> Option<Request> {
     }
 }
 
-fn render_request(
-    shared: &Shared,
-    prepared: &Prepared,
-    request: &Request,
-    planner: &mut PreviewPlanner,
-) -> Result<(), Cancelled> {
-    let view = &request.view;
-    let deliver = |stage: Stage, image: Image, depth_mm: &[f32], time: Duration| {
+/// Hands a finished level of `request`'s frame to the UI: the shown frame and a wake-up.
+fn deliverer<'a>(
+    shared: &'a Shared,
+    request: &'a Request,
+) -> impl Fn(Stage, Image, &[f32], Duration) + 'a {
+    move |stage: Stage, image: Image, depth_mm: &[f32], time: Duration| {
         let frame = Delivered {
             generation: request.generation,
             stage,
             image,
             depth_mm: depth_mm.to_vec(),
-            camera: view.camera,
+            camera: request.view.camera,
             render_time: time,
             since_request: request.at.elapsed(),
         };
@@ -280,7 +295,17 @@ fn render_request(
         drop(latest);
         shared.delivered.notify_all();
         (shared.on_frame)();
-    };
+    }
+}
+
+fn render_request(
+    shared: &Shared,
+    prepared: &Prepared,
+    request: &Request,
+    planner: &mut PreviewPlanner,
+) -> Result<(), Cancelled> {
+    let view = &request.view;
+    let deliver = deliverer(shared, request);
     let background = view.settings.background;
     match view.stereo {
         None => {

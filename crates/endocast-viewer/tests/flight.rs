@@ -282,3 +282,20 @@ fn a_click_beside_the_lumen_jumps_into_it_and_one_far_from_any_says_so() {
     assert!(said.starts_with("not in a lumen"), "{said}");
     assert!(session.jump_to(truth.centre_mm).is_none());
 }
+
+#[test]
+fn the_realistic_look_refines_to_its_still_and_then_rests() {
+    use endocast_core::look::LookKind;
+    let (mut session, _) = tube_session();
+    session.turn(0.0, 0.6);
+    let plain = settled(&mut session);
+    session.controls.look = LookKind::Realistic;
+    let look = settled(&mut session);
+    assert!(
+        mean_difference(&plain, &look) > 2.0,
+        "the look shows the plain picture"
+    );
+    let g = session.worker().generation();
+    assert_eq!(session.sync(false), None);
+    assert_eq!(session.worker().generation(), g);
+}

@@ -82,7 +82,7 @@ pub use kind::{Look, LookKind, PresetLook};
 pub use reduced::shade_reduced;
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;
-pub use still::{still, still_view, MAX_STILL_FRAMES};
+pub use still::{still, still_frame, still_view, MAX_STILL_FRAMES};
 pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, MAX_TEXELS};
 
 use thiserror::Error;

@@ -22,13 +22,26 @@ pub fn still(
 ) -> Result<Frame, LookError> {
     let mut still = Still::new();
     for k in 0..frames.max(1) {
-        let jitter = Jitter::of_frame(k);
-        let (dx, dy) = jitter.pixel_offset;
-        let jittered = camera.with_pixel_offset(dx, dy);
-        let gbuffer = pass.trace_shifted(&jittered, Quality::Full, jitter.grid_shift);
-        still.add(&shade_with_scene(&gbuffer, &jittered, shading, scene)?);
+        still.add(&still_frame(pass, camera, shading, scene, k)?);
     }
     Ok(still.frame().clone())
+}
+
+/// Frame `k` of [`still`]: the shaded ray pass of `camera` jittered as
+/// [`Jitter::of_frame`]`(k)` says, for callers that average frames one at a time (and may stop
+/// between them, as the workstation does when the view changes).
+pub fn still_frame(
+    pass: &RayPass,
+    camera: &Camera,
+    shading: &Shading,
+    scene: Option<&Scene>,
+    k: usize,
+) -> Result<Frame, LookError> {
+    let jitter = Jitter::of_frame(k);
+    let (dx, dy) = jitter.pixel_offset;
+    let jittered = camera.with_pixel_offset(dx, dy);
+    let gbuffer = pass.trace_shifted(&jittered, Quality::Full, jitter.grid_shift);
+    shade_with_scene(&gbuffer, &jittered, shading, scene)
 }
 
 /// The most frames a still averages on request (`--still`, `still=`).

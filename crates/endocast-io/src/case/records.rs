@@ -32,6 +32,9 @@ pub struct CaseControls {
     /// The geometry shown with the scan (version 3; absent: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geometry: Option<CaseGeometry>,
+    /// The endoscope's look: plain, clinical or realistic (absent: the preset's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub look: Option<String>,
 }
 
 /// A transfer function's points as transfer-function files hold them (see

@@ -1,0 +1,82 @@
+//! The endoscope's clinical or realistic look in the workstation: the look's ray pass (kept
+//! while its settings stay) traced at half resolution while the camera moves, then the full
+//! frame with the view's geometry composited, then jittered frames averaged into a still, each
+//! level delivered as it finishes; a new view stops it between levels and between still frames.
+
+use crate::worker::{View, STILL_FRAMES};
+use endocast_core::look::{shade_reduced, still_frame, Look, RayPass, RayPassSettings};
+use endocast_core::render::progressive::Stage;
+use endocast_core::render::{Frame, Quality, RenderSettings, Renderer, Still};
+use endocast_core::views::Image;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// The look's ray pass for the settings it was made for, made again only when they change.
+#[derive(Default)]
+pub(crate) struct LookPass {
+    made: Option<(RenderSettings, RayPassSettings, RayPass)>,
+}
+
+impl LookPass {
+    /// The ray pass of `look` over `renderer` with `settings`.
+    fn get(
+        &mut self,
+        renderer: &Arc<Renderer>,
+        settings: &RenderSettings,
+        look: &Look,
+    ) -> Result<&RayPass, String> {
+        let current = self
+            .made
+            .as_ref()
+            .is_some_and(|(s, r, _)| s == settings && *r == look.ray);
+        if !current {
+            let pass = RayPass::new(renderer, settings, &look.ray).map_err(|e| e.to_string())?;
+            self.made = Some((settings.clone(), look.ray.clone(), pass));
+        }
+        Ok(&self.made.as_ref().expect("made above").2)
+    }
+}
+
+/// Renders `view` in `look` level by level, handing each to `deliver`; stops (without error)
+/// as soon as `superseded` says a newer view waits, between levels and still frames.
+pub(crate) fn render_look(
+    passes: &mut LookPass,
+    renderer: &Arc<Renderer>,
+    view: &View,
+    look: &Look,
+    superseded: &dyn Fn() -> bool,
+    deliver: &dyn Fn(Stage, Image, &[f32], Duration),
+) -> Result<(), String> {
+    let pass = passes.get(renderer, &view.settings, look)?;
+    let (camera, shading) = (&view.camera, &look.shading);
+    let scene = view.scene.0.as_deref();
+    let background = view.settings.background;
+    let show = |stage: Stage, frame: &Frame, start: Instant| {
+        if let Ok(image) = Image::from_frame(frame, background) {
+            deliver(stage, image, &frame.depth_mm, start.elapsed());
+        }
+    };
+    let start = Instant::now();
+    let preview = pass.trace(camera, Quality::Half);
+    let frame = shade_reduced(&preview, camera, shading).map_err(|e| e.to_string())?;
+    show(Stage::Preview(Quality::Half), &frame, start);
+    if view.moving {
+        return Ok(());
+    }
+    let mut still = Still::new();
+    for k in 0..STILL_FRAMES {
+        if superseded() {
+            return Ok(());
+        }
+        let start = Instant::now();
+        let frame = still_frame(pass, camera, shading, scene, k).map_err(|e| e.to_string())?;
+        still.add(&frame);
+        let stage = if k == 0 {
+            Stage::Full
+        } else {
+            Stage::Still(k + 1)
+        };
+        show(stage, still.frame(), start);
+    }
+    Ok(())
+}
