@@ -3,13 +3,13 @@
 //! frame with the view's geometry composited, then jittered frames averaged into a still, each
 //! level delivered as it finishes; a new view stops it between levels and between still frames.
 
-use crate::worker::{View, STILL_FRAMES};
+use crate::worker::{Deliver, View, STILL_FRAMES};
 use endocast_core::look::{shade_reduced, still_frame, Look, RayPass, RayPassSettings};
 use endocast_core::render::progressive::Stage;
 use endocast_core::render::{Frame, Quality, RenderSettings, Renderer, Still};
 use endocast_core::views::Image;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// The look's ray pass for the settings it was made for, made again only when they change.
 #[derive(Default)]
@@ -45,7 +45,7 @@ pub(crate) fn render_look(
     view: &View,
     look: &Look,
     superseded: &dyn Fn() -> bool,
-    deliver: &dyn Fn(Stage, Image, &[f32], Duration),
+    deliver: &Deliver<'_>,
 ) -> Result<(), String> {
     let pass = passes.get(renderer, &view.settings, look)?;
     let (camera, shading) = (&view.camera, &look.shading);

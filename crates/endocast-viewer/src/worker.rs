@@ -26,7 +26,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// Hands a finished stage of a frame to the UI: its quality, image, depths and render time.
-type Deliver<'a> = dyn Fn(Stage, Image, &[f32], Duration) + 'a;
+pub(crate) type Deliver<'a> = dyn Fn(Stage, Image, &[f32], Duration) + 'a;
 
 /// Frames averaged into the still when the view stands (the full frame included).
 pub const STILL_FRAMES: usize = 8;
