@@ -4,7 +4,8 @@
 # (endocast: --from; VTK: flying edges + vtkPolyDataConnectivityFilter, closest region).
 # Prints one line per run: wall and CPU seconds (median of RUNS), triangles, vertices.
 #
-# Usage (repository root, VTK from ../shared/peers/install_vtk.sh):
+# Usage (repository root, VTK from ../shared/peers/install_vtk.sh; SHARED_DATA: the shared
+# data folder when it is not ../shared/data):
 #   bench/mesh_vs_vtk.sh [RUNS]
 set -euo pipefail
 runs=${1:-3}
@@ -21,7 +22,7 @@ sphere=$out/sphere256.nii.gz
 tube=$out/curvedtube256.nii.gz
 [ -f "$tube" ] || $bin phantom curved-tube --size 256 -o "$tube" >/dev/null
 cthead=$out/cthead.nii.gz
-[ -f "$cthead" ] || $bin convert ../shared/data/head-ct-stanford-cthead/CThead.nhdr -o "$cthead" >/dev/null
+[ -f "$cthead" ] || $bin convert "${SHARED_DATA:-../shared/data}"/head-ct-stanford-cthead/CThead.nhdr -o "$cthead" >/dev/null
 
 # endocast_runs VOLUME ISO [X,Y,Z]: median wall and CPU seconds of `endocast mesh`.
 endocast_runs() {

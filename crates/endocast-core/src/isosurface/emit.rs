@@ -131,8 +131,7 @@ fn row_triangles(grid: &Grid, layout: &Layout, j: usize, k: usize, out: &mut [[u
         next[8 + 2 * d] = z_row.vertex + z_row.x + z_row.y;
     }
     let mut n = 0;
-    for i in layout.row(j, k, ny).cubes.clone() {
-        let case = cube_row.case(i);
+    for case in cube_row.cut(layout.row(j, k, ny).cubes.clone()) {
         let id = |e: usize| match e {
             5 | 7 | 9 | 11 => next[e - 1] + u32::from(crossed(case, e - 1)),
             _ => next[e],

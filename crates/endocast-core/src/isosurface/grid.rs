@@ -5,12 +5,13 @@
 use crate::navigate::Lumen;
 use crate::Volume;
 use rayon::prelude::*;
-use std::ops::Range;
+use std::ops::{Range, RangeInclusive};
 
 /// Which voxels lie inside the surface.
 pub(super) enum Inside<'a> {
-    /// The voxels whose stored value is flagged (one flag per `u16`).
-    Values(Vec<bool>),
+    /// The voxels whose stored value lies in this range (stored values map linearly to
+    /// physical ones, so one side of an isovalue is one range of them).
+    Values(RangeInclusive<u16>),
     /// The voxels of a lumen.
     Lumen(&'a Lumen),
 }
@@ -115,8 +116,42 @@ impl CubeRow<'_> {
 
     /// The case of cube `i` (bit `c` set: corner `c` inside).
     #[inline]
-    pub fn case(&self, i: usize) -> u8 {
+    fn case(&self, i: usize) -> u8 {
         self.column(i) | self.column(i + 1) << 1
+    }
+
+    /// The cases of the cubes of `range` that the surface cuts, in order (stretches of eight
+    /// cubes whose corners are all inside or all outside are passed over at once).
+    pub fn cut(&self, range: Range<usize>) -> impl Iterator<Item = u8> + '_ {
+        let mut i = range.start;
+        std::iter::from_fn(move || {
+            while i < range.end {
+                if i + 8 <= range.end && self.uniform8(i) {
+                    i += 8;
+                    continue;
+                }
+                let case = self.case(i);
+                i += 1;
+                if case != 0 && case != 0xff {
+                    return Some(case);
+                }
+            }
+            None
+        })
+    }
+
+    /// True when the corners of cubes `i .. i + 8` (columns `i ..= i + 8`) are all alike.
+    fn uniform8(&self, i: usize) -> bool {
+        let word = |r: &[u8]| {
+            let mut bytes = [0u8; 8];
+            bytes.copy_from_slice(&r[i..i + 8]);
+            u64::from_le_bytes(bytes)
+        };
+        let first = word(self.rows[0]);
+        let alike = matches!(first, 0 | 0x0101_0101_0101_0101);
+        alike
+            && self.rows[1..].iter().all(|r| word(r) == first)
+            && self.rows.iter().all(|r| r[i + 8] == self.rows[0][i])
     }
 
     /// The cubes that may be cut: outside this range each of the four rows is constant, and all
@@ -139,11 +174,12 @@ impl CubeRow<'_> {
 /// Writes the inside flags of the row starting at voxel `start` into `row`.
 fn classify(volume: &Volume, start: [usize; 3], inside: &Inside, row: &mut [u8]) {
     match inside {
-        Inside::Values(table) => {
+        Inside::Values(range) => {
             let [nx, ny, _] = volume.dims();
             let at = start[0] + nx * (start[1] + ny * start[2]);
+            let (lo, hi) = (*range.start(), *range.end());
             for (flag, &s) in row.iter_mut().zip(&volume.voxels()[at..]) {
-                *flag = u8::from(table[usize::from(s)]);
+                *flag = u8::from(s >= lo && s <= hi);
             }
         }
         Inside::Lumen(lumen) => {
@@ -160,7 +196,7 @@ fn span_of(row: &[u8]) -> Span {
         return Span::none(row.len());
     }
     let crossed = |w: &[u8]| w[0] != w[1];
-    let count = row.windows(2).filter(|w| crossed(w)).count();
+    let count = differences(&row[1..], row);
     let first = row.windows(2).position(crossed).unwrap_or(row.len() - 1);
     let end = row.windows(2).rposition(crossed).map_or(0, |i| i + 1);
     Span {
@@ -168,4 +204,10 @@ fn span_of(row: &[u8]) -> Span {
         first: first as u32,
         end: end as u32,
     }
+}
+
+/// How many places two rows of flags differ at (a sum of exclusive ors, which vectorises).
+pub(super) fn differences(a: &[u8], b: &[u8]) -> usize {
+    let sum: u32 = a.iter().zip(b).map(|(x, y)| u32::from(x ^ y)).sum();
+    sum as usize
 }

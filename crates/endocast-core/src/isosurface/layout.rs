@@ -4,7 +4,7 @@
 //! can write rows in parallel without locks, in an order that does not depend on the threads.
 
 use super::cases::CASES;
-use super::grid::Grid;
+use super::grid::{differences, Grid};
 use crate::scene::MeshError;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -97,7 +97,7 @@ impl Layout {
 fn count_row(grid: &Grid, j: usize, k: usize) -> Counts {
     let [_, ny, nz] = grid.dims;
     let row = grid.row(j, k);
-    let crossings = |other: &[u8]| row.iter().zip(other).filter(|(a, b)| a != b).count();
+    let crossings = |other: &[u8]| differences(row, other);
     let y = if j + 1 < ny {
         crossings(grid.row(j + 1, k))
     } else {
@@ -112,9 +112,9 @@ fn count_row(grid: &Grid, j: usize, k: usize) -> Counts {
     if j + 1 < ny && k + 1 < nz {
         let cube_row = grid.cube_rows(j, k);
         cubes = cube_row.trim();
-        triangles = cubes
-            .clone()
-            .map(|i| usize::from(CASES[usize::from(cube_row.case(i))].count))
+        triangles = cube_row
+            .cut(cubes.clone())
+            .map(|case| usize::from(CASES[usize::from(case)].count))
             .sum();
     }
     Counts {

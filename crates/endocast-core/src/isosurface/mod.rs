@@ -47,10 +47,17 @@ pub fn lumen_surface(volume: &Volume, lumen: &Lumen) -> Result<TriangleMesh, Mes
 /// `side` of it, in world mm.
 pub fn isosurface(volume: &Volume, iso: f64, side: LumenSide) -> Result<TriangleMesh, MeshError> {
     let map = volume.value_map();
-    let table = (0..=u16::MAX)
-        .map(|s| side.holds(map.physical(s), iso))
-        .collect();
-    extract(volume, ([0; 3], volume.dims()), &Inside::Values(table), iso)
+    let holds = |s: &u16| side.holds(map.physical(*s), iso);
+    let stored = match ((0..=u16::MAX).find(holds), (0..=u16::MAX).rev().find(holds)) {
+        (Some(lo), Some(hi)) => lo..=hi,
+        _ => 1..=0,
+    };
+    extract(
+        volume,
+        ([0; 3], volume.dims()),
+        &Inside::Values(stored),
+        iso,
+    )
 }
 
 /// The surface of the voxels whose value is `label` (a segmentation's region), in world mm,
