@@ -186,12 +186,8 @@ mod tests {
                     directed.push((t[k], t[(k + 1) % 3]));
                 }
             }
-            for e in 0..12 {
-                assert_eq!(
-                    used[e] > 0,
-                    crossed(flags, e),
-                    "case {flags:#010b} edge {e}"
-                );
+            for (e, &n) in used.iter().enumerate() {
+                assert_eq!(n > 0, crossed(flags, e), "case {flags:#010b} edge {e}");
             }
             for &(a, b) in &directed {
                 let on_face = on_one_face(usize::from(a), usize::from(b));

@@ -48,14 +48,15 @@ pub fn lumen_surface(volume: &Volume, lumen: &Lumen) -> Result<TriangleMesh, Mes
 pub fn isosurface(volume: &Volume, iso: f64, side: LumenSide) -> Result<TriangleMesh, MeshError> {
     let map = volume.value_map();
     let holds = |s: &u16| side.holds(map.physical(*s), iso);
-    let stored = match ((0..=u16::MAX).find(holds), (0..=u16::MAX).rev().find(holds)) {
-        (Some(lo), Some(hi)) => lo..=hi,
-        _ => 1..=0,
+    // No voxel value on the inside's side: no surface.
+    let (Some(lo), Some(hi)) = ((0..=u16::MAX).find(holds), (0..=u16::MAX).rev().find(holds))
+    else {
+        return Err(MeshError::Empty);
     };
     extract(
         volume,
         ([0; 3], volume.dims()),
-        &Inside::Values(stored),
+        &Inside::Values(lo..=hi),
         iso,
     )
 }
