@@ -4,7 +4,8 @@
 # (endocast: --from; VTK: flying edges + vtkPolyDataConnectivityFilter, closest region).
 # Prints one line per run: wall and CPU seconds (median of RUNS), triangles, vertices.
 #
-# Usage (repository root, VTK from ../shared/peers/install_vtk.sh):
+# Usage (repository root, VTK from ../shared/peers/install_vtk.sh; SHARED_DATA: the shared
+# data folder when it is not ../shared/data):
 #   bench/mesh_vs_vtk.sh [RUNS]
 set -euo pipefail
 runs=${1:-3}
@@ -16,8 +17,12 @@ endocast_binary
 bin=$endocast
 colon=$out/colon256.nii.gz
 [ -f "$colon" ] || $bin phantom colon --size 256 -o "$colon" >/dev/null
+sphere=$out/sphere256.nii.gz
+[ -f "$sphere" ] || $bin phantom sphere-shell --size 256 -o "$sphere" >/dev/null
+tube=$out/curvedtube256.nii.gz
+[ -f "$tube" ] || $bin phantom curved-tube --size 256 -o "$tube" >/dev/null
 cthead=$out/cthead.nii.gz
-[ -f "$cthead" ] || $bin convert ../shared/data/head-ct-stanford-cthead/CThead.nhdr -o "$cthead" >/dev/null
+[ -f "$cthead" ] || $bin convert "${SHARED_DATA:-../shared/data}"/head-ct-stanford-cthead/CThead.nhdr -o "$cthead" >/dev/null
 
 # endocast_runs VOLUME ISO [X,Y,Z]: median wall and CPU seconds of `endocast mesh`.
 endocast_runs() {
@@ -40,6 +45,18 @@ endocast_runs "$colon" -500
 "$py" bench/vtk_mesh.py "$colon" --iso -500 --runs "$runs"
 endocast_runs "$colon" -500 56.5,-11.5,-18
 "$py" bench/vtk_mesh.py "$colon" --iso -500 --runs "$runs" --from-ijk 184 116 101
+# There is no torus phantom: the curved tube (a tube bent through 270° around a circle, closed
+# by half balls) is the nearest.
+echo "== sphere-shell phantom 256 (256³, 1 mm), −500 HU; --from the centre (the inner air)"
+endocast_runs "$sphere" -500
+"$py" bench/vtk_mesh.py "$sphere" --iso -500 --runs "$runs"
+endocast_runs "$sphere" -500 0,0,0
+"$py" bench/vtk_mesh.py "$sphere" --iso -500 --runs "$runs" --from-ijk 128 128 128
+echo "== curved-tube phantom 256 (256³, 1 mm), −500 HU; --from a point of its axis"
+endocast_runs "$tube" -500
+"$py" bench/vtk_mesh.py "$tube" --iso -500 --runs "$runs"
+endocast_runs "$tube" -500 76.8,0,0
+"$py" bench/vtk_mesh.py "$tube" --iso -500 --runs "$runs" --from-ijk 204 128 128
 echo "== CThead (256×256×113, 1×1×2 mm), skin/air at 550 (stored, about −470 HU)"
 endocast_runs "$cthead" 550
 "$py" bench/vtk_mesh.py "$cthead" --iso 550 --runs "$runs"

@@ -29,6 +29,12 @@ pub enum MeshError {
         /// How many vertices there are.
         vertices: usize,
     },
+    /// More vertices than 32-bit indices can name.
+    #[error("the mesh would have {vertices} vertices, more than 32-bit indices can name")]
+    TooLarge {
+        /// How many vertices it would have.
+        vertices: usize,
+    },
 }
 
 /// A triangle mesh: world positions (mm, LPS) and triangles as three vertex indices each.

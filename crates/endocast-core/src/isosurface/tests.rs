@@ -1,0 +1,209 @@
+//! Tests of the isosurface: watertight, outward, on the isovalue, lean, thread-independent.
+
+use super::*;
+use crate::phantom::{self, PhantomOptions};
+
+#[test]
+fn the_sphere_phantom_gives_a_closed_surface_on_the_isovalue() {
+    let (volume, shell) = phantom::sphere_shell(&PhantomOptions {
+        size: 32,
+        ..Default::default()
+    });
+    let c = shell.centre_vox.round();
+    let seed = [c.x as usize, c.y as usize, c.z as usize];
+    let lumen = Lumen::from_seed(&volume, seed, -480.0, LumenSide::Below).unwrap();
+    let mesh = lumen_surface(&volume, &lumen).unwrap();
+    assert_eq!(mesh.open_edges(), 0);
+    let g = volume.geometry();
+    for v in mesh.vertices() {
+        let p = g.voxel_from_world().transform_point3(*v);
+        let value = volume.sample_physical(p).unwrap();
+        // The wall's ramp is about 1000 HU per voxel: 0.1 voxel is 100 HU.
+        assert!((value + 480.0).abs() < 5.0, "{value} at {p}");
+        let r = p.distance(shell.centre_vox);
+        assert!((r - shell.inner_radius_vox).abs() < 0.1, "{r}");
+    }
+    // Facing out of the lumen: the signed volume is positive.
+    let volume_mm3: f64 = (0..mesh.triangles().len())
+        .map(|i| {
+            let [a, b, c] = mesh.corners(i);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum();
+    let sphere = 4.0 / 3.0 * std::f64::consts::PI * shell.inner_radius_vox.powi(3);
+    assert!(
+        (volume_mm3 / sphere - 1.0).abs() < 0.02,
+        "{volume_mm3} vs {sphere}"
+    );
+}
+
+/// The isovalue of [`field_volume`]: stored values are 10 000 + 1000 · d.
+const ISO: f64 = 10_000.0;
+
+/// An `n³` volume (1 mm voxels) whose value at voxel `p` is `ISO + 1000 · d(p)`, rounded.
+fn field_volume(n: usize, mut d: impl FnMut(DVec3) -> f64) -> Volume {
+    let dims = [n; 3];
+    let voxels = (0..n * n * n)
+        .map(|m| {
+            let p = DVec3::new((m % n) as f64, (m / n % n) as f64, (m / (n * n)) as f64);
+            (ISO + 1000.0 * d(p)).round().clamp(0.0, 65_535.0) as u16
+        })
+        .collect();
+    let geometry = crate::Geometry::axis_aligned(dims, DVec3::ONE, DVec3::ZERO).unwrap();
+    Volume::new(
+        geometry,
+        voxels,
+        crate::ValueMap::IDENTITY,
+        crate::Modality::Unknown,
+    )
+    .unwrap()
+}
+
+/// The volume the mesh encloses (positive when its triangles face out).
+fn signed_volume(mesh: &TriangleMesh) -> f64 {
+    (0..mesh.triangles().len())
+        .map(|i| {
+            let [a, b, c] = mesh.corners(i);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum()
+}
+
+/// The smallest triangle area.
+fn smallest_area(mesh: &TriangleMesh) -> f64 {
+    (0..mesh.triangles().len())
+        .map(|i| {
+            let [a, b, c] = mesh.corners(i);
+            (b - a).cross(c - a).length() / 2.0
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Asserts a closed, consistently oriented surface: every edge in exactly two triangles, once
+/// in each direction.
+fn assert_watertight(mesh: &TriangleMesh) {
+    assert_eq!(mesh.open_edges(), 0);
+    let mut directed: Vec<(u32, u32)> = mesh
+        .triangles()
+        .iter()
+        .flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)])
+        .collect();
+    directed.sort_unstable();
+    assert!(
+        directed.windows(2).all(|w| w[0] != w[1]),
+        "an edge twice in one direction"
+    );
+}
+
+#[test]
+fn a_distance_sphere_is_closed_outward_on_its_radius_and_lean() {
+    let (centre, r) = (DVec3::new(12.3, 11.8, 12.1), 9.0);
+    let volume = field_volume(25, |p| r - p.distance(centre));
+    let mesh = isosurface(&volume, ISO, LumenSide::Above).unwrap();
+    assert_watertight(&mesh);
+    for v in mesh.vertices() {
+        assert!((v.distance(centre) - r).abs() < 0.03, "{v}");
+    }
+    let ball = 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+    assert!((signed_volume(&mesh) / ball - 1.0).abs() < 0.01);
+    // A closed surface of genus 0 (Euler): T = 2V − 4, V being the crossed grid edges, about
+    // 4πr² · 1.5 (the mean of |nx| + |ny| + |nz| over a sphere).
+    let (t, v) = (mesh.triangles().len(), mesh.vertices().len());
+    assert_eq!(t, 2 * v - 4);
+    assert!(
+        (t as f64) < 1.2 * 12.0 * std::f64::consts::PI * r * r,
+        "{t} triangles"
+    );
+    // The lumen around the centre is the whole inside: the same mesh from its bounding box.
+    let seed = centre.round().to_array().map(|c| c as usize);
+    let lumen = Lumen::from_seed(&volume, seed, ISO, LumenSide::Above).unwrap();
+    assert_eq!(lumen_surface(&volume, &lumen).unwrap(), mesh);
+}
+
+#[test]
+fn a_torus_is_closed_outward_on_its_surface_and_of_genus_one() {
+    let (centre, big, small) = (DVec3::new(15.4, 15.2, 8.3), 9.0, 3.5);
+    let torus = |p: DVec3| {
+        let q = p - centre;
+        small - (q.x.hypot(q.y) - big).hypot(q.z)
+    };
+    let volume = field_volume(31, torus);
+    let mesh = isosurface(&volume, ISO, LumenSide::Above).unwrap();
+    assert_watertight(&mesh);
+    for v in mesh.vertices() {
+        assert!(torus(*v).abs() < 0.06, "{v}");
+    }
+    let solid = 2.0 * std::f64::consts::PI.powi(2) * big * small * small;
+    let ratio = signed_volume(&mesh) / solid;
+    assert!((ratio - 1.0).abs() < 0.03, "{ratio}");
+    assert_eq!(mesh.triangles().len(), 2 * mesh.vertices().len());
+}
+
+#[test]
+fn random_fields_give_closed_outward_surfaces_without_zero_area_triangles() {
+    let mut rng = crate::test_rng::Rng::new(33);
+    for values in [
+        [-900.0, -300.0, 200.0, 700.0],
+        [-1000.0, 0.0, 1000.0, 1000.0],
+    ] {
+        for _ in 0..4 {
+            // Random voxels inside a border of outside ones (values below the isovalue).
+            let volume = field_volume(10, |p| {
+                let border = p.min_element() == 0.0 || p.max_element() == 9.0;
+                let pick = values[(rng.unit() * 4.0) as usize] / 1000.0;
+                if border {
+                    -1.0
+                } else {
+                    pick
+                }
+            });
+            let Ok(mesh) = isosurface(&volume, ISO, LumenSide::Above) else {
+                continue;
+            };
+            assert_watertight(&mesh);
+            assert!(smallest_area(&mesh) > 1e-7, "{}", smallest_area(&mesh));
+            assert!(signed_volume(&mesh) > 0.0);
+        }
+    }
+}
+
+#[test]
+fn voxels_equal_to_the_isovalue_give_no_zero_area_triangles() {
+    // A plane of voxels exactly at the isovalue between inside (above) and outside (below),
+    // with a dent: one voxel of the plane pushed a voxel into the inside, so that several of
+    // its edges end on the same isovalue voxel.
+    let volume = field_volume(8, |p| {
+        if p == DVec3::new(4.0, 4.0, 4.0) {
+            0.0
+        } else {
+            (p.z - 3.0).clamp(-1.0, 1.0)
+        }
+    });
+    let mesh = isosurface(&volume, ISO, LumenSide::Above).unwrap();
+    assert!(smallest_area(&mesh) > 1e-7, "{}", smallest_area(&mesh));
+    // Each crossed edge keeps its own vertex, a thousandth of a voxel off the isovalue voxel.
+    let dent = DVec3::new(4.0, 4.0, 4.0);
+    for v in mesh.vertices() {
+        assert!(
+            (v.z - 3.001).abs() < 1e-9 || (v.distance(dent) - 0.001).abs() < 1e-9,
+            "{v}"
+        );
+    }
+    assert_eq!(mesh.vertices().len(), 63 + 5);
+}
+
+#[test]
+fn the_mesh_does_not_depend_on_the_thread_count() {
+    let volume = phantom::Phantom::Colon.build(&PhantomOptions {
+        size: 48,
+        ..Default::default()
+    });
+    let mesh_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| isosurface(&volume, -500.0, LumenSide::Below).unwrap())
+    };
+    assert_eq!(mesh_on(1), mesh_on(3));
+}
