@@ -9,6 +9,8 @@ mod peel;
 pub(crate) use peel::PeelParams;
 
 use super::bricks::{Activity, BitSet, BrickGrid};
+use super::cell_mask::CellMask;
+use super::cell_walk::CellWalk;
 use super::crossing::{bisect, crosses, first_crossing, BISECTION_LEVELS};
 use super::march::{Batch, Flow, RayMarch, Sample, Stopped, Walk};
 use super::ray_task::Bracket;
@@ -56,6 +58,7 @@ pub(crate) struct Params {
     pub crossing: Crossing,
     pub early_termination: f32,
     pub refine_steps: u32,
+    pub exact_hits: bool,
     pub shade_dvr: bool,
     pub skip_empty: bool,
     pub peel: PeelParams,
@@ -74,6 +77,8 @@ pub(crate) struct Integrator<'a> {
     pub sampler: Sampler<'a>,
     pub grid: &'a BrickGrid,
     pub activity: &'a Activity,
+    /// The cells that can hold the lower isosurface, for the exact search (iso and hybrid).
+    pub cells: &'a CellMask,
     pub table: &'a TfTable,
     /// The transfer function behind a peel ([`Mode::Peel`]; the same as `table` otherwise).
     pub after: Classified<'a>,
@@ -147,8 +152,16 @@ impl Integrator<'_> {
             }
         };
         let surface = self.params.lower;
-        self.search_group(tasks, surface.iso);
-        self.refine_group(tasks, surface.iso);
+        if self.sampled_hits() {
+            self.search_group(tasks, surface.iso);
+            self.refine_group(tasks, surface.iso);
+        } else {
+            // The exact search, ray by ray.
+            for task in tasks.iter_mut() {
+                let hit = self.first_hit(&mut task.march, &mut ());
+                task.out.depth_mm = hit.unwrap_or(f32::NAN);
+            }
+        }
         if !shade && !volume_behind {
             return;
         }
@@ -157,7 +170,7 @@ impl Integrator<'_> {
         }
         if volume_behind {
             for (k, task) in tasks.iter_mut().enumerate() {
-                if task.bracket.is_none() {
+                if task.out.depth_mm.is_nan() {
                     continue;
                 }
                 if let Some(&end) = composite_ends.get(k) {
@@ -202,11 +215,10 @@ impl Integrator<'_> {
         volume_behind: bool,
     ) -> PixelOut {
         let mut out = PixelOut::default();
-        let iso = self.params.lower.iso;
-        let Some(bracket) = self.search(march, iso, probe) else {
+        let Some(depth) = self.first_hit(march, probe) else {
             return out;
         };
-        out.depth_mm = self.refine(march.grid(), iso, bracket);
+        out.depth_mm = depth;
         self.lit_surface(march, dir_world, &mut out);
         if volume_behind {
             self.composite(march, &mut out, dir_world, false, probe);
@@ -214,19 +226,59 @@ impl Integrator<'_> {
         out
     }
 
+    /// Whether iso and hybrid find their surface by the samples' search and bisection rather
+    /// than exactly by the cell walk ([`super::RenderSettings::exact_hits`]); other modes
+    /// always search by samples.
+    pub(super) fn sampled_hits(&self) -> bool {
+        !(self.params.exact_hits && matches!(self.params.mode, Mode::Iso | Mode::Hybrid))
+    }
+
+    /// The exact search for the lower isovalue ([`Self::sampled_hits`] false).
+    fn cell_walk(&self) -> CellWalk<'_> {
+        CellWalk {
+            voxels: self.sampler.voxel_grid(),
+            cells: self.cells,
+            iso: self.params.lower.iso,
+        }
+    }
+
+    /// The direction of the first crossing of `iso` along a fresh `march` ([`Self::rising`]),
+    /// and whether the ray starts on its near side (always in auto mode: the start decides).
+    fn side(&self, march: &RayMarch, iso: f32) -> (bool, bool) {
+        let rising = self.rising(march, iso);
+        let before = self.params.crossing == Crossing::Auto || {
+            let grid = march.grid();
+            (self.sampler.value(grid.at(grid.t_start)) < iso) == rising
+        };
+        (rising, before)
+    }
+
+    /// The first hit of the lower isosurface along a fresh `march`, mm, as
+    /// [`Self::sampled_hits`] says; the march is left for the volume behind it.
+    pub(super) fn first_hit(&self, march: &mut RayMarch, probe: &mut impl Probe) -> Option<f32> {
+        let iso = self.params.lower.iso;
+        if self.sampled_hits() {
+            let bracket = self.search(march, iso, probe)?;
+            return Some(self.refine(march.grid(), iso, bracket));
+        }
+        let hit = self.cell_walk().first_hit(march, self.side(march, iso))?;
+        probe.sample(hit, iso, 0.0);
+        Some(hit)
+    }
+
     /// [`Self::lit_surface`] for each ray of up to eight that hit, their gradients in batches
     /// across the rays.
     fn lit_surfaces(&self, tasks: &mut [RayTask]) {
         let mut points = [Vec3::ZERO; 8];
         for (point, task) in points.iter_mut().zip(tasks.iter()) {
-            if task.bracket.is_some() {
+            if !task.out.depth_mm.is_nan() {
                 *point = task.march.grid().at(task.out.depth_mm);
             }
         }
         let gradients = self.sampler.gradients8(&points);
         let surface = self.params.lower;
         for (gradient, task) in gradients.iter().zip(tasks.iter_mut()) {
-            if task.bracket.is_some() {
+            if !task.out.depth_mm.is_nan() {
                 let lit = self.shaded(*gradient, surface.color, task.dir_world);
                 task.out.accum.under_surface(lit, surface.opacity);
             }
@@ -344,6 +396,11 @@ impl Integrator<'_> {
     /// crossing found.
     pub fn crossings(&self, march: &mut RayMarch, depths_mm: &mut [f32]) {
         let iso = self.params.lower.iso;
+        if !self.sampled_hits() {
+            self.cell_walk()
+                .crossings(march, self.side(march, iso), depths_mm);
+            return;
+        }
         let mut rising = self.rising(march, iso);
         let mut previous = (0.0, 0.0);
         for depth in depths_mm {

@@ -261,6 +261,33 @@ impl RayMarch {
         self.stats = stats;
     }
 
+    /// Hands the bricks, in order, to an exact search ([`super::cell_walk`]): `active(brick)`
+    /// gives what the search reads of a brick (`None`: nothing can be found there, skipped) and
+    /// `visit` searches the brick's segment with it, until it returns a hit (mm). The march is
+    /// then left as a search walk leaves it: the brick of the hit pending, its next sample the
+    /// first at or past the hit. For a march not yet walked.
+    pub(crate) fn find<T>(
+        &mut self,
+        mut active: impl FnMut(u32) -> Option<T>,
+        mut visit: impl FnMut(Segment, T) -> Option<f32>,
+    ) -> Option<f32> {
+        debug_assert!(self.pending.is_none());
+        while let Some(segment) = self.dda.next() {
+            let Some(found) = active(segment.brick) else {
+                self.stats.bricks_skipped += 1;
+                continue;
+            };
+            self.stats.bricks_visited += 1;
+            if let Some(t) = visit(segment, found) {
+                self.next = self.next.max(self.index_at(t));
+                self.has_previous = false;
+                self.pending = Some(segment);
+                return Some(t);
+            }
+        }
+        None
+    }
+
     /// Samples, in order, the bricks for which `active(brick)` holds, handing each sample to
     /// `visit` until it stops the walk (returns true) or the ray ends (returns false), as
     /// `walk` says (see [`Walk`]).

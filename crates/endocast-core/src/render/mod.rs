@@ -44,6 +44,8 @@
 
 mod bricks;
 
+mod cell_mask;
+mod cell_walk;
 mod crossing;
 mod frame;
 mod integrate;
@@ -63,10 +65,13 @@ mod tiles;
 mod trace;
 mod transfer;
 pub mod traverse;
+mod trilinear_root;
 mod voxel_grid;
 
 #[cfg(test)]
 mod camera_tests;
+#[cfg(test)]
+mod exact_tests;
 #[cfg(test)]
 mod interactive_tests;
 #[cfg(test)]
@@ -82,6 +87,7 @@ pub use crate::camera::{Camera, CameraError, FOV_RANGE_DEG, MAX_IMAGE_EDGE};
 
 use crate::camera::Ray;
 pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
+use cell_mask::CellMask;
 pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
 pub use options::{Cancelled, Progress, Quality, RenderOptions};
 pub use progressive::{progressive, PreviewPlanner};
@@ -199,6 +205,8 @@ struct Derived {
     settings: RenderSettings,
     table: TfTable,
     activity: Activity,
+    /// The cells that can hold the isosurface of the exact search (iso and hybrid only).
+    cells: CellMask,
     /// The transfer function behind a peel and its active bricks ([`Mode::Peel`] only).
     after: Option<(TfTable, BitSet)>,
     params: Params,
@@ -234,6 +242,12 @@ impl Derived {
             isovalues.push(stored(settings.iso2_hu));
         }
         let activity = Activity::classify(&renderer.grid, &isovalues, &table);
+        let exact = settings.exact_hits && matches!(settings.mode, Mode::Iso | Mode::Hybrid);
+        let cells = if exact {
+            CellMask::new(volume, &renderer.grid, &activity, isovalues[0])
+        } else {
+            CellMask::default()
+        };
         let after = peel.then(|| {
             let tf = settings.peel.tf_after.as_ref().unwrap_or(&settings.tf);
             let after = TfTable::new(tf, map, volume.stored_range(), step_mm);
@@ -252,6 +266,7 @@ impl Derived {
             crossing: settings.crossing,
             early_termination: settings.early_termination,
             refine_steps: settings.refine_steps,
+            exact_hits: settings.exact_hits,
             shade_dvr: settings.shade_dvr,
             skip_empty: settings.skip_empty,
             peel: PeelParams {
@@ -271,6 +286,7 @@ impl Derived {
             settings: settings.clone(),
             table,
             activity,
+            cells,
             after,
             params,
             shader,
@@ -288,6 +304,7 @@ pub struct Prepared {
     settings: RenderSettings,
     table: TfTable,
     activity: Activity,
+    cells: CellMask,
     after: Option<(TfTable, BitSet)>,
     params: Params,
     shader: Shader,
@@ -316,6 +333,7 @@ impl Prepared {
             settings: d.settings,
             table: d.table,
             activity: d.activity,
+            cells: d.cells,
             after: d.after,
             params: d.params,
             shader: d.shader,
@@ -332,6 +350,7 @@ impl Prepared {
         self.settings = d.settings;
         self.table = d.table;
         self.activity = d.activity;
+        self.cells = d.cells;
         self.after = d.after;
         self.params = d.params;
         self.shader = d.shader;
@@ -374,6 +393,7 @@ impl Prepared {
             sampler: self.renderer.sampler(),
             grid: &self.renderer.grid,
             activity: &self.activity,
+            cells: &self.cells,
             table: &self.table,
             after: Classified { table, active },
             shader: self.shader,

@@ -436,10 +436,8 @@ impl Integrator<'_> {
         let span = march.span();
         match self.params.mode {
             Mode::Hybrid => {
-                let iso = self.params.lower.iso;
                 let depth = self
-                    .search(march, iso, &mut ())
-                    .map(|bracket| self.refine(march.grid(), iso, bracket))
+                    .first_hit(march, &mut ())
                     .filter(|&depth| depth < split.end_mm);
                 let Some(depth) = depth else {
                     for hit in hits {

@@ -442,13 +442,15 @@ fn the_colon_mesh_is_watertight_on_the_isosurface_and_drawn_where_the_wall_is() 
         assert_eq!(a.is_nan(), b.is_nan());
         if !b.is_nan() {
             compared += 1;
-            off += usize::from((a - b).abs() >= 0.2);
+            // Marching cubes' flat triangles cut across each cube where the trilinear surface
+            // bulges: up to about a quarter of a voxel from it inside a cube.
+            off += usize::from((a - b).abs() >= 0.25);
         }
     }
     assert!(compared > 3000, "{compared}");
     assert!(
         off * 100 <= compared,
-        "{off} of {compared} pixels off by 0.2 voxel or more"
+        "{off} of {compared} pixels off by 0.25 voxel or more"
     );
 }
 

@@ -192,11 +192,13 @@ impl Prepared {
     /// Whether the right eye's searches may start from the left eye's emptiness.
     fn shares_emptiness(&self, left: &Camera, right: &Camera) -> bool {
         let pinhole = |c: &Camera| c.projection() == Projection::Pinhole && c.lens().is_ideal();
+        let integrator = self.integrator(left);
+        // The exact search walks cells, not samples: it has no samples to start late.
         let surface_first = matches!(self.settings.mode, Mode::Iso | Mode::Hybrid);
-        if !(surface_first && pinhole(left) && left.near_mm() == 0.0) {
+        let sampled = surface_first && integrator.sampled_hits();
+        if !(sampled && pinhole(left) && left.near_mm() == 0.0) {
             return false;
         }
-        let integrator = self.integrator(left);
         let iso = self.params.lower.iso;
         let dims = self.renderer.volume.dims();
         let extent = DVec3::from(dims.map(|n| (n - 1) as f64));
