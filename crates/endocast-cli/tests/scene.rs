@@ -74,7 +74,6 @@ fn bad_geometry_options_are_clear_errors() {
     render(&["--grid", "0,0,0:0,0,0:5"], "grid");
     render(&["--marker", "0,0,nan"], "nan");
     render(&["--endoscope", "0"], "endoscope");
-    fails_with(&["mesh", volume, "-o", "x.stl"], "--iso or --preset");
     fails_with(&["mesh", volume, "--iso", "-480", "-o", "x.vtk"], "x.vtk");
 }
 

@@ -242,26 +242,26 @@ impl ViewerApp {
         });
     }
 
-    /// The frame's status on one line, and below it the last message, wrapped, greyed once it
-    /// is [`STALE_MESSAGE`] old.
+    /// The frame's status and the last message, wrapped onto more lines when long, the message
+    /// greyed once it is [`STALE_MESSAGE`] old.
     fn status_ui(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
+        if self.message_since.0 != self.message {
+            self.message_since = (self.message.clone(), Instant::now());
+        }
+        let stale = self.message_since.1.elapsed() > STALE_MESSAGE;
+        ui.horizontal_wrapped(|ui| {
             if let Some(loading) = &self.loading {
                 loading.ui(ui);
             }
             if let Some(ready) = &self.ready {
                 ui.label(frame_status(ready));
             }
+            if !self.message.is_empty() {
+                ui.separator();
+                let text = egui::RichText::new(&self.message);
+                ui.label(if stale { text.weak() } else { text });
+            }
         });
-        if self.message.is_empty() {
-            return;
-        }
-        if self.message_since.0 != self.message {
-            self.message_since = (self.message.clone(), Instant::now());
-        }
-        let text = egui::RichText::new(&self.message);
-        let stale = self.message_since.1.elapsed() > STALE_MESSAGE;
-        ui.add(egui::Label::new(if stale { text.weak() } else { text }).wrap());
     }
 
     fn act(&mut self, action: Action) {

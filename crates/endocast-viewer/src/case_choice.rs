@@ -19,7 +19,8 @@ pub struct CaseChoice {
 
 /// The case for a session on `source`: `given` (`--case`) when there is one; else the scan's
 /// default case ([`default_case_path`]) reopened when it is this scan's; else, when that file
-/// cannot be read or belongs to another scan, a new file beside it, never written over.
+/// cannot be read or belongs to another scan (or the scan is a phantom), a new file beside it:
+/// an existing one is never written over.
 pub fn choose_case(source: &ScanSource, given: Option<PathBuf>) -> CaseChoice {
     if let Some(path) = given {
         return CaseChoice {
@@ -33,6 +34,15 @@ pub fn choose_case(source: &ScanSource, given: Option<PathBuf>) -> CaseChoice {
         return CaseChoice {
             open: None,
             save_to: default,
+            note: None,
+        };
+    }
+    // A phantom is made anew, not a study with saved work: its case in the temporary folder
+    // (perhaps another session's) is not reopened, nor written over.
+    if matches!(source, ScanSource::Phantom { .. }) {
+        return CaseChoice {
+            open: None,
+            save_to: free_name(&default),
             note: None,
         };
     }

@@ -215,17 +215,22 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     }
     let scene = Arc::clone(session.scene());
     let c = &mut session.controls;
-    egui::ComboBox::from_label("mode")
-        .selected_text(c.mode.name())
-        .show_ui(ui, |ui| {
-            for m in Mode::ALL {
-                ui.selectable_value(&mut c.mode, m, m.name());
-            }
-        });
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_label("mode")
+            .selected_text(c.mode.name())
+            .show_ui(ui, |ui| {
+                for m in Mode::ALL {
+                    ui.selectable_value(&mut c.mode, m, m.name());
+                }
+            });
+        // The histogram's help on a mark of its own, so that it covers no slider.
+        ui.weak("(?)").on_hover_text(
+            "histogram below — click: isovalue · drag a dot: opacity · double-click: add a dot · \
+             right-click: remove it",
+        );
+    });
     let (lo, hi) = scene.value_range;
     histogram_ui(ui, &scene.histogram, (lo, hi), &mut c.iso_hu, &mut c.tf);
-    // A line under the histogram, not a tooltip over the sliders below it.
-    ui.small("click: isovalue · drag a dot: opacity · double-click: add · right-click: remove");
     ui.add(egui::Slider::new(&mut c.iso_hu, lo..=hi).text("isovalue"));
     ui.add(egui::Slider::new(&mut c.iso_opacity, 0.0..=1.0).text("surface opacity"));
     egui::ComboBox::from_label("lens")
