@@ -376,29 +376,81 @@ fn key_frames_ui(ui: &mut egui::Ui, session: &mut Session) -> Option<Action> {
             session.scrub(s);
         }
     }
-    let mut go = None;
-    let mut delete = None;
+    if let Some(edit) = key_frame_rows(ui, session) {
+        if let Err(e) = edit.apply(session) {
+            action = Some(Action::Message(e));
+        }
+    }
+    action
+}
+
+/// What a key frame's row asks for.
+enum KeyEdit {
+    GoTo(usize),
+    InsertBefore(usize),
+    Move(usize, usize),
+    Delete(usize),
+    Undo,
+}
+
+impl KeyEdit {
+    fn apply(self, session: &mut Session) -> Result<(), String> {
+        match self {
+            Self::GoTo(i) => session.go_to_key_frame(i),
+            Self::InsertBefore(i) => session.insert_key_frame(i)?,
+            Self::Move(from, to) => session.move_key_frame(from, to),
+            Self::Delete(i) => session.delete_key_frame(i),
+            Self::Undo => {
+                session.undo_key_frames();
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The key frames, a row each (go to it; insert the current view before it; move it up or
+/// down; delete it), and Undo for the last change.
+fn key_frame_rows(ui: &mut egui::Ui, session: &Session) -> Option<KeyEdit> {
+    let mut edit = None;
+    let n = session.key_frames().len();
     for (i, k) in session.key_frames().iter().enumerate() {
         ui.horizontal(|ui| {
             let e = k.eye_mm;
+            let go = ui.button(format!("{} ({:.0}, {:.0}, {:.0})", i + 1, e.x, e.y, e.z));
+            if go.on_hover_text("go to this key frame").clicked() {
+                edit = Some(KeyEdit::GoTo(i));
+            }
+            let insert = ui
+                .small_button("+")
+                .on_hover_text("insert the view before it");
+            if insert.clicked() {
+                edit = Some(KeyEdit::InsertBefore(i));
+            }
             if ui
-                .button(format!("{} ({:.0}, {:.0}, {:.0})", i + 1, e.x, e.y, e.z))
+                .add_enabled(i > 0, egui::Button::new("up").small())
                 .clicked()
             {
-                go = Some(i);
+                edit = Some(KeyEdit::Move(i, i - 1));
             }
-            if ui.small_button("delete").clicked() {
-                delete = Some(i);
+            if ui
+                .add_enabled(i + 1 < n, egui::Button::new("down").small())
+                .clicked()
+            {
+                edit = Some(KeyEdit::Move(i, i + 1));
+            }
+            if ui.small_button("×").on_hover_text("delete it").clicked() {
+                edit = Some(KeyEdit::Delete(i));
             }
         });
     }
-    if let Some(i) = go {
-        session.go_to_key_frame(i);
+    let undo = egui::Button::new("Undo key frames").small();
+    if ui
+        .add_enabled(session.can_undo_key_frames(), undo)
+        .clicked()
+    {
+        edit = Some(KeyEdit::Undo);
     }
-    if let Some(i) = delete {
-        session.delete_key_frame(i);
-    }
-    action
+    edit
 }
 
 /// Renders the current view at full quality (with its annotations) off the UI thread and

@@ -26,6 +26,9 @@ use std::time::{Duration, Instant};
 /// The default size of the endoscopic view, pixels.
 pub const DEFAULT_VIEW_SIZE: [usize; 2] = [512, 512];
 
+/// How many changes to the key frames can be taken back.
+pub const KEY_FRAME_UNDO: usize = 50;
+
 /// How long a moving view waits for the last one's first frame before superseding it anyway.
 const MAX_WAIT_FOR_FRAME: Duration = Duration::from_millis(150);
 
@@ -164,6 +167,8 @@ pub struct Session {
     stereo_focus: Option<(FlyCamera, f64)>,
     last_submit: Option<(u64, Instant)>,
     key_frames: Vec<KeyFrame>,
+    /// The key frames before each of the last changes, oldest first.
+    key_frame_history: Vec<Vec<KeyFrame>>,
     playback: Option<Playback>,
     marks: Annotations,
     /// The stroke being drawn, surface points so far.
@@ -213,6 +218,7 @@ impl Session {
             stereo_focus: None,
             last_submit: None,
             key_frames: Vec::new(),
+            key_frame_history: Vec::new(),
             playback: None,
             marks: Annotations::default(),
             stroke: Vec::new(),
@@ -573,10 +579,15 @@ impl Session {
         self.study.lumen_at(self.controls.iso_hu).ok()
     }
 
-    /// Records the current view as a key frame (after the last).
+    /// Records the current view as a key frame (after the last); undoable.
     pub fn record_key_frame(&mut self) -> Result<(), String> {
+        self.insert_key_frame(usize::MAX)
+    }
+
+    /// The current view as a key frame.
+    fn current_key_frame(&self) -> Result<KeyFrame, String> {
         let c = &self.camera;
-        let key = KeyFrame::new(
+        KeyFrame::new(
             c.eye_mm(),
             c.forward(),
             c.up(),
@@ -584,9 +595,7 @@ impl Session {
             self.controls.iso_hu,
             f64::from(self.controls.iso_opacity),
         )
-        .map_err(|e| e.to_string())?;
-        self.key_frames.push(key);
-        Ok(())
+        .map_err(|e| e.to_string())
     }
 
     /// The recorded key frames.
@@ -594,18 +603,64 @@ impl Session {
         &self.key_frames
     }
 
-    /// Replaces the key frames (a reopened case, an imported path).
+    /// Replaces the key frames (a reopened case, an imported path); undoable.
     pub fn set_key_frames(&mut self, keys: Vec<KeyFrame>) {
-        self.key_frames = keys;
-        self.playback = None;
+        self.edit_key_frames(|frames| *frames = keys);
     }
 
-    /// Deletes key frame `index`.
+    /// Deletes key frame `index`; undoable.
     pub fn delete_key_frame(&mut self, index: usize) {
         if index < self.key_frames.len() {
-            self.key_frames.remove(index);
-            self.playback = None;
+            self.edit_key_frames(|frames| {
+                frames.remove(index);
+            });
         }
+    }
+
+    /// Records the current view as a key frame before key frame `index` (after the last when
+    /// `index` is past it); undoable.
+    pub fn insert_key_frame(&mut self, index: usize) -> Result<(), String> {
+        let key = self.current_key_frame()?;
+        let at = index.min(self.key_frames.len());
+        self.edit_key_frames(|frames| frames.insert(at, key));
+        Ok(())
+    }
+
+    /// Moves key frame `from` to place `to` (both within the list); undoable.
+    pub fn move_key_frame(&mut self, from: usize, to: usize) {
+        let n = self.key_frames.len();
+        if from < n && to < n && from != to {
+            self.edit_key_frames(|frames| {
+                let key = frames.remove(from);
+                frames.insert(to, key);
+            });
+        }
+    }
+
+    /// Takes back the last change to the key frames; false when there is none to take back.
+    pub fn undo_key_frames(&mut self) -> bool {
+        let Some(before) = self.key_frame_history.pop() else {
+            return false;
+        };
+        self.key_frames = before;
+        self.playback = None;
+        true
+    }
+
+    /// Whether a change to the key frames can be taken back.
+    pub fn can_undo_key_frames(&self) -> bool {
+        !self.key_frame_history.is_empty()
+    }
+
+    /// Changes the key frames by `change`, keeping what they were for [`Self::undo_key_frames`]
+    /// (the last [`KEY_FRAME_UNDO`] changes); a flight being played stops.
+    fn edit_key_frames(&mut self, change: impl FnOnce(&mut Vec<KeyFrame>)) {
+        if self.key_frame_history.len() == KEY_FRAME_UNDO {
+            self.key_frame_history.remove(0);
+        }
+        self.key_frame_history.push(self.key_frames.clone());
+        change(&mut self.key_frames);
+        self.playback = None;
     }
 
     /// Moves to key frame `index` (its pose, field of view and wall).

@@ -299,3 +299,34 @@ fn the_realistic_look_refines_to_its_still_and_then_rests() {
     assert_eq!(session.sync(false), None);
     assert_eq!(session.worker().generation(), g);
 }
+
+#[test]
+fn key_frames_insert_move_delete_and_undo() {
+    let (mut session, _) = tube_session();
+    let eye = |s: &endocast_viewer::session::Session| -> Vec<f64> {
+        s.key_frames().iter().map(|k| k.eye_mm.z).collect()
+    };
+    session.record_key_frame().unwrap();
+    session.fly(forward(2.0));
+    session.record_key_frame().unwrap();
+    session.fly(forward(2.0));
+    // The view now goes between the two.
+    session.insert_key_frame(1).unwrap();
+    let [a, b, c] = eye(&session)[..] else {
+        panic!("{:?}", eye(&session));
+    };
+    session.move_key_frame(2, 0);
+    assert_eq!(eye(&session), [c, a, b]);
+    session.delete_key_frame(1);
+    assert_eq!(eye(&session), [c, b]);
+    // Each change taken back in turn, to none recorded.
+    assert!(session.undo_key_frames());
+    assert_eq!(eye(&session), [c, a, b]);
+    assert!(session.undo_key_frames());
+    assert_eq!(eye(&session), [a, b, c]);
+    for _ in 0..3 {
+        assert!(session.undo_key_frames());
+    }
+    assert!(session.key_frames().is_empty());
+    assert!(!session.undo_key_frames());
+}
