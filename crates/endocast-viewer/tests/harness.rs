@@ -169,10 +169,25 @@ impl Window {
         assert!(missing.is_empty(), "drawn without glyphs: {missing:?}");
     }
 
+    /// Where `text` is once the panel has stopped moving (a wheel's scroll is animated over
+    /// several frames: a click aimed at the first frame's place would land beside it).
+    fn settled_text_rect(&mut self, text: &str) -> Option<Rect> {
+        let mut rect = self.text_rect(text)?;
+        for _ in 0..60 {
+            self.frame(Vec::new());
+            let now = self.text_rect(text)?;
+            if now == rect {
+                return Some(now);
+            }
+            rect = now;
+        }
+        Some(rect)
+    }
+
     /// Clicks the widget that shows `text`, scrolling the control panel down to it.
     pub fn click_text(&mut self, text: &str) {
         for _ in 0..40 {
-            if let Some(rect) = self.text_rect(text) {
+            if let Some(rect) = self.settled_text_rect(text) {
                 self.click(rect.center());
                 return;
             }
