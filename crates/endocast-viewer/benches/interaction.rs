@@ -2,7 +2,9 @@
 //! updated frame the UI can show, at moving quality, and to the full-quality frame, at 512×512
 //! on the colon phantom, through the viewer's own session and render worker.
 //!
-//! `cargo bench -p endocast-viewer --bench interaction [-- SIZE [POSES]]` (defaults 512, 40).
+//! `cargo bench -p endocast-viewer --bench interaction [-- SIZE [POSES [SCAN PRESET]]]`
+//! (defaults 512, 40, the colon phantom of SIZE with colonoscopy); with a scan and a preset,
+//! the poses follow the path the preset's study plans on it (as `endocast path`).
 //!
 //! On Linux it also reports the CPU time the process's threads ran, and waited runnable for a
 //! CPU, from the input to the first frame (`/proc/self/task/*/schedstat`): on a shared machine
@@ -22,43 +24,16 @@ fn main() {
     let mut args = std::env::args().skip(1).filter(|a| !a.starts_with("--"));
     let size: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(512);
     let poses: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(40);
-    let options = PhantomOptions {
-        size,
-        ..PhantomOptions::default()
+    let (mut session, flight, what) = match (args.next(), args.next()) {
+        (Some(scan), Some(preset)) => on_scan(&scan, &preset),
+        _ => on_colon(size),
     };
-    let (volume, colon) = phantom::colon(&options);
-    let geometry = *volume.geometry();
-    let line = &colon.centreline;
-    let source = ScanSource::Phantom {
-        name: "colon".into(),
-        size,
-    };
-    let scene = Arc::new(Scene::new(source, volume));
-    let preset = Preset::find("colonoscopy");
-    let at = |s: f64| geometry.world_of(line.point_at(s));
-    let pose = |s: f64| {
-        let (eye_mm, look_at_mm) = (at(s), at(s + 10.0));
-        let forward = (look_at_mm - eye_mm).normalize_or_zero();
-        let up = if forward.y.abs() < 0.9 {
-            glam::DVec3::NEG_Y
-        } else {
-            glam::DVec3::Z
-        };
-        Pose {
-            eye_mm,
-            look_at_mm,
-            up,
-        }
-    };
-    let mut session = Session::new(scene, preset, Some(pose(20.0)), || {});
     session.set_view_size([512, 512]);
     let (mut first, mut full) = (Vec::new(), Vec::new());
     let (mut ran, mut waited) = (Vec::new(), Vec::new());
-    let length = line.length_vox();
     let wait = Duration::from_secs(60);
     for k in 0..poses {
-        let s = 20.0 + (length - 40.0) * k as f64 / poses as f64;
-        let Some(camera) = FlyCamera::from_pose(&pose(s)) else {
+        let Some(camera) = FlyCamera::from_pose(&flight(k as f64 / poses as f64)) else {
             continue;
         };
         session.set_camera(camera);
@@ -86,7 +61,7 @@ fn main() {
     let mut first_ms: Vec<f64> = first.iter().map(|(d, _)| ms(*d)).collect();
     let mut full_ms: Vec<f64> = full.iter().map(|d| ms(*d)).collect();
     println!(
-        "colon phantom {size}, 512x512, {} poses along the centreline, first stages: {}",
+        "{what}, 512x512, {} poses along the path, first stages: {}",
         first.len(),
         stage_counts(first.iter().map(|f| f.1))
     );
@@ -99,6 +74,74 @@ fn main() {
             &mut waited,
         );
     }
+}
+
+/// Poses along a flight, by the share of it flown (0–1).
+type Flight = Box<dyn Fn(f64) -> Pose>;
+
+/// The colon phantom at `size` with the colonoscopy preset, flown along its centreline.
+fn on_colon(size: usize) -> (Session, Flight, String) {
+    let options = PhantomOptions {
+        size,
+        ..PhantomOptions::default()
+    };
+    let (volume, colon) = phantom::colon(&options);
+    let geometry = *volume.geometry();
+    let line = colon.centreline;
+    let source = ScanSource::Phantom {
+        name: "colon".into(),
+        size,
+    };
+    let scene = Arc::new(Scene::new(source, volume));
+    let length = line.length_vox();
+    let at = move |s: f64| geometry.world_of(line.point_at(s));
+    let pose = move |s: f64| {
+        let (eye_mm, look_at_mm) = (at(s), at(s + 10.0));
+        let forward = (look_at_mm - eye_mm).normalize_or_zero();
+        let up = if forward.y.abs() < 0.9 {
+            glam::DVec3::NEG_Y
+        } else {
+            glam::DVec3::Z
+        };
+        Pose {
+            eye_mm,
+            look_at_mm,
+            up,
+        }
+    };
+    let session = Session::new(scene, Preset::find("colonoscopy"), Some(pose(20.0)), || {});
+    let flight = Box::new(move |share: f64| pose(20.0 + (length - 40.0) * share));
+    (
+        session,
+        flight,
+        format!("colon phantom {size}, colonoscopy"),
+    )
+}
+
+/// A real scan with `preset`, flown along the path its study plans (`endocast path`'s).
+fn on_scan(scan: &str, preset: &str) -> (Session, Flight, String) {
+    let source = ScanSource::File {
+        path: scan.into(),
+        series: None,
+        orientation: None,
+    };
+    let (volume, facts) = source
+        .load_with_facts(&Default::default())
+        .expect("the scan");
+    let scene = Arc::new(Scene::new(source, volume).with_facts(facts));
+    let session = Session::new(scene, Preset::find(preset), None, || {});
+    let path = session
+        .study()
+        .path()
+        .expect("a path the preset plans on this scan")
+        .path
+        .clone();
+    let length = path.len_mm();
+    let flight = Box::new(move |share: f64| {
+        path.pose_at(length * share * 0.9, 10.0)
+            .expect("a pose on the path")
+    });
+    (session, flight, format!("{scan}, {preset}"))
 }
 
 fn ms(d: Duration) -> f64 {
