@@ -6,9 +6,10 @@ use crate::mark_tool::Tool;
 use crate::session::Session;
 use crate::state::Ready;
 use crate::worker::Delivered;
-use egui::{Pos2, Rect, Response};
+use egui::{Align2, Color32, Pos2, Rect, Response, Stroke, Vec2};
 use endocast_core::annotate::{draw, Annotation, DrawOptions, Shape, SurfaceView};
 use endocast_core::views::Image;
+use glam::DVec3;
 
 /// The pixel of the view under `pos`.
 fn pixel(rect: Rect, pos: Pos2, ppp: f64) -> [usize; 2] {
@@ -51,6 +52,44 @@ pub(crate) fn view_input(response: &Response, ready: &mut Ready, rect: Rect, ppp
     }
     true
 }
+
+/// While a measurement waits for its second point: a line from the first to the pointer, and
+/// the distance between the surface points under them with how much deeper along the view the
+/// second lies (two points at very different depths look close on the screen).
+pub(crate) fn rubber_band(ui: &egui::Ui, response: &Response, ready: &Ready, rect: Rect, ppp: f64) {
+    let (Some(first), Some(hover)) = (ready.marks.measure_from, response.hover_pos()) else {
+        return;
+    };
+    let start = rect.min + Vec2::new(first[0] as f32, first[1] as f32) / ppp as f32;
+    let painter = ui.painter_at(rect);
+    painter.line_segment([start, hover], Stroke::new(1.5, BAND_COLOR));
+    let [x, y] = pixel(rect, hover, ppp);
+    let session = &ready.session;
+    let camera = session.fly_camera();
+    let depth = |p: DVec3| (p - camera.eye_mm()).dot(camera.forward());
+    let text = match (
+        session.surface_point(first[0], first[1]),
+        session.surface_point(x, y),
+    ) {
+        (Some(a), Some(b)) => format!(
+            "{:.1} mm · {:+.1} mm deeper",
+            a.distance(b),
+            depth(b) - depth(a)
+        ),
+        _ => "no surface under the pointer".into(),
+    };
+    let font = egui::FontId::proportional(14.0);
+    painter.text(
+        hover + Vec2::new(12.0, -12.0),
+        Align2::LEFT_BOTTOM,
+        text,
+        font,
+        BAND_COLOR,
+    );
+}
+
+/// The measurement's line while it is placed.
+const BAND_COLOR: Color32 = Color32::from_rgb(255, 220, 60);
 
 /// The tools and the list of annotations, for the control panel.
 pub(crate) fn marks_ui(ui: &mut egui::Ui, ready: &mut Ready) {

@@ -47,6 +47,7 @@ pub(crate) fn view_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     let moving = moved || ready.session.view_changed();
     ready.session.sync(moving);
     show_frame(ui, ready, rect);
+    crate::marks::rubber_band(ui, &response, ready, rect, ppp);
 }
 
 /// A click in the view: turn toward the surface point there.

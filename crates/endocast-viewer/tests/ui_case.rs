@@ -108,3 +108,30 @@ fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_pic
     assert!(message.contains("reopened the saved case"), "{message}");
     assert_eq!(std::fs::read(&path).unwrap(), bytes);
 }
+
+#[test]
+fn a_measurement_shows_its_line_and_depth_while_placed() {
+    let (volume, pose, _) = tube();
+    let dir = tempfile::tempdir().unwrap();
+    let scan = dir.path().join("tube.nii.gz");
+    endocast_io::write(&scan, &volume).unwrap();
+    let source = ScanSource::File {
+        path: scan,
+        series: None,
+        orientation: None,
+    };
+    let mut window = Window::open(ViewerOptions {
+        pose: Some(pose),
+        ..options(source)
+    });
+    window.settle();
+    window.click_text("measure");
+    window.click(view_centre() + Vec2::new(0.0, 60.0));
+    window.frame(vec![Event::PointerMoved(
+        view_centre() + Vec2::new(80.0, 60.0),
+    )]);
+    let texts = window.painted_texts();
+    assert!(texts.iter().any(|t| t.ends_with("mm deeper")), "{texts:?}");
+    // Nothing measured yet: the second click makes it.
+    assert!(window.app.session().unwrap().annotations().is_empty());
+}
