@@ -17,6 +17,7 @@ use crate::session::Session;
 use crate::slices::SlicesView;
 use crate::state::{Action, Ready};
 use crate::view::view_ui;
+use endocast_core::look::LookKind;
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::progressive::Stage;
@@ -45,6 +46,8 @@ pub struct ViewerOptions {
     pub screenshot: Option<PathBuf>,
     /// Called with the session when the screenshot is taken (e.g. to print what it resolved).
     pub on_screenshot: Option<ScreenshotHook>,
+    /// The endoscope's look to start with; `None`: the preset's (or the case's).
+    pub look: Option<LookKind>,
 }
 
 /// What to do with the session when `--screenshot` grabs the window.
@@ -182,7 +185,7 @@ impl ViewerApp {
                 self.message = e;
                 self.loading = None;
             }
-            Some(Ok((session, case, problems))) => {
+            Some(Ok((mut session, case, problems))) => {
                 self.message = format!("opened {}", loading.what);
                 for problem in problems {
                     self.message += &format!("; mesh not read: {problem}");
@@ -190,6 +193,9 @@ impl ViewerApp {
                 let choice = self.case_choice.take();
                 if let Some(note) = choice.as_ref().and_then(|c| c.note.as_ref()) {
                     self.message += &format!("; {note}");
+                }
+                if let Some(look) = self.options.look {
+                    session.controls.look = look;
                 }
                 let path = match (case, choice) {
                     (Some(path), _) => path,

@@ -32,6 +32,7 @@
 //!     case: None,
 //!     screenshot: None,
 //!     on_screenshot: None,
+//!     look: None,
 //! })
 //! .unwrap();
 //! # }

@@ -24,6 +24,7 @@ pub fn options(source: ScanSource) -> ViewerOptions {
         case: None,
         screenshot: None,
         on_screenshot: None,
+        look: None,
     }
 }
 

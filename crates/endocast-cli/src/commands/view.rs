@@ -5,6 +5,7 @@ use crate::pose_args::PoseArgs;
 use crate::study_report;
 use anyhow::{bail, Result};
 use clap::Args;
+use endocast_core::look::LookKind;
 use endocast_viewer::app::{run as run_viewer, ScreenshotHook, ViewerOptions};
 use endocast_viewer::scene::ScanSource;
 use endocast_viewer::session::Session;
@@ -36,6 +37,10 @@ pub struct ViewArgs {
     case: Option<PathBuf>,
     #[command(flatten)]
     pose: PoseArgs,
+    /// The endoscope's look to start with: plain, clinical or realistic (default: the
+    /// preset's; the panel changes it).
+    #[arg(long, value_name = "LOOK")]
+    look: Option<String>,
     /// Write a screenshot of the window (PNG) once the view has refined, then quit.
     #[arg(long, value_name = "FILE.png")]
     screenshot: Option<PathBuf>,
@@ -70,6 +75,13 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         },
         (None, None, None) => bail!("give a scan, --phantom NAME or --case FILE"),
     };
+    let look = match &args.look {
+        Some(name) => Some(
+            LookKind::from_name(name)
+                .ok_or_else(|| anyhow::anyhow!("--look {name:?}: plain, clinical or realistic"))?,
+        ),
+        None => None,
+    };
     let on_screenshot = args
         .json
         .then(|| ScreenshotHook(Arc::new(|session: &Session| print_session(session))));
@@ -80,6 +92,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         case: args.case.clone(),
         screenshot: args.screenshot.clone(),
         on_screenshot,
+        look,
     })
     .map_err(anyhow::Error::msg)
 }
