@@ -54,7 +54,6 @@ pub mod jobs;
 pub mod keys;
 #[cfg(feature = "window")]
 mod loading;
-mod look_frames;
 #[cfg(feature = "window")]
 mod mark_tool;
 #[cfg(feature = "window")]

@@ -10,7 +10,8 @@
 
 use crate::geometry::SceneRef;
 use crate::jobs::Notify;
-use crate::look_frames::{render_look, LookPass};
+mod look_frames;
+
 use endocast_core::camera::StereoRig;
 use endocast_core::look::Look;
 use endocast_core::render::progressive::{progressive, PreviewPlanner, ProgressiveOptions, Stage};
@@ -20,6 +21,7 @@ use endocast_core::render::{
 };
 use endocast_core::views::stereo::{combine, StereoOutput};
 use endocast_core::views::Image;
+use look_frames::{render_look, LookPass};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;

@@ -3,7 +3,7 @@
 //! frame with the view's geometry composited, then jittered frames averaged into a still, each
 //! level delivered as it finishes; a new view stops it between levels and between still frames.
 
-use crate::worker::{Deliver, View, STILL_FRAMES};
+use super::{Deliver, View, STILL_FRAMES};
 use endocast_core::look::{shade_reduced, still_frame, Look, RayPass, RayPassSettings};
 use endocast_core::render::progressive::Stage;
 use endocast_core::render::{Frame, Quality, RenderSettings, Renderer, Still};
