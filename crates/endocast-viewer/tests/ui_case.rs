@@ -26,10 +26,9 @@ fn retype(window: &mut Window, old: &str, new: &str) {
     window.frame(events);
 }
 
-#[test]
-fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_picture() {
-    let dir = tempfile::tempdir().unwrap();
-    let scan = dir.path().join("tube.nii.gz");
+/// The window on the tube phantom written as a scan in `dir`, at its known pose, settled.
+fn tube_window(dir: &std::path::Path) -> (Window, ScanSource) {
+    let scan = dir.join("tube.nii.gz");
     let (volume, pose, _) = tube();
     endocast_io::write(&scan, &volume).unwrap();
     let source = ScanSource::File {
@@ -42,6 +41,13 @@ fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_pic
         ..options(source.clone())
     });
     window.settle();
+    (window, source)
+}
+
+#[test]
+fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut window, source) = tube_window(dir.path());
     let unmarked = window.view.clone().expect("the view's picture");
 
     // Label the wall in the middle of the view.
@@ -111,20 +117,8 @@ fn marks_made_with_the_tools_are_in_the_saved_case_which_reopens_to_the_same_pic
 
 #[test]
 fn a_measurement_shows_its_line_and_depth_while_placed() {
-    let (volume, pose, _) = tube();
     let dir = tempfile::tempdir().unwrap();
-    let scan = dir.path().join("tube.nii.gz");
-    endocast_io::write(&scan, &volume).unwrap();
-    let source = ScanSource::File {
-        path: scan,
-        series: None,
-        orientation: None,
-    };
-    let mut window = Window::open(ViewerOptions {
-        pose: Some(pose),
-        ..options(source)
-    });
-    window.settle();
+    let (mut window, _) = tube_window(dir.path());
     window.click_text("measure");
     window.click(view_centre() + Vec2::new(0.0, 60.0));
     window.frame(vec![Event::PointerMoved(

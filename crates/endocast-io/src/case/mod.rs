@@ -37,7 +37,6 @@ pub use scan::{IdentityRecord, ScanFacts, ScanSource};
 use endocast_core::annotate::{Annotations, ScanIdentity};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// The `"format"` value of case files.
@@ -133,18 +132,11 @@ impl Case {
 
     /// The file's bytes, refused beyond [`MAX_BYTES`] (read no further).
     fn read_bytes(path: &Path) -> Result<Vec<u8>, CaseError> {
-        let file = File::open(path).map_err(|e| CaseError::new(path, e))?;
-        let mut bytes = Vec::new();
-        file.take(MAX_BYTES + 1)
-            .read_to_end(&mut bytes)
-            .map_err(|e| CaseError::new(path, e))?;
-        if bytes.len() as u64 > MAX_BYTES {
-            return Err(CaseError::new(
-                path,
-                format!("more than {MAX_BYTES} bytes is too large"),
-            ));
-        }
-        Ok(bytes)
+        crate::text::read_capped(path, MAX_BYTES)
+            .map_err(|e| CaseError::new(path, e))?
+            .ok_or_else(|| {
+                CaseError::new(path, format!("more than {MAX_BYTES} bytes is too large"))
+            })
     }
 
     /// Writes the case to `path` atomically, as the current [`VERSION`], under the case's
