@@ -110,10 +110,6 @@ fn add_segments(
         }
         let size = format!("{} {:.1} ml", segment.label, voxels as f64 * voxel_ml);
         let mesh = label_surface(volume, segment.number);
-        if matches!(mesh, Err(MeshError::Empty)) {
-            parts.push((format!("{size} (too thin to draw)"), false));
-            continue;
-        }
         let what = format!("segment {}", segment.number);
         let material = (segment.colour, SEGMENT_OPACITY);
         add_surface(scene, mesh, material, &what, file)?;
@@ -244,7 +240,7 @@ mod tests {
             refused.to_string().contains("levels apply to a dose grid"),
             "{refused}"
         );
-        // One voxel wide: no surface, said so, nothing else lost.
+        // One voxel wide: still a surface.
         let thin = dir.path().join("thin.dcm");
         let line: Vec<SegFrame> = (0..3)
             .map(|z| SegFrame {
@@ -254,13 +250,13 @@ mod tests {
             })
             .collect();
         write_segmentation(&thin, &GRID, &[(2, "line", [34865, 53485, 50171])], &line);
-        let said = add_overlay(
-            &mut Scene::new(),
-            thin.to_str().unwrap(),
-            &Limits::default(),
+        let mut scene = Scene::new();
+        let said = add_overlay(&mut scene, thin.to_str().unwrap(), &Limits::default()).unwrap();
+        assert!(
+            said.complete && said.summary.ends_with("line 0.0 ml"),
+            "{said:?}"
         );
-        let said = said.unwrap();
-        assert!(!said.complete && said.summary.ends_with("line 0.0 ml (too thin to draw)"));
+        assert!(!scene.is_empty());
     }
 
     #[test]

@@ -27,8 +27,8 @@ impl SceneFiles {
     }
 
     /// The scene of the files (slow for large meshes: call it without the GIL), `None` when
-    /// there are none; with a line for each overlay not drawn whole (a segment too thin, a dose
-    /// level outside the grid's range), for a Python warning.
+    /// there are none; with a line for each overlay not drawn whole (a dose level outside the
+    /// grid's range), for a Python warning.
     pub fn read(&self) -> PyResult<(Option<Arc<Scene>>, Vec<String>)> {
         let mut scene = Scene::new();
         for path in &self.meshes {

@@ -65,19 +65,27 @@ pub fn isosurface(volume: &Volume, iso: f64, side: LumenSide) -> Result<Triangle
 /// facing out of it: the region's indicator, padded by a voxel of nothing on every side (so a
 /// region touching the grid's edge is closed), blurred once by [1, 2, 1] / 4 along each axis
 /// and cut at one half — a smooth surface instead of voxel steps, that keeps the region's
-/// volume and its place to a fraction of a voxel.
+/// volume and its place to a fraction of a voxel. Every voxel of the region stays inside (the
+/// blurred value of its centre is kept at [`LABEL_FLOOR`] at least), so a region one voxel
+/// thin (a small vessel, a lymph node of a voxel or two) keeps a surface instead of vanishing
+/// under the blur.
 pub fn label_surface(volume: &Volume, label: u16) -> Result<TriangleMesh, MeshError> {
     let [nx, ny, nz] = volume.dims();
     let dims = [nx + 2, ny + 2, nz + 2];
     let mut field = vec![0.0f32; dims.iter().product()];
     let at = |[i, j, k]: [usize; 3]| i + dims[0] * (j + dims[1] * k);
-    for (n, &v) in volume.voxels().iter().enumerate() {
-        if v == label {
-            field[at([n % nx + 1, n / nx % ny + 1, n / (nx * ny) + 1])] = 1.0;
-        }
+    let region: Vec<usize> = (volume.voxels().iter().enumerate())
+        .filter(|(_, &v)| v == label)
+        .map(|(n, _)| at([n % nx + 1, n / nx % ny + 1, n / (nx * ny) + 1]))
+        .collect();
+    for &n in &region {
+        field[n] = 1.0;
     }
     for axis in 0..3 {
         field = blurred(&field, dims, axis);
+    }
+    for &n in &region {
+        field[n] = field[n].max(LABEL_FLOOR);
     }
     let geometry = volume.geometry();
     let origin = geometry.world_of(DVec3::splat(-1.0));
@@ -93,6 +101,11 @@ pub fn label_surface(volume: &Volume, label: u16) -> Result<TriangleMesh, MeshEr
     .map_err(|_| MeshError::Empty)?;
     isosurface(&indicator, 500.0, LumenSide::Above)
 }
+
+/// The least value a region's voxel keeps after the blur (the cut is at 0.5): a voxel alone
+/// then has its surface about 0.4 voxel from its centre, and a flat face (0.75 after the blur)
+/// is untouched.
+const LABEL_FLOOR: f32 = 0.75;
 
 /// `field` (a `dims` grid) blurred by [1, 2, 1] / 4 along `axis` (the ends see zero beyond).
 fn blurred(field: &[f32], dims: [usize; 3], axis: usize) -> Vec<f32> {

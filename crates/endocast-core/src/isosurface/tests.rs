@@ -207,3 +207,41 @@ fn the_mesh_does_not_depend_on_the_thread_count() {
     };
     assert_eq!(mesh_on(1), mesh_on(3));
 }
+
+#[test]
+fn a_label_one_voxel_thin_keeps_a_closed_surface_around_its_voxels_and_a_block_its_volume() {
+    let geometry = crate::Geometry::axis_aligned([12, 12, 12], DVec3::ONE, DVec3::ZERO).unwrap();
+    let mut voxels = vec![0u16; 12 * 12 * 12];
+    let at = |i: usize, j: usize, k: usize| i + 12 * (j + 12 * k);
+    // Label 1: a line one voxel thin along k; label 2: a 4 × 4 × 4 block.
+    for k in 2..9 {
+        voxels[at(3, 3, k)] = 1;
+    }
+    for (i, j, k) in
+        (6..10).flat_map(|i| (6..10).flat_map(move |j| (6..10).map(move |k| (i, j, k))))
+    {
+        voxels[at(i, j, k)] = 2;
+    }
+    let map = crate::ValueMap::IDENTITY;
+    let volume = Volume::new(geometry, voxels, map, crate::Modality::Unknown).unwrap();
+    let signed_volume = |mesh: &TriangleMesh| -> f64 {
+        (0..mesh.triangles().len())
+            .map(|i| {
+                let [a, b, c] = mesh.corners(i);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    };
+    let line = label_surface(&volume, 1).unwrap();
+    assert_eq!(line.open_edges(), 0);
+    for v in line.vertices() {
+        let off_axis = (v.x - 3.0).hypot(v.y - 3.0);
+        assert!(off_axis < 0.6, "{v}");
+    }
+    assert!(signed_volume(&line) > 0.5, "{}", signed_volume(&line));
+    let block = label_surface(&volume, 2).unwrap();
+    assert_eq!(block.open_edges(), 0);
+    // Rounded at its edges and corners by the blur: a little under its 64 voxels.
+    let v = signed_volume(&block);
+    assert!((0.8..1.05).contains(&(v / 64.0)), "{v} against 64");
+}
