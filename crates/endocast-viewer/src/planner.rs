@@ -131,9 +131,8 @@ pub fn start_planning(
     let (threshold, side) = session
         .lumen_threshold()
         .ok_or("this preset and isovalue name no lumen")?;
-    let study = session.shared_study();
-    let lumen = if session.controls.iso_hu == study.settings().iso_hu {
-        Lumen::Study(study)
+    let lumen = if session.wall_is_the_studys() {
+        Lumen::Study(session.shared_study())
     } else {
         Lumen::Threshold(threshold, side)
     };
