@@ -14,13 +14,15 @@ use crate::overview::OverviewView;
 use crate::panel::controls_ui;
 use crate::scene::ScanSource;
 use crate::session::Session;
-use crate::slices::SlicesView;
+use crate::slice_viewer::{slice_viewer_ui, SliceViewer};
+use crate::slices::{SliceClicked, SlicesView};
 use crate::state::{Action, Ready};
 use crate::view::view_ui;
 use endocast_core::look::LookKind;
 use endocast_core::pose::Pose;
 use endocast_core::presets::Preset;
 use endocast_core::render::progressive::Stage;
+use endocast_core::views::slices::Plane;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -48,6 +50,8 @@ pub struct ViewerOptions {
     pub on_screenshot: Option<ScreenshotHook>,
     /// The endoscope's look to start with; `None`: the preset's (or the case's).
     pub look: Option<LookKind>,
+    /// A slice to show large beside the endoscope from the start; `None`: the endoscope alone.
+    pub layout: Option<Plane>,
 }
 
 /// What to do with the session when `--screenshot` grabs the window.
@@ -153,6 +157,16 @@ impl ViewerApp {
                 .resizable(false)
                 .exact_width(250.0)
                 .show(ctx, |ui| side_ui(ui, ready));
+            if let Some(viewer) = &mut ready.large_slice {
+                // The rest of the window shared between the large slice and the endoscope.
+                egui::SidePanel::right("large slice")
+                    .resizable(false)
+                    .exact_width(ctx.available_rect().width() / 2.0)
+                    .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(24)))
+                    .show(ctx, |ui| {
+                        slice_viewer_ui(ui, viewer, &mut ready.session, &mut ready.tools)
+                    });
+            }
             egui::CentralPanel::default()
                 .frame(egui::Frame::NONE.fill(egui::Color32::BLACK))
                 .show(ctx, |ui| view_ui(ui, ready));
@@ -211,6 +225,7 @@ impl ViewerApp {
                 self.ready = Some(Ready {
                     session,
                     slices: SlicesView::default(),
+                    large_slice: self.options.layout.map(SliceViewer::new),
                     overview: OverviewView::default(),
                     tools: FlightTools::default(),
                     meshes: MeshLoader::default(),
@@ -373,9 +388,12 @@ impl ViewerApp {
 /// The right column: the three slices through the camera and the overview, each `edge`
 /// wide, with the camera's position and direction.
 fn side_ui(ui: &mut egui::Ui, ready: &mut Ready) {
+    large_slice_choice(ui, ready);
     let edge = ui.available_width().min(ui.available_height() / 4.5);
-    if let Some(p) = ready.slices.slices_ui(ui, &ready.session, edge) {
-        ready.tools.slice_clicked(&mut ready.session, p);
+    match ready.slices.slices_ui(ui, &ready.session, edge) {
+        Some(SliceClicked::Point(p)) => ready.tools.slice_clicked(&mut ready.session, p),
+        Some(SliceClicked::Enlarge(plane)) => ready.large_slice = Some(SliceViewer::new(plane)),
+        None => {}
     }
     let path: Vec<_> = ready
         .session
@@ -390,6 +408,26 @@ fn side_ui(ui: &mut egui::Ui, ready: &mut Ready) {
     let (e, f) = (c.eye_mm(), c.forward());
     ui.label(format!("eye  {:7.1} {:7.1} {:7.1} mm", e.x, e.y, e.z));
     ui.label(format!("view {:7.2} {:7.2} {:7.2}", f.x, f.y, f.z));
+}
+
+/// "large: off axial coronal sagittal": which slice is shown large beside the endoscope.
+fn large_slice_choice(ui: &mut egui::Ui, ready: &mut Ready) {
+    let shown = ready.large_slice.as_ref().map(SliceViewer::plane);
+    ui.horizontal(|ui| {
+        ui.label("large:");
+        if ui.selectable_label(shown.is_none(), "off").clicked() {
+            ready.large_slice = None;
+        }
+        for plane in Plane::ALL {
+            if ui
+                .selectable_label(shown == Some(plane), plane.name())
+                .clicked()
+                && shown != Some(plane)
+            {
+                ready.large_slice = Some(SliceViewer::new(plane));
+            }
+        }
+    });
 }
 
 /// "frame 12.3 ms · quarter · 41 ms after the request · eye (…) mm · wall 4.1 mm" (a still's

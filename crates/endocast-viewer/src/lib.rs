@@ -33,6 +33,7 @@
 //!     screenshot: None,
 //!     on_screenshot: None,
 //!     look: None,
+//!     layout: None,
 //! })
 //! .unwrap();
 //! # }
@@ -65,6 +66,8 @@ mod panel;
 pub mod planner;
 pub mod scene;
 pub mod session;
+#[cfg(feature = "window")]
+mod slice_viewer;
 #[cfg(feature = "window")]
 mod slices;
 #[cfg(feature = "window")]

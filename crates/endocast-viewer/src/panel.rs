@@ -98,14 +98,12 @@ pub(crate) fn controls_ui(
                 }
             });
         });
+    // One key a line, what it does wrapped under it: a table would be wider than the panel.
     egui::CollapsingHeader::new("Keys").show(ui, |ui| {
-        egui::Grid::new("keys").show(ui, |ui| {
-            for (key, what) in HELP {
-                ui.label(*key);
-                ui.label(*what);
-                ui.end_row();
-            }
-        });
+        for (key, what) in HELP {
+            ui.label(egui::RichText::new(*key).strong());
+            ui.indent(key, |ui| ui.label(*what));
+        }
     });
     action
 }

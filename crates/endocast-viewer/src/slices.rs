@@ -7,7 +7,7 @@ use crate::jobs::{Derived, Job, Notify};
 use crate::session::Session;
 use egui::{Sense, TextureOptions, Vec2};
 use endocast_core::render::Camera;
-use endocast_core::views::slices::{camera_slices, Slice, SliceOptions, Window};
+use endocast_core::views::slices::{camera_slices, Plane, Slice, SliceOptions, Window};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -16,6 +16,14 @@ const SLICE_PX: usize = 256;
 
 /// What the slices are drawn for: the eye, the view direction and the window.
 type SliceKey = (DVec3, DVec3, Window);
+
+/// What a click on a thumbnail asks for.
+pub(crate) enum SliceClicked {
+    /// Jump there (or set the path's end there).
+    Point(DVec3),
+    /// Show this plane large.
+    Enlarge(Plane),
+}
 
 /// The slices shown and their textures.
 #[derive(Default)]
@@ -26,29 +34,31 @@ pub(crate) struct SlicesView {
 
 impl SlicesView {
     /// Draws the three slices in a column, each `edge` points wide; returns the world point of
-    /// a click in one.
+    /// a click in one, or the plane double-clicked to be shown large.
     pub(crate) fn slices_ui(
         &mut self,
         ui: &mut egui::Ui,
         session: &Session,
         edge: f32,
-    ) -> Option<DVec3> {
+    ) -> Option<SliceClicked> {
         self.refresh(ui.ctx(), session);
         let slices = self.slices.shown().and_then(|(_, s)| s.as_ref())?;
         let mut clicked = None;
-        for ((slice, texture), name) in slices
-            .iter()
-            .zip(&self.textures)
-            .zip(["axial", "coronal", "sagittal"])
-        {
+        for ((slice, texture), plane) in slices.iter().zip(&self.textures).zip(Plane::ALL) {
             let image =
                 egui::Image::from_texture((texture.id(), Vec2::splat(edge))).sense(Sense::click());
-            let response = ui.add(image).on_hover_text(format!("{name}: click"));
-            if response.clicked() {
+            let response = ui.add(image).on_hover_text(format!(
+                "{}: click to jump, double click to show it large",
+                plane.name()
+            ));
+            if response.double_clicked() {
+                clicked = Some(SliceClicked::Enlarge(plane));
+            } else if response.clicked() {
                 if let Some(pos) = response.interact_pointer_pos() {
                     let scale = SLICE_PX as f64 / f64::from(response.rect.width());
                     let d = pos - response.rect.min;
-                    clicked = Some(slice.world_at(f64::from(d.x) * scale, f64::from(d.y) * scale));
+                    let p = slice.world_at(f64::from(d.x) * scale, f64::from(d.y) * scale);
+                    clicked = Some(SliceClicked::Point(p));
                 }
             }
         }

@@ -7,6 +7,7 @@ use crate::jobs::Job;
 use crate::mark_tool::MarkTool;
 use crate::overview::OverviewView;
 use crate::session::Session;
+use crate::slice_viewer::SliceViewer;
 use crate::slices::SlicesView;
 use endocast_core::render::progressive::Stage;
 use std::time::Instant;
@@ -15,6 +16,8 @@ use std::time::Instant;
 pub(crate) struct Ready {
     pub session: Session,
     pub slices: SlicesView,
+    /// The slice shown large beside the endoscope, if one is.
+    pub large_slice: Option<SliceViewer>,
     pub overview: OverviewView,
     /// Path planning and export.
     pub tools: FlightTools,

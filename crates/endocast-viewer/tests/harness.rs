@@ -25,6 +25,7 @@ pub fn options(source: ScanSource) -> ViewerOptions {
         screenshot: None,
         on_screenshot: None,
         look: None,
+        layout: None,
     }
 }
 
@@ -148,6 +149,17 @@ impl Window {
         found.into_iter().min_by(|a, b| a.min.y.total_cmp(&b.min.y))
     }
 
+    /// Every text the last frame painted and where, clipped or not.
+    pub fn painted_text_rects(&self) -> Vec<(String, Rect)> {
+        let mut all = Vec::new();
+        for clipped in &self.shapes {
+            texts(&clipped.shape, &mut |pos, shown, rect| {
+                all.push((shown.to_owned(), rect.translate(pos.to_vec2())))
+            });
+        }
+        all
+    }
+
     /// Every text the last frame painted.
     pub fn painted_texts(&self) -> Vec<String> {
         let mut all = Vec::new();
@@ -217,6 +229,45 @@ impl Window {
         }
     }
 
+    /// Two presses and releases of the primary button at `pos`, quickly.
+    pub fn double_click(&mut self, pos: Pos2) {
+        self.frame(vec![Event::PointerMoved(pos)]);
+        for _ in 0..2 {
+            self.frame(vec![button(pos, true)]);
+            self.frame(vec![button(pos, false)]);
+        }
+        for _ in 0..ANIMATION_FRAMES {
+            self.frame(Vec::new());
+        }
+    }
+
+    /// How many line segments of colour `rgb` (within 3 levels, at any opacity) the last frame
+    /// painted.
+    pub fn segments_coloured(&self, rgb: [u8; 3]) -> usize {
+        let mut count = 0;
+        for clipped in &self.shapes {
+            segments(&clipped.shape, &mut |colour| {
+                let drawn = colour.to_srgba_unmultiplied();
+                count += usize::from(rgb.iter().zip(drawn).all(|(a, b)| a.abs_diff(b) <= 3));
+            });
+        }
+        count
+    }
+
+    /// The wheel turned by `delta` points (up: positive) over `pos` with `modifiers` held, and
+    /// the frames that finish what it animates.
+    pub fn wheel(&mut self, pos: Pos2, delta: f32, modifiers: Modifiers) {
+        self.frame(vec![Event::PointerMoved(pos)]);
+        self.frame(vec![Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: Vec2::new(0.0, delta),
+            modifiers,
+        }]);
+        for _ in 0..ANIMATION_FRAMES {
+            self.frame(Vec::new());
+        }
+    }
+
     /// A drag with the primary button from `from` to `to` in `steps` moves.
     pub fn drag(&mut self, from: Pos2, to: Pos2, steps: usize) {
         self.frame(vec![Event::PointerMoved(from)]);
@@ -235,6 +286,15 @@ fn button(pos: Pos2, pressed: bool) -> Event {
         button: PointerButton::Primary,
         pressed,
         modifiers: Modifiers::NONE,
+    }
+}
+
+/// Calls `f` with the colour of each line segment in `shape`.
+fn segments(shape: &Shape, f: &mut impl FnMut(egui::Color32)) {
+    match shape {
+        Shape::LineSegment { stroke, .. } => f(stroke.color),
+        Shape::Vec(shapes) => shapes.iter().for_each(|s| segments(s, f)),
+        _ => {}
     }
 }
 

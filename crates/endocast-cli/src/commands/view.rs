@@ -6,6 +6,7 @@ use crate::study_report;
 use anyhow::{bail, Result};
 use clap::Args;
 use endocast_core::look::LookKind;
+use endocast_core::views::slices::Plane;
 use endocast_viewer::app::{run as run_viewer, ScreenshotHook, ViewerOptions};
 use endocast_viewer::scene::ScanSource;
 use endocast_viewer::session::Session;
@@ -41,6 +42,10 @@ pub struct ViewArgs {
     /// preset's; the panel changes it).
     #[arg(long, value_name = "LOOK")]
     look: Option<String>,
+    /// Show a slice large beside the endoscope from the start: axial, coronal or sagittal
+    /// (the slice column's "large:" buttons change it).
+    #[arg(long, value_name = "PLANE")]
+    layout: Option<String>,
     /// Write a screenshot of the window (PNG) once the view has refined, then quit.
     #[arg(long, value_name = "FILE.png")]
     screenshot: Option<PathBuf>,
@@ -82,6 +87,15 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         ),
         None => None,
     };
+    let layout = match &args.layout {
+        Some(name) => Some(
+            Plane::ALL
+                .into_iter()
+                .find(|p| p.name() == name)
+                .ok_or_else(|| anyhow::anyhow!("--layout {name:?}: axial, coronal or sagittal"))?,
+        ),
+        None => None,
+    };
     let on_screenshot = args
         .json
         .then(|| ScreenshotHook(Arc::new(|session: &Session| print_session(session))));
@@ -93,6 +107,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         screenshot: args.screenshot.clone(),
         on_screenshot,
         look,
+        layout,
     })
     .map_err(anyhow::Error::msg)
 }

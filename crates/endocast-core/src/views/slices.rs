@@ -364,19 +364,10 @@ fn sample_pixels(volume: &Volume, slice: &Slice) -> Vec<f32> {
     values
 }
 
-/// The centre (mm) and edge (mm) of the square field of view: around the plane's point with the
-/// given edge, or framing the volume's grid corners as they project onto the plane (2 % margin).
-fn field(
-    volume: &Volume,
-    plane: &SlicePlane,
-    field_mm: Option<f64>,
-) -> Result<(DVec3, f64), ViewError> {
-    if let Some(edge) = field_mm {
-        if !(edge.is_finite() && edge > 0.0 && edge <= MAX_FIELD_MM) {
-            return Err(out_of_range("field of view (mm)", edge, "in (0, 10000]"));
-        }
-        return Ok((plane.point_mm, edge));
-    }
+/// The centre (mm) and edge (mm) of the square field of view that frames `volume` on `plane`
+/// (its grid corners as they project onto the plane, 2 % margin): what [`reformat`] shows
+/// when [`SliceOptions::field_mm`] is `None`. A viewer zooms and pans from it.
+pub fn framing(volume: &Volume, plane: &SlicePlane) -> (DVec3, f64) {
     let geometry = volume.geometry();
     let last = geometry.dims().map(|n| (n - 1) as f64);
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -399,10 +390,26 @@ fn field(
     }
     let edge = ((hi[0] - lo[0]).max(hi[1] - lo[1]) * 1.02).max(1.0);
     let mid = |axis: usize| (lo[axis] + hi[axis]) / 2.0;
-    Ok((
+    (
         plane.point_mm + plane.right * mid(0) + plane.down * mid(1),
         edge,
-    ))
+    )
+}
+
+/// The centre (mm) and edge (mm) of the square field of view: around the plane's point with the
+/// given edge, or the volume's [`framing`].
+fn field(
+    volume: &Volume,
+    plane: &SlicePlane,
+    field_mm: Option<f64>,
+) -> Result<(DVec3, f64), ViewError> {
+    match field_mm {
+        Some(edge) if !(edge.is_finite() && edge > 0.0 && edge <= MAX_FIELD_MM) => {
+            Err(out_of_range("field of view (mm)", edge, "in (0, 10000]"))
+        }
+        Some(edge) => Ok((plane.point_mm, edge)),
+        None => Ok(framing(volume, plane)),
+    }
 }
 
 /// The axial, coronal and sagittal slices through the camera's eye, with the camera drawn.
