@@ -73,6 +73,8 @@ mod slices;
 #[cfg(feature = "window")]
 mod state;
 #[cfg(feature = "window")]
+mod tf_colours;
+#[cfg(feature = "window")]
 mod tf_editor;
 #[cfg(feature = "window")]
 mod view;

@@ -6,6 +6,7 @@ use crate::keys::HELP;
 use crate::scene::ScanSource;
 use crate::session::{Session, NO_PRESET};
 use crate::state::{Action, Ready};
+use crate::tf_colours::colour_strip_ui;
 use crate::tf_editor::histogram_ui;
 use endocast_core::camera::Projection;
 use endocast_core::look::LookKind;
@@ -178,7 +179,7 @@ fn orientation_ui(ui: &mut egui::Ui, session: &Session) -> Option<String> {
         })
         .collect();
     let mut asked = None;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label(format!("orientation {code} (not in the file)"))
             .on_hover_text("guessed from the anatomy, or as given with --orientation");
         if ui
@@ -229,6 +230,7 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     });
     let (lo, hi) = scene.value_range;
     histogram_ui(ui, &scene.histogram, (lo, hi), &mut c.iso_hu, &mut c.tf);
+    colour_strip_ui(ui, (lo, hi), &mut c.tf);
     ui.add(egui::Slider::new(&mut c.iso_hu, lo..=hi).text("isovalue"));
     ui.add(egui::Slider::new(&mut c.iso_opacity, 0.0..=1.0).text("surface opacity"));
     egui::ComboBox::from_label("lens")

@@ -118,20 +118,25 @@ pub(crate) fn histogram_ui(
     response
 }
 
-/// Moves point `i` to `(value, opacity)`, kept between its neighbours' values.
-fn move_point(points: &mut [(f64, f32)], i: usize, (value, opacity): (f64, f32)) -> bool {
+/// Moves point `i` to `(value, y)`, kept between its neighbours' values.
+pub(crate) fn move_point<T: PartialEq>(
+    points: &mut [(f64, T)],
+    i: usize,
+    (value, y): (f64, T),
+) -> bool {
     let below = i.checked_sub(1).map_or(f64::NEG_INFINITY, |j| points[j].0);
     let above = points.get(i + 1).map_or(f64::INFINITY, |p| p.0);
-    let moved = (value.clamp(below, above), opacity);
+    let moved = (value.clamp(below, above), y);
     let changed = points[i] != moved;
     points[i] = moved;
     changed
 }
 
-/// Adds `point` in value order.
-fn insert_point(points: &mut Vec<(f64, f32)>, point: (f64, f32)) {
+/// Adds `point` in value order; returns where.
+pub(crate) fn insert_point<T>(points: &mut Vec<(f64, T)>, point: (f64, T)) -> usize {
     let at = points.partition_point(|p| p.0 <= point.0);
     points.insert(at, point);
+    at
 }
 
 /// The value range at the axis' ends and, under the pointer, its value and opacity.

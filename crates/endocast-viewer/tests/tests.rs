@@ -11,4 +11,4 @@ mod plan_export;
 mod series;
 mod ui;
 mod ui_case;
-mod ui_slices;
+mod ui_tools;

@@ -1,6 +1,7 @@
-//! The large slice beside the endoscope, driven as a radiologist drives it: the wheel pages,
-//! Ctrl+wheel zooms, a drag sets the window, a double click frames the volume again, a click
-//! jumps the camera, and the key frames' path is drawn on it.
+//! The window's tools driven as a radiologist drives them: the large slice beside the endoscope
+//! (the wheel pages, Ctrl+wheel zooms, a drag sets the window, a double click frames the volume
+//! again, a click jumps the camera, the key frames' path is drawn on it), the keys help inside
+//! the panel, and the transfer function's colour strip.
 
 use crate::harness::{key, options, Window};
 use egui::{Key, Modifiers, Pos2, Vec2};
@@ -134,4 +135,28 @@ fn the_keys_help_fits_the_panel_and_leaves_the_view_its_width() {
     for (text, rect) in drawn {
         assert!(rect.max.x <= 290.0, "{text:?} reaches {}", rect.max.x);
     }
+}
+
+#[test]
+fn a_colour_point_is_added_on_the_strip_under_the_histogram_and_offered_for_editing() {
+    let source = ScanSource::Phantom {
+        name: "straight-tube".into(),
+        size: 48,
+    };
+    let mut window = Window::open(options(source));
+    window.run_until(|app| app.session().is_some());
+    window.frame(Vec::new());
+    let colours = |w: &Window| w.app.session().unwrap().controls.tf.color_points().len();
+    let before = colours(&window);
+    // The strip lies just above the isovalue slider.
+    let slider = window.text_rect("isovalue").unwrap();
+    window.double_click(Pos2::new(145.0, slider.top() - 12.0));
+    assert_eq!(colours(&window), before + 1);
+    assert!(
+        window
+            .painted_texts()
+            .iter()
+            .any(|t| t.starts_with("colour at ")),
+        "no colour editor for the new point"
+    );
 }
