@@ -1,4 +1,5 @@
-//! The overview: the lumen the camera is in, seen from outside (the patient's front), with the
+//! The overview: the lumen the camera is in (the study's structure while the wall is the
+//! study's), seen from outside (the patient's front), with the
 //! camera, its view cone and the flight's path drawn live over it. The lumen's picture is
 //! rendered off the UI thread when the lumen changes; what is drawn over it follows every UI
 //! frame.
@@ -81,6 +82,13 @@ impl OverviewView {
         let Some(navigation) = session.navigation() else {
             return;
         };
+        // While the wall is the study's, its structure (the navigable core the planner uses):
+        // the lumen flooded from the eye may leak to the air around the patient (the sinuses'
+        // through the nostrils) and would show the whole scan as a box.
+        let study = session
+            .wall_is_the_studys()
+            .then(|| session.shared_study())
+            .filter(|s| s.structure().is_some());
         let lumen = Arc::clone(navigation.lumen());
         let renderer = Arc::clone(&session.scene().renderer);
         let repaint = ctx.clone();
@@ -88,7 +96,8 @@ impl OverviewView {
         let arrived = self.overview.refresh(&navigation.id(), |_| {
             Job::spawn("overview", notify, move || {
                 let geometry = renderer.volume().geometry();
-                lumen_overview(&lumen, geometry, [OVERVIEW_PX; 2]).ok()
+                let shown = study.as_ref().and_then(|s| s.structure()).unwrap_or(&lumen);
+                lumen_overview(shown, geometry, [OVERVIEW_PX; 2]).ok()
             })
         });
         if let (true, Some((_, Some(overview)))) = (arrived, self.overview.shown()) {
