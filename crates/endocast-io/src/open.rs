@@ -8,10 +8,14 @@ use crate::{dicom, metaimage, nifti, nrrd, raw};
 use endocast_core::navigate::guess_head_orientation;
 use endocast_core::{Geometry, Volume};
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Reads the scan at `path`, choosing the reader from the path: a directory is a DICOM series;
-/// otherwise the extension; otherwise the file's magic bytes. Raw files are read only when
+/// Entries of a folder looked at for a scan file when it holds no DICOM series.
+const MAX_FOLDER_ENTRIES: usize = 100_000;
+
+/// Reads the scan at `path`, choosing the reader from the path: a directory is a DICOM series
+/// (or, without one, the one scan file of another format it holds, with a warning); otherwise
+/// the extension; otherwise the file's magic bytes. Raw files are read only when
 /// `options.raw` describes them. The warnings come with control characters escaped
 /// ([`escape`]), as error messages do.
 pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
@@ -19,27 +23,91 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     if options.raw.is_some() {
         return raw::read(path, options);
     }
-    let format = if meta.is_dir() {
-        Format::Dicom
+    let (path, loaded) = if meta.is_dir() {
+        read_folder(path, options)?
     } else {
-        match Format::from_extension(path) {
-            Some(f) => f,
-            None => sniff(path)?,
-        }
+        (path.to_owned(), read_file(path, options)?)
     };
-    let loaded = match format {
-        Format::Dicom => dicom::read(path, options),
-        Format::Nifti | Format::Analyze => nifti::read(path, options),
-        Format::Nrrd => nrrd::read(path, options),
-        Format::MetaImage => metaimage::read(path, options),
-        Format::Raw => raw::read(path, options),
-    }?;
-    let mut loaded = apply_orientation(path, loaded, options.orientation.as_deref())?;
+    let mut loaded = apply_orientation(&path, loaded, options.orientation.as_deref())?;
     // Warnings quote headers and file names: no control characters reach the terminal.
     for warning in &mut loaded.warnings {
         *warning = escape(warning);
     }
     Ok(loaded)
+}
+
+/// Reads one file by the reader its extension or magic bytes name.
+fn read_file(path: &Path, options: &OpenOptions) -> Result<Loaded> {
+    let format = match Format::from_extension(path) {
+        Some(f) => f,
+        None => sniff(path)?,
+    };
+    match format {
+        Format::Dicom => dicom::read(path, options),
+        Format::Nifti | Format::Analyze => nifti::read(path, options),
+        Format::Nrrd => nrrd::read(path, options),
+        Format::MetaImage => metaimage::read(path, options),
+        Format::Raw => raw::read(path, options),
+    }
+}
+
+/// A folder's DICOM series; where it has none, the one NIfTI, Analyze, NRRD or MetaImage file
+/// it holds (the Stanford CThead's `.nhdr` beside its raw slices), with a warning that says
+/// so. Returns the path read and the scan.
+fn read_folder(path: &Path, options: &OpenOptions) -> Result<(PathBuf, Loaded)> {
+    let no_dicom = match dicom::read(path, options) {
+        Ok(loaded) => return Ok((path.to_owned(), loaded)),
+        Err(e) => e,
+    };
+    let files = scan_files_in(path);
+    match files.as_slice() {
+        [] => Err(no_dicom),
+        [one] => {
+            let mut loaded = read_file(one, options)?;
+            loaded.warnings.insert(
+                0,
+                format!(
+                    "{}: no DICOM series; read {}, the one scan file in the folder",
+                    path.display(),
+                    one.display()
+                ),
+            );
+            Ok((one.clone(), loaded))
+        }
+        several => {
+            let names: Vec<String> = several.iter().map(|p| p.display().to_string()).collect();
+            Err(ReadError::unsupported(
+                path,
+                format!(
+                    "{no_dicom}; the folder holds {}: name one",
+                    names.join(", ")
+                ),
+            ))
+        }
+    }
+}
+
+/// The NIfTI, Analyze, NRRD and MetaImage files directly in `folder` (by their names; at most
+/// [`MAX_FOLDER_ENTRIES`] entries looked at), sorted.
+fn scan_files_in(folder: &Path) -> Vec<PathBuf> {
+    const SCAN_SUFFIXES: [&str; 7] = [".nii", ".nii.gz", ".hdr", ".nrrd", ".nhdr", ".mha", ".mhd"];
+    let Ok(entries) = std::fs::read_dir(folder) else {
+        return Vec::new();
+    };
+    let mut found: Vec<PathBuf> = entries
+        .take(MAX_FOLDER_ENTRIES)
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.is_file())
+        .filter(|p| {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().to_ascii_lowercase());
+            name.is_some_and(|n| SCAN_SUFFIXES.iter().any(|s| n.ends_with(s)))
+        })
+        .collect();
+    found.sort();
+    found
 }
 
 /// Gives an undeclared orientation the code the user named (see [`OpenOptions::orientation`]).

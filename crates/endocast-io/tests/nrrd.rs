@@ -529,3 +529,32 @@ fn missing_and_truncated_data_fail_naming_the_file() {
     std::fs::write(&corrupt_path, corrupt).unwrap();
     assert_fails(&corrupt_path, &OpenOptions::default());
 }
+
+#[test]
+fn a_folder_without_dicom_opens_its_one_scan_file_and_names_several() {
+    let dims = [7, 5, 4];
+    let voxels: Vec<u16> = (0..140u16).map(|n| n * 29 % 4096).collect();
+    let hu = ValueMap::new(1.0, -1024.0).unwrap();
+    let volume = Volume::new(oblique_geometry(dims), voxels, hu, Modality::Ct).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("README.md"), "not a scan").unwrap();
+    let scan = tmp.path().join("head.nrrd");
+    nrrd::write(&scan, &volume).unwrap();
+    let loaded = endocast_io::open(tmp.path(), &OpenOptions::default()).unwrap();
+    for (a, b) in volume.voxels().iter().zip(loaded.volume.voxels()) {
+        assert_eq!(hu.physical(*a), loaded.volume.value_map().physical(*b));
+    }
+    assert!(
+        loaded.warnings[0].contains("no DICOM series") && loaded.warnings[0].contains("head.nrrd"),
+        "{:?}",
+        loaded.warnings
+    );
+    // Two scan files: which one is meant is the user's to say.
+    nrrd::write(&tmp.path().join("other.nrrd"), &volume).unwrap();
+    let error = endocast_io::open(tmp.path(), &OpenOptions::default()).unwrap_err();
+    let said = error.to_string();
+    assert!(
+        said.contains("head.nrrd") && said.contains("other.nrrd") && said.contains("name one"),
+        "{said}"
+    );
+}
