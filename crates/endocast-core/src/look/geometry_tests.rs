@@ -246,3 +246,33 @@ fn a_mesh_around_the_eye_tints_the_view_instead_of_hiding_it() {
         }
     }
 }
+
+#[test]
+fn the_reduced_preview_composites_the_scene_too() {
+    let (_, camera, volume) = traced(wall(false), SecretionMode::Off);
+    // A sphere well in front of the wall, about the view's axis.
+    let (scene, _, _) = blue_sphere(&volume, WALL_K - 8.0, 3.0);
+    let shading = red_and_green();
+    let small = crate::render::quality::reduced_camera(&camera, [SIZE / 2, SIZE / 2]);
+    let settings = RayPassSettings {
+        tissue_hu: 0.5 * (AIR_HU + TISSUE_HU),
+        ..RayPassSettings::default()
+    };
+    let renderer = Arc::new(Renderer::new(volume));
+    let pass = RayPass::new(&renderer, &RenderSettings::default(), &settings).unwrap();
+    let half = pass.trace(&small, Quality::Full);
+    let without = shade_reduced(&half, &camera, &shading).unwrap();
+    let with = shade_reduced_with_scene(&half, &camera, &shading, Some(&scene)).unwrap();
+    assert_eq!([with.width, with.height], [SIZE, SIZE]);
+    let centre = SIZE / 2 + SIZE * (SIZE / 2);
+    assert!(
+        without.color[centre].rgb[2] < 0.01,
+        "{:?}",
+        without.color[centre]
+    );
+    let c = with.color[centre];
+    assert!(c.rgb[2] > 0.1, "no sphere in the preview: {c:?}");
+    assert!(with.depth_mm[centre] < without.depth_mm[centre] - 5.0);
+    // Beside the sphere, the preview is the look's own.
+    assert_eq!(with.color[0], without.color[0]);
+}

@@ -79,7 +79,7 @@ pub use deferred::shade;
 pub use gbuffer::{GBuffer, RayPass};
 pub use geometry::shade_with_scene;
 pub use kind::{Look, LookKind, PresetLook};
-pub use reduced::shade_reduced;
+pub use reduced::{shade_reduced, shade_reduced_with_scene};
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;
 pub use still::{still, still_frame, still_view, MAX_STILL_FRAMES};

@@ -1,11 +1,12 @@
 //! The endoscope's clinical or realistic look in the workstation: the look's ray pass (kept
 //! while its settings stay) traced at half resolution while the camera moves, then the full
-//! frame with the view's geometry composited, then jittered frames averaged into a still, each
+//! frame, both with the view's geometry composited, then jittered frames averaged into a still, each
 //! level delivered as it finishes; a new view stops it between levels and between still frames.
 
 use super::{Deliver, View, STILL_FRAMES};
-use endocast_core::look::{shade_reduced, still_frame, Look, RayPass, RayPassSettings};
+use endocast_core::look::{shade_reduced_with_scene, still_frame, Look, RayPass, RayPassSettings};
 use endocast_core::render::progressive::Stage;
+use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{Frame, Quality, RenderSettings, Renderer, Still};
 use endocast_core::views::Image;
 use std::sync::Arc;
@@ -57,8 +58,11 @@ pub(crate) fn render_look(
         }
     };
     let start = Instant::now();
-    let preview = pass.trace(camera, Quality::Half);
-    let frame = shade_reduced(&preview, camera, shading).map_err(|e| e.to_string())?;
+    // Both stages at half size (the deferred stage too), the shaded frame upsampled.
+    let small = reduced_camera(camera, Quality::Half.reduced_size(camera.size()));
+    let preview = pass.trace(&small, Quality::Full);
+    let frame =
+        shade_reduced_with_scene(&preview, camera, shading, scene).map_err(|e| e.to_string())?;
     show(Stage::Preview(Quality::Half), &frame, start);
     if view.moving {
         return Ok(());
