@@ -157,6 +157,13 @@ fn every_text_of_the_window_has_its_glyphs_in_the_font() {
         window.click_text(header);
         window.assert_glyphs();
     }
+    // The keys, one a line, run below the panel's fold: scrolled to.
+    window.wheel(
+        egui::Pos2::new(100.0, 300.0),
+        -2000.0,
+        egui::Modifiers::NONE,
+    );
+    window.assert_glyphs();
     let texts = window.painted_texts();
     assert!(texts.iter().any(|t| t.contains("slide left")), "{texts:?}");
 }
