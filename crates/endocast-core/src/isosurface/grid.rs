@@ -1,10 +1,10 @@
-//! Flying edges' first pass: which voxels of a box of the volume are inside, one byte each, and
-//! for every row of voxels along `i` the span of its crossed `i` edges (the trim that lets the
-//! later passes skip the stretches of a row where nothing crosses).
+//! Flying edges' first pass, a slab of planes at a time: which voxels of a box of the volume are
+//! inside, one byte each, and for every row of voxels along `i` the span of its crossed `i`
+//! edges (the trim that lets the later passes skip the stretches of a row where nothing
+//! crosses). A slab's flags stay in the cache while the later passes read them and its voxels.
 
 use crate::navigate::Lumen;
 use crate::Volume;
-use rayon::prelude::*;
 use std::ops::{Range, RangeInclusive};
 
 /// Which voxels lie inside the surface.
@@ -39,13 +39,16 @@ impl Span {
     }
 }
 
-/// A box of the volume with its voxels' inside flags, rows of `i` stored one after another.
+/// A slab of planes of a box of the volume with its voxels' inside flags, rows of `i` stored
+/// one after another; loaded slab after slab into the same buffers.
 pub(super) struct Grid<'a> {
     /// The volume.
     pub volume: &'a Volume,
-    /// The box's lowest voxel in the volume.
+    /// Which voxels are inside.
+    inside: &'a Inside<'a>,
+    /// The slab's lowest voxel in the volume.
     pub lo: [usize; 3],
-    /// The box's size in voxels (at least 2 along each axis).
+    /// The slab's size in voxels (at least 2 along `i` and `j`; its planes along `k`).
     pub dims: [usize; 3],
     /// 1 for an inside voxel, 0 for an outside one.
     flags: Vec<u8>,
@@ -54,32 +57,52 @@ pub(super) struct Grid<'a> {
 }
 
 impl<'a> Grid<'a> {
-    /// Classifies the voxels of the box at `lo` of size `dims` (planes in parallel).
-    pub fn new(volume: &'a Volume, lo: [usize; 3], dims: [usize; 3], inside: &Inside) -> Self {
-        let [nx, ny, nz] = dims;
-        let mut flags = vec![0u8; nx * ny * nz];
-        let mut spans = vec![Span::none(nx); ny * nz];
-        let grid = |k: usize, plane: &mut [u8], spans: &mut [Span]| {
+    /// An empty grid over the rows of `i` of the box at `lo` with `dims[0]` by `dims[1]` voxels
+    /// a plane; [`Grid::load`] fills its planes.
+    pub fn new(
+        volume: &'a Volume,
+        inside: &'a Inside<'a>,
+        lo: [usize; 3],
+        dims: [usize; 2],
+    ) -> Self {
+        Self {
+            volume,
+            inside,
+            lo,
+            dims: [dims[0], dims[1], 0],
+            flags: Vec::new(),
+            spans: Vec::new(),
+        }
+    }
+
+    /// Classifies the `planes` planes from volume plane `k0` on. When the slab starts at the
+    /// last plane of the one before, that plane's flags are moved rather than classified again.
+    pub fn load(&mut self, k0: usize, planes: usize) {
+        let [nx, ny, old] = self.dims;
+        let carried = usize::from(old > 0 && self.lo[2] + old - 1 == k0 && planes > 0);
+        if carried == 1 {
+            self.flags
+                .copy_within((old - 1) * nx * ny..old * nx * ny, 0);
+            self.spans.copy_within((old - 1) * ny..old * ny, 0);
+        }
+        self.flags.resize(planes * nx * ny, 0);
+        self.spans.resize(planes * ny, Span::none(nx));
+        self.lo[2] = k0;
+        self.dims[2] = planes;
+        let (volume, inside, lo) = (self.volume, self.inside, self.lo);
+        let flag_planes = self
+            .flags
+            .chunks_mut(nx * ny)
+            .zip(self.spans.chunks_mut(ny));
+        for (k, (plane, spans)) in flag_planes.enumerate().skip(carried) {
             for (j, (row, span)) in plane.chunks_mut(nx).zip(spans).enumerate() {
                 classify(volume, [lo[0], lo[1] + j, lo[2] + k], inside, row);
                 *span = span_of(row);
             }
-        };
-        flags
-            .par_chunks_mut(nx * ny)
-            .zip(spans.par_chunks_mut(ny))
-            .enumerate()
-            .for_each(|(k, (plane, spans))| grid(k, plane, spans));
-        Self {
-            volume,
-            lo,
-            dims,
-            flags,
-            spans,
         }
     }
 
-    /// The flags of row `(j, k)`.
+    /// The flags of row `(j, k)` (`k` counted from the slab's first plane).
     pub fn row(&self, j: usize, k: usize) -> &[u8] {
         let nx = self.dims[0];
         &self.flags[(j + self.dims[1] * k) * nx..][..nx]
