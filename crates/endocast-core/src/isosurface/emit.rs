@@ -4,7 +4,7 @@
 //! far in each of the rows it touches.
 
 use super::cases::{crossed, CASES};
-use super::grid::Grid;
+use super::grid::{along, for_each_one, Grid};
 use super::layout::Layout;
 use crate::{ValueMap, Volume};
 use glam::{DAffine3, DVec3};
@@ -79,9 +79,13 @@ pub(super) fn emit(grid: &Grid, layout: &Layout, placer: &Placer, base: u32, out
             for j in 0..ny {
                 let (row, next) = (grid.row(j, k), grid.row(j, k + 1));
                 let v = voxel(grid, 0, j, k);
-                for_crossed(row, next, |i| {
-                    out.vertices.push(placer.vertex([v[0] + i, v[1], v[2]], 2));
-                });
+                for_each_one(
+                    row.len(),
+                    |w| row[w] ^ next[w],
+                    |i| {
+                        out.vertices.push(placer.vertex([v[0] + i, v[1], v[2]], 2));
+                    },
+                );
             }
         }
     }
@@ -99,43 +103,25 @@ fn voxel(grid: &Grid, i: usize, j: usize, k: usize) -> [usize; 3] {
 
 /// Appends the vertices of row `(j, k)`'s crossed `i` edges, then its crossed `j` edges.
 fn plane_vertices(grid: &Grid, placer: &Placer, j: usize, k: usize, out: &mut Vec<DVec3>) {
+    let [nx, ny, _] = grid.dims;
     let row = grid.row(j, k);
-    let span = grid.span(j, k);
     let v = voxel(grid, 0, j, k);
-    if span.count > 0 {
-        let (first, end) = (span.first as usize, span.end as usize);
-        for_crossed(&row[first..end], &row[first + 1..=end], |i| {
-            out.push(placer.vertex([v[0] + first + i, v[1], v[2]], 0));
-        });
-    }
-    if j + 1 < grid.dims[1] {
-        for_crossed(row, grid.row(j + 1, k), |i| {
-            out.push(placer.vertex([v[0] + i, v[1], v[2]], 1));
-        });
-    }
-}
-
-/// Calls `f` with every place, in order, where the flags `a` and `b` (of one length) differ,
-/// eight at a time where they agree.
-fn for_crossed(a: &[u8], b: &[u8], mut f: impl FnMut(usize)) {
-    let word = |s: &[u8]| u64::from_le_bytes(s.try_into().unwrap_or_default());
-    let whole = a.len() / 8 * 8;
-    for (n, (x, y)) in a[..whole]
-        .chunks_exact(8)
-        .zip(b.chunks_exact(8))
-        .enumerate()
-    {
-        // Flags are 0 or 1: each differing byte has its lowest bit set, and only it.
-        let mut differ = word(x) ^ word(y);
-        while differ != 0 {
-            f(8 * n + differ.trailing_zeros() as usize / 8);
-            differ &= differ - 1;
-        }
-    }
-    for i in whole..a.len() {
-        if a[i] != b[i] {
-            f(i);
-        }
+    for_each_one(
+        row.len(),
+        |w| along(row, nx, w),
+        |i| {
+            out.push(placer.vertex([v[0] + i, v[1], v[2]], 0));
+        },
+    );
+    if j + 1 < ny {
+        let next = grid.row(j + 1, k);
+        for_each_one(
+            row.len(),
+            |w| row[w] ^ next[w],
+            |i| {
+                out.push(placer.vertex([v[0] + i, v[1], v[2]], 1));
+            },
+        );
     }
 }
 
@@ -162,7 +148,7 @@ fn row_triangles(
         next[4 + 2 * d] = base + y_row.vertex + y_row.x;
         next[8 + 2 * d] = base + row(d, 0).z_vertex;
     }
-    for case in cube_row.cut(layout.row(j, k, ny).cubes.clone()) {
+    for case in cube_row.cut() {
         let id = |e: usize| match e {
             5 | 7 | 9 | 11 => next[e - 1] + u32::from(crossed(case, e - 1)),
             _ => next[e],

@@ -8,10 +8,9 @@
 //! gets the ids the next slab (which starts at that plane) gives it: a slab writes the vertices
 //! of its planes but the last, and names the last plane's by those ids.
 
-use super::grid::{differences, Grid};
-use std::ops::Range;
+use super::grid::{along, count, Grid};
 
-/// Where one row's vertices lie, and its row of cubes.
+/// Where one row's vertices lie.
 #[derive(Debug, Clone, Default)]
 pub(super) struct RowLayout {
     /// The id of the row's first in-plane vertex (its `i` edges' vertices, then `j`'s).
@@ -24,8 +23,6 @@ pub(super) struct RowLayout {
     pub y: u32,
     /// How many of its `k` edges (to the next plane) are crossed.
     pub z: u32,
-    /// The cubes of the row of cubes starting at this row that may be cut.
-    pub cubes: Range<usize>,
 }
 
 /// Every row's layout in a slab (`j + ny·k`), ids counted from the slab's first vertex.
@@ -76,11 +73,11 @@ impl Layout {
     }
 }
 
-/// The crossed edges of row `(j, k)` and its row of cubes' trim (ids not yet given).
+/// The crossed edges of row `(j, k)` (ids not yet given).
 fn count_row(grid: &Grid, j: usize, k: usize) -> RowLayout {
-    let [_, ny, nz] = grid.dims;
+    let [nx, ny, nz] = grid.dims;
     let row = grid.row(j, k);
-    let crossings = |other: &[u8]| differences(row, other) as u32;
+    let crossings = |other: &[u64]| count(row.len(), |w| row[w] ^ other[w]);
     let y = if j + 1 < ny {
         crossings(grid.row(j + 1, k))
     } else {
@@ -91,17 +88,11 @@ fn count_row(grid: &Grid, j: usize, k: usize) -> RowLayout {
     } else {
         0
     };
-    let cubes = if j + 1 < ny && k + 1 < nz {
-        grid.cube_rows(j, k).trim()
-    } else {
-        0..0
-    };
     RowLayout {
         vertex: 0,
         z_vertex: 0,
-        x: grid.span(j, k).count,
+        x: count(row.len(), |w| along(row, nx, w)),
         y,
         z,
-        cubes,
     }
 }
