@@ -67,25 +67,24 @@ impl<'v> Placer<'v> {
 /// Appends the vertices the slab in `grid` writes and the triangles of its cubes to `out`, its
 /// ids counted from `base`.
 pub(super) fn emit(grid: &Grid, layout: &Layout, placer: &Placer, base: u32, out: &mut Pieces) {
-    let [_, ny, nz] = grid.dims;
+    let [nx, ny, nz] = grid.dims;
     let writes_last = layout.written == layout.named;
     for k in 0..nz {
+        let edges = |j| Edges { grid, placer, j, k };
         if k + 1 < nz || writes_last {
             for j in 0..ny {
-                plane_vertices(grid, placer, j, k, &mut out.vertices);
+                let row = grid.row(j, k);
+                edges(j).push(0, |w| along(row, nx, w), &mut out.vertices);
+                if j + 1 < ny {
+                    let next = grid.row(j + 1, k);
+                    edges(j).push(1, |w| row[w] ^ next[w], &mut out.vertices);
+                }
             }
         }
         if k + 1 < nz {
             for j in 0..ny {
                 let (row, next) = (grid.row(j, k), grid.row(j, k + 1));
-                let v = voxel(grid, 0, j, k);
-                for_each_one(
-                    row.len(),
-                    |w| row[w] ^ next[w],
-                    |i| {
-                        out.vertices.push(placer.vertex([v[0] + i, v[1], v[2]], 2));
-                    },
-                );
+                edges(j).push(2, |w| row[w] ^ next[w], &mut out.vertices);
             }
         }
     }
@@ -96,32 +95,23 @@ pub(super) fn emit(grid: &Grid, layout: &Layout, placer: &Placer, base: u32, out
     }
 }
 
-/// The volume voxel of slab voxel `(i, j, k)`.
-fn voxel(grid: &Grid, i: usize, j: usize, k: usize) -> [usize; 3] {
-    [grid.lo[0] + i, grid.lo[1] + j, grid.lo[2] + k]
+/// The edges from the voxels of row `(j, k)` of a slab.
+struct Edges<'e> {
+    grid: &'e Grid<'e>,
+    placer: &'e Placer<'e>,
+    j: usize,
+    k: usize,
 }
 
-/// Appends the vertices of row `(j, k)`'s crossed `i` edges, then its crossed `j` edges.
-fn plane_vertices(grid: &Grid, placer: &Placer, j: usize, k: usize, out: &mut Vec<DVec3>) {
-    let [nx, ny, _] = grid.dims;
-    let row = grid.row(j, k);
-    let v = voxel(grid, 0, j, k);
-    for_each_one(
-        row.len(),
-        |w| along(row, nx, w),
-        |i| {
-            out.push(placer.vertex([v[0] + i, v[1], v[2]], 0));
-        },
-    );
-    if j + 1 < ny {
-        let next = grid.row(j + 1, k);
-        for_each_one(
-            row.len(),
-            |w| row[w] ^ next[w],
-            |i| {
-                out.push(placer.vertex([v[0] + i, v[1], v[2]], 1));
-            },
-        );
+impl Edges<'_> {
+    /// Appends the vertices on the row's edges along `axis` that are crossed: the edge from
+    /// voxel `i` where bit `i % 64` of `crossed(i / 64)` is set.
+    fn push(&self, axis: usize, crossed: impl Fn(usize) -> u64, out: &mut Vec<DVec3>) {
+        let g = self.grid;
+        let v = [g.lo[0], g.lo[1] + self.j, g.lo[2] + self.k];
+        for_each_one(g.row(self.j, self.k).len(), crossed, |i| {
+            out.push(self.placer.vertex([v[0] + i, v[1], v[2]], axis));
+        });
     }
 }
 

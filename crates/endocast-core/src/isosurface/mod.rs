@@ -6,9 +6,10 @@
 //! on faces (`cases`) keeps it watertight without face or body deciders, and the rule keeps
 //! the inside 6-connected, as a [`Lumen`] is, so the lumen's surface never merges two lumen
 //! voxels that only touch along a diagonal. Flying edges' passes (`grid`, `layout`,
-//! `emit`) classify the voxels once, count each row's crossed edges and triangles, turn the
-//! counts into output offsets, and write every plane in parallel without locks or sorting: the
-//! result does not depend on the thread count.
+//! `emit`) run on one slab of planes after another while it is in the cache: classify its voxels
+//! into bits, count each row's crossed edges and number their vertices, then write the vertices
+//! and triangles. Several threads sweep consecutive runs of slabs, joined in order without locks
+//! or sorting: the result does not depend on the thread count.
 //!
 //! Which voxels lie inside is a [`Lumen`] (the component around a seed; only its bounding box
 //! is scanned) or, for the whole volume, the side of the isovalue (a voxel equal to it is on
@@ -128,8 +129,8 @@ fn blurred(field: &[f32], dims: [usize; 3], axis: usize) -> Vec<f32> {
         .collect()
 }
 
-/// How many planes of cubes a slab holds: its flags and voxels (8 planes of a 512² scan: 2 MiB
-/// and 4 MiB) stay in the cache from classifying them to placing the vertices.
+/// How many planes of cubes a slab holds: its bits and voxels (9 planes of a 256² scan: 74 KiB
+/// and 1.2 MiB) stay in the cache from classifying them to placing the vertices.
 const SLAB: usize = 8;
 
 /// The surface between the inside voxels of the box at `lo` of size `dims` and the others,
