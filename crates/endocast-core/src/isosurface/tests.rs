@@ -206,7 +206,7 @@ fn rows_longer_than_a_word_and_several_slabs_give_a_vertex_a_crossed_edge_and_th
                 let corner = [i + (c & 1), j + (c >> 1 & 1), k + (c >> 2)];
                 case | u8::from(inside(corner)) << c
             });
-            triangles += usize::from(super::cases::CASES[usize::from(case)].count);
+            triangles += usize::from(cases::CASES[usize::from(case)].count);
         }
     }
     let mesh = isosurface(&volume, ISO, LumenSide::Above).unwrap();
