@@ -7,14 +7,27 @@
 # Usage (repository root, VTK from ../shared/peers/install_vtk.sh; SHARED_DATA: the shared
 # data folder when it is not ../shared/data):
 #   bench/mesh_vs_vtk.sh [RUNS]
+#
+# The extraction alone, interleaved with VTK (issue 33, item 6): each round runs, per phantom,
+# `isosurface()` (the `mesh_extraction` example on one thread: mean CPU of 20 runs), then the
+# same with the example in $BEFORE when set (another build, e.g. an older commit's), then VTK's
+# flying edges (SMP backend "Sequential": one thread; median CPU of 20 runs); the last lines are
+# the medians over the rounds and the median of the per-round ratios endocast ÷ VTK.
+#   bench/mesh_vs_vtk.sh extraction [ROUNDS]
 set -euo pipefail
-runs=${1:-3}
 out=${OUT:-bench/out}
 py=${VTK_PYTHON:-/opt/peers-venv/bin/python}
 mkdir -p "$out"
 source "$(dirname "$0")/cargo_bin.sh"
 endocast_binary
 bin=$endocast
+if [ "${1:-}" = extraction ]; then
+  mode=extraction
+  rounds=${2:-5}
+else
+  mode=command
+  runs=${1:-3}
+fi
 colon=$out/colon256.nii.gz
 [ -f "$colon" ] || $bin phantom colon --size 256 -o "$colon" >/dev/null
 sphere=$out/sphere256.nii.gz
@@ -23,6 +36,42 @@ tube=$out/curvedtube256.nii.gz
 [ -f "$tube" ] || $bin phantom curved-tube --size 256 -o "$tube" >/dev/null
 cthead=$out/cthead.nii.gz
 [ -f "$cthead" ] || $bin convert "${SHARED_DATA:-../shared/data}"/head-ct-stanford-cthead/CThead.nhdr -o "$cthead" >/dev/null
+
+# extraction_rounds: the interleaved rounds of the extraction alone (see the usage above).
+extraction_rounds() {
+  cargo build --release -q -p endocast-core --example mesh_extraction
+  local example=$release_dir/examples/mesh_extraction log=$out/extraction.txt
+  : >"$log"
+  for round in $(seq "$rounds"); do
+    for p in colon:$colon sphere-shell:$sphere curved-tube:$tube; do
+      local name=${p%%:*} file=${p#*:}
+      for build in after ${BEFORE:+before}; do
+        local exe=$example
+        [ "$build" = before ] && exe=$BEFORE
+        RAYON_NUM_THREADS=1 "$exe" "$name" 256 -500 20 |
+          sed -n "s/.*: \([0-9]*\) triangles.*CPU \([0-9.]*\) s each.*/$round $name $build \2 \1/p" >>"$log"
+      done
+      "$py" bench/vtk_mesh.py "$file" --iso -500 --runs 20 | python3 -c "import json, sys
+d = json.load(sys.stdin)
+print($round, '$name', 'vtk', d['median_cpu_s'], d['triangles'], d['smp_backend'])" >>"$log"
+    done
+    tail -n "$((3 * (${BEFORE:+1} + 2)))" "$log"
+  done
+  python3 - "$log" <<'PY'
+import collections, statistics, sys
+cpu = collections.defaultdict(dict)
+for line in open(sys.argv[1]):
+    r, name, build, s = line.split()[:4]
+    cpu[(name, build)][r] = float(s)
+for name in ("colon", "sphere-shell", "curved-tube"):
+    builds = [b for b in ("before", "after", "vtk") if (name, b) in cpu]
+    medians = ", ".join(f"{b} {statistics.median(cpu[(name, b)].values()):.4f} s" for b in builds)
+    ratios = lambda b: [cpu[(name, b)][r] / cpu[(name, "vtk")][r] for r in cpu[(name, "vtk")]]
+    told = ", ".join(f"{b} ÷ vtk {statistics.median(ratios(b)):.2f} (rounds {min(ratios(b)):.2f}–{max(ratios(b)):.2f})"
+                     for b in builds if b != "vtk")
+    print(f"{name}: CPU medians {medians}; median of the rounds' ratios: {told}")
+PY
+}
 
 # endocast_runs VOLUME ISO [X,Y,Z]: median wall and CPU seconds of `endocast mesh`.
 endocast_runs() {
@@ -39,6 +88,11 @@ endocast_runs() {
     "$(printf '%s\n' "${cpus[@]}" | sort -n | sed -n "$(((runs + 1) / 2))p")" "$runs" \
     "$(cat "$out/mesh.txt")"
 }
+
+if [ "$mode" = extraction ]; then
+  extraction_rounds
+  exit
+fi
 
 echo "== colon phantom 256 (256×256×239, 1 mm), −500 HU"
 endocast_runs "$colon" -500

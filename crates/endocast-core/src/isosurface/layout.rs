@@ -1,90 +1,70 @@
-//! Flying edges' second pass and the prefix sums: how many vertices each row of voxels owns
-//! (one per crossed edge from its voxels along `i`, then `j`, then `k`) and how many triangles
-//! each row of cubes makes, so that every row knows where its output starts and the last pass
-//! can write rows in parallel without locks, in an order that does not depend on the threads.
+//! Flying edges' second pass and the prefix sums, for one slab: how many vertices each row of
+//! voxels owns (one per crossed edge from its voxels along `i`, then `j`, then `k`), so that
+//! every crossed edge has its id before the triangles that use it are written.
+//!
+//! The numbering, plane after plane: first the vertices in the plane (each row's `i` edges, then
+//! its `j` edges), then those on the `k` edges to the next plane (row after row). The in-plane
+//! vertices of a plane are thus numbered without looking past it, so the last plane of a slab
+//! gets the ids the next slab (which starts at that plane) gives it: a slab writes the vertices
+//! of its planes but the last, and names the last plane's by those ids.
 
-use super::cases::CASES;
-use super::grid::{differences, Grid};
-use crate::scene::MeshError;
-use rayon::prelude::*;
-use std::ops::Range;
+use super::grid::{along, count, Grid};
 
-/// Where one row's output lies.
+/// Where one row's vertices lie.
 #[derive(Debug, Clone, Default)]
 pub(super) struct RowLayout {
-    /// The id of the row's first vertex (its `i` edges' vertices, then `j`'s, then `k`'s).
+    /// The id of the row's first in-plane vertex (its `i` edges' vertices, then `j`'s).
     pub vertex: u32,
+    /// The id of its first vertex on a `k` edge.
+    pub z_vertex: u32,
     /// How many of its `i` edges are crossed.
     pub x: u32,
     /// How many of its `j` edges (to the next row) are crossed.
     pub y: u32,
     /// How many of its `k` edges (to the next plane) are crossed.
     pub z: u32,
-    /// The index of the first triangle of the row of cubes starting at this row.
-    pub triangle: usize,
-    /// The cubes of that row that may be cut.
-    pub cubes: Range<usize>,
 }
 
-/// Every row's layout (`j + ny·k`) and the totals.
+/// Every row's layout in a slab (`j + ny·k`), ids counted from the slab's first vertex.
+#[derive(Default)]
 pub(super) struct Layout {
     /// The rows.
     pub rows: Vec<RowLayout>,
-    /// How many vertices in all.
-    pub vertices: usize,
-    /// How many triangles in all.
-    pub triangles: usize,
-}
-
-/// What pass two counts for one row: its crossed `i`, `j` and `k` edges and its cubes.
-struct Counts {
-    edges: [usize; 3],
-    cubes: Range<usize>,
-    triangles: usize,
+    /// How many vertices the slab writes: all of its planes' but the last one's in-plane
+    /// vertices, which the next slab writes (all of them when there is no next slab).
+    pub written: usize,
+    /// How many ids the slab's rows name (its vertices and its last plane's in-plane ones).
+    pub named: usize,
 }
 
 impl Layout {
-    /// Counts every row (planes in parallel), then lays the rows out one after another.
-    pub fn new(grid: &Grid) -> Result<Self, MeshError> {
+    /// Counts every row of the slab loaded in `grid` and numbers its vertices; `last` tells
+    /// whether the slab ends the box (and so writes its last plane's vertices too).
+    pub fn count(&mut self, grid: &Grid, last: bool) {
         let [_, ny, nz] = grid.dims;
-        let counts: Vec<Counts> = (0..ny * nz)
-            .into_par_iter()
-            .with_min_len(ny)
-            .map(|r| count_row(grid, r % ny, r / ny))
-            .collect();
-        let (mut vertices, mut triangles) = (0usize, 0usize);
-        let mut rows = Vec::with_capacity(counts.len());
-        for c in counts {
-            rows.push(RowLayout {
-                vertex: vertices as u32,
-                x: c.edges[0] as u32,
-                y: c.edges[1] as u32,
-                z: c.edges[2] as u32,
-                triangle: triangles,
-                cubes: c.cubes,
-            });
-            vertices += c.edges.iter().sum::<usize>();
-            triangles += c.triangles;
+        self.rows.clear();
+        self.rows
+            .extend((0..ny * nz).map(|r| count_row(grid, r % ny, r / ny)));
+        // Ids past u32 wrap here; the caller checks `named` before any is used.
+        let mut next = 0usize;
+        for k in 0..nz {
+            let plane = &mut self.rows[k * ny..(k + 1) * ny];
+            if k + 1 == nz && !last {
+                self.written = next;
+            }
+            for row in plane.iter_mut() {
+                row.vertex = next as u32;
+                next += (row.x + row.y) as usize;
+            }
+            for row in plane.iter_mut() {
+                row.z_vertex = next as u32;
+                next += row.z as usize;
+            }
         }
-        if vertices > u32::MAX as usize {
-            return Err(MeshError::TooLarge { vertices });
+        self.named = next;
+        if last {
+            self.written = next;
         }
-        Ok(Self {
-            rows,
-            vertices,
-            triangles,
-        })
-    }
-
-    /// Where each plane's vertices and triangles start (planes of `ny` rows), then the totals.
-    pub fn plane_starts(&self, ny: usize) -> (Vec<usize>, Vec<usize>) {
-        let starts = self.rows.iter().step_by(ny);
-        let vertices = starts.clone().map(|r| r.vertex as usize);
-        let triangles = starts.map(|r| r.triangle);
-        (
-            vertices.chain([self.vertices]).collect(),
-            triangles.chain([self.triangles]).collect(),
-        )
     }
 
     /// The row `(j, k)`.
@@ -93,11 +73,11 @@ impl Layout {
     }
 }
 
-/// The crossed edges of row `(j, k)` and its row of cubes' trim and triangles.
-fn count_row(grid: &Grid, j: usize, k: usize) -> Counts {
-    let [_, ny, nz] = grid.dims;
+/// The crossed edges of row `(j, k)` (ids not yet given).
+fn count_row(grid: &Grid, j: usize, k: usize) -> RowLayout {
+    let [nx, ny, nz] = grid.dims;
     let row = grid.row(j, k);
-    let crossings = |other: &[u8]| differences(row, other);
+    let crossings = |other: &[u64]| count(row.len(), |w| row[w] ^ other[w]);
     let y = if j + 1 < ny {
         crossings(grid.row(j + 1, k))
     } else {
@@ -108,18 +88,11 @@ fn count_row(grid: &Grid, j: usize, k: usize) -> Counts {
     } else {
         0
     };
-    let (mut cubes, mut triangles) = (0..0, 0);
-    if j + 1 < ny && k + 1 < nz {
-        let cube_row = grid.cube_rows(j, k);
-        cubes = cube_row.trim();
-        triangles = cube_row
-            .cut(cubes.clone())
-            .map(|case| usize::from(CASES[usize::from(case)].count))
-            .sum();
-    }
-    Counts {
-        edges: [grid.span(j, k).count as usize, y, z],
-        cubes,
-        triangles,
+    RowLayout {
+        vertex: 0,
+        z_vertex: 0,
+        x: count(row.len(), |w| along(row, nx, w)),
+        y,
+        z,
     }
 }

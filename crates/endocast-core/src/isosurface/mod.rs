@@ -6,9 +6,10 @@
 //! on faces (`cases`) keeps it watertight without face or body deciders, and the rule keeps
 //! the inside 6-connected, as a [`Lumen`] is, so the lumen's surface never merges two lumen
 //! voxels that only touch along a diagonal. Flying edges' passes (`grid`, `layout`,
-//! `emit`) classify the voxels once, count each row's crossed edges and triangles, turn the
-//! counts into output offsets, and write every plane in parallel without locks or sorting: the
-//! result does not depend on the thread count.
+//! `emit`) run on one slab of planes after another while it is in the cache: classify its voxels
+//! into bits, count each row's crossed edges and number their vertices, then write the vertices
+//! and triangles. Several threads sweep consecutive runs of slabs, joined in order without locks
+//! or sorting: the result does not depend on the thread count.
 //!
 //! Which voxels lie inside is a [`Lumen`] (the component around a seed; only its bounding box
 //! is scanned) or, for the whole volume, the side of the isovalue (a voxel equal to it is on
@@ -26,11 +27,12 @@ mod layout;
 use crate::navigate::{Lumen, LumenSide};
 use crate::scene::{MeshError, TriangleMesh};
 use crate::Volume;
-use emit::emit;
+use emit::{emit, Pieces, Placer};
 use glam::DVec3;
 use grid::{Grid, Inside};
 use layout::Layout;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// The surface of `lumen` at its threshold: the boundary between its voxels and the rest, in
 /// world mm (watertight where the lumen does not reach the volume's border).
@@ -127,8 +129,13 @@ fn blurred(field: &[f32], dims: [usize; 3], axis: usize) -> Vec<f32> {
         .collect()
 }
 
+/// How many planes of cubes a slab holds: its bits and voxels (9 planes of a 256² scan: 74 KiB
+/// and 1.2 MiB) stay in the cache from classifying them to placing the vertices.
+const SLAB: usize = 8;
+
 /// The surface between the inside voxels of the box at `lo` of size `dims` and the others,
-/// vertices where the field crosses `iso`.
+/// vertices where the field crosses `iso`: slabs of planes swept in order, by one thread or, cut
+/// into consecutive runs of slabs, by several (the runs joined in order: the same mesh).
 fn extract(
     volume: &Volume,
     (lo, dims): ([usize; 3], [usize; 3]),
@@ -138,10 +145,78 @@ fn extract(
     if dims.iter().any(|&n| n < 2) {
         return Err(MeshError::Empty);
     }
-    let grid = Grid::new(volume, lo, dims, inside);
-    let layout = Layout::new(&grid)?;
-    let (vertices, triangles) = emit(&grid, &layout, iso);
+    let slabs = (dims[2] - 1).div_ceil(SLAB);
+    let threads = rayon::current_num_threads();
+    // Several runs a thread even out the work of unequal slabs.
+    let runs = if threads == 1 {
+        1
+    } else {
+        (4 * threads).min(slabs)
+    };
+    let pieces = (0..runs)
+        .into_par_iter()
+        .map(|r| {
+            sweep(
+                volume,
+                inside,
+                (lo, dims),
+                r * slabs / runs..(r + 1) * slabs / runs,
+                iso,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let Pieces {
+        vertices,
+        triangles,
+    } = joined(pieces)?;
     TriangleMesh::new(vertices, triangles)
+}
+
+/// The vertices and triangles of the slabs `slabs` of the box, their ids counted from the run's
+/// first vertex (ids at or past its end name the next run's first vertices).
+fn sweep(
+    volume: &Volume,
+    inside: &Inside,
+    (lo, dims): ([usize; 3], [usize; 3]),
+    slabs: Range<usize>,
+    iso: f64,
+) -> Result<Pieces, MeshError> {
+    let mut grid = Grid::new(volume, inside, lo, [dims[0], dims[1]]);
+    let mut layout = Layout::default();
+    let placer = Placer::new(volume, iso);
+    let mut out = Pieces::default();
+    for s in slabs {
+        let k0 = s * SLAB;
+        let planes = (dims[2] - 1 - k0).min(SLAB) + 1;
+        grid.load(lo[2] + k0, planes);
+        layout.count(&grid, k0 + planes == dims[2]);
+        let base = out.vertices.len();
+        if base + layout.named > u32::MAX as usize {
+            let vertices = base + layout.named;
+            return Err(MeshError::TooLarge { vertices });
+        }
+        emit(&grid, &layout, &placer, base as u32, &mut out);
+    }
+    Ok(out)
+}
+
+/// The runs' pieces one after another, each run's ids moved by the vertices before it.
+fn joined(pieces: Vec<Pieces>) -> Result<Pieces, MeshError> {
+    let vertices = pieces.iter().map(|p| p.vertices.len()).sum::<usize>();
+    if vertices > u32::MAX as usize {
+        return Err(MeshError::TooLarge { vertices });
+    }
+    let triangles = pieces.iter().map(|p| p.triangles.len()).sum::<usize>();
+    let mut pieces = pieces.into_iter();
+    let mut whole = pieces.next().unwrap_or_default();
+    whole.vertices.reserve(vertices - whole.vertices.len());
+    whole.triangles.reserve(triangles - whole.triangles.len());
+    for piece in pieces {
+        let base = whole.vertices.len() as u32;
+        whole.vertices.extend_from_slice(&piece.vertices);
+        (whole.triangles).extend(piece.triangles.iter().map(|t| t.map(|v| v + base)));
+    }
+    Ok(whole)
 }
 
 /// The box of the volume that holds `lumen` and a voxel more on every side (within the volume).

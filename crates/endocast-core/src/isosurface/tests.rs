@@ -41,11 +41,20 @@ fn the_sphere_phantom_gives_a_closed_surface_on_the_isovalue() {
 const ISO: f64 = 10_000.0;
 
 /// An `n³` volume (1 mm voxels) whose value at voxel `p` is `ISO + 1000 · d(p)`, rounded.
-fn field_volume(n: usize, mut d: impl FnMut(DVec3) -> f64) -> Volume {
-    let dims = [n; 3];
-    let voxels = (0..n * n * n)
+fn field_volume(n: usize, d: impl FnMut(DVec3) -> f64) -> Volume {
+    field_box([n; 3], d)
+}
+
+/// A volume of `dims` voxels (1 mm) whose value at voxel `p` is `ISO + 1000 · d(p)`, rounded.
+fn field_box(dims: [usize; 3], mut d: impl FnMut(DVec3) -> f64) -> Volume {
+    let [nx, ny, nz] = dims;
+    let voxels = (0..nx * ny * nz)
         .map(|m| {
-            let p = DVec3::new((m % n) as f64, (m / n % n) as f64, (m / (n * n)) as f64);
+            let p = DVec3::new(
+                (m % nx) as f64,
+                (m / nx % ny) as f64,
+                (m / (nx * ny)) as f64,
+            );
             (ISO + 1000.0 * d(p)).round().clamp(0.0, 65_535.0) as u16
         })
         .collect();
@@ -165,6 +174,46 @@ fn random_fields_give_closed_outward_surfaces_without_zero_area_triangles() {
             assert!(signed_volume(&mesh) > 0.0);
         }
     }
+}
+
+#[test]
+fn rows_longer_than_a_word_and_several_slabs_give_a_vertex_a_crossed_edge_and_the_cases_triangles()
+{
+    // Rows of 131 voxels (three words, crossings at the words' seams) and 21 planes (slabs of
+    // 8 planes of cubes, the last one short), random voxels inside a border of outside ones.
+    let dims = [131, 6, 21];
+    let mut rng = crate::test_rng::Rng::new(7);
+    let volume = field_box(dims, |p| {
+        let border = p.min_element() == 0.0 || p.x == 130.0 || p.y == 5.0 || p.z == 20.0;
+        if border || rng.unit() < 0.5 {
+            -0.5
+        } else {
+            0.5
+        }
+    });
+    let inside = |v: [usize; 3]| volume.voxels()[v[0] + 131 * (v[1] + 6 * v[2])] > ISO as u16;
+    let (mut edges, mut triangles) = (0, 0);
+    for (i, j, k) in
+        (0..131).flat_map(|i| (0..6).flat_map(move |j| (0..21).map(move |k| (i, j, k))))
+    {
+        for axis in 0..3 {
+            let mut u = [i, j, k];
+            u[axis] += 1;
+            edges += usize::from(u[axis] < dims[axis] && inside([i, j, k]) != inside(u));
+        }
+        if i + 1 < 131 && j + 1 < 6 && k + 1 < 21 {
+            let case = (0..8).fold(0u8, |case, c| {
+                let corner = [i + (c & 1), j + (c >> 1 & 1), k + (c >> 2)];
+                case | u8::from(inside(corner)) << c
+            });
+            triangles += usize::from(cases::CASES[usize::from(case)].count);
+        }
+    }
+    let mesh = isosurface(&volume, ISO, LumenSide::Above).unwrap();
+    assert_eq!(mesh.vertices().len(), edges);
+    assert_eq!(mesh.triangles().len(), triangles);
+    assert_watertight(&mesh);
+    assert!(signed_volume(&mesh) > 0.0);
 }
 
 #[test]
