@@ -9,7 +9,7 @@
 //! operation for operation the same (the same cells, the same distances, the same bits).
 
 use super::bricks::BRICK_VOX;
-use super::cell_mask::{is_set, CellMask, NONE};
+use super::cell_mask::{is_set, CellMask};
 use super::march::RayMarch;
 use super::sample::SampleGrid;
 use super::trilinear_root::CellCubic;
@@ -101,41 +101,20 @@ impl CellWalk<'_> {
         let line = march.grid();
         let mut dda = self.dda(march);
         let mut side = Side::new(side);
-        loop {
-            if !dda.running() {
-                return None;
-            }
-            let slot = self.slot_of(dda.cell);
-            if slot == NONE {
+        while dda.running() {
+            let Some(cells) = self.cells.of(self.cells.brick_of(dda.cell)) else {
                 dda.leave_brick(&line, self.voxels.max_base);
                 continue;
-            }
+            };
             let (cell, span) = dda.step(self.voxels.max_base);
-            if self.is_flagged(slot, cell) {
+            let [i, j, k] = cell.map(|c| c as usize % BRICK_VOX);
+            if is_set(cells, i + BRICK_VOX * (j + BRICK_VOX * k)) {
                 if let Some(hit) = self.in_cell(&line, cell, span, &mut side, &mut stop) {
                     return Some(hit);
                 }
             }
         }
-    }
-
-    /// The place of the cells of the brick holding `cell` in the mask, or [`NONE`].
-    #[inline]
-    fn slot_of(&self, cell: [i32; 3]) -> u32 {
-        let brick = self.cells.brick_of(cell) as usize;
-        self.cells.slots().get(brick).copied().unwrap_or(NONE)
-    }
-
-    /// Whether `cell`, in the brick whose cells are at place `slot`, can hold the isovalue.
-    #[inline]
-    fn is_flagged(&self, slot: u32, cell: [i32; 3]) -> bool {
-        let words = self.cells.words();
-        let first = slot as usize * BRICK_VOX;
-        let local = cell.map(|c| c as usize % BRICK_VOX);
-        words.get(first..first + BRICK_VOX).is_some_and(|brick| {
-            let cells = brick.try_into().unwrap_or(&[0; BRICK_VOX]);
-            is_set(cells, local[0] + BRICK_VOX * (local[1] + BRICK_VOX * local[2]))
-        })
+        None
     }
 
     /// The crossing in cell `cell` (its lowest voxel) over `(ta, tb)` mm of `line` at which
@@ -158,7 +137,8 @@ impl CellWalk<'_> {
         // Where the walk was on the near side and this cell's entry is past the isovalue, the
         // crossing is the shared face: the neighbours' cubics, each from its own entry point,
         // may differ there in the last bits. (Not where a crossing was just found there.)
-        let at_face = side.before && cubic.is_past(iso, side.rising, 0.0) && ta > side.last_hit + FACE_MM;
+        let at_face =
+            side.before && cubic.is_past(iso, side.rising, 0.0) && ta > side.last_hit + FACE_MM;
         let mut found = if at_face {
             Some(0.0)
         } else {
