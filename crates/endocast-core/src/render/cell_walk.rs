@@ -12,7 +12,7 @@ use super::bricks::BRICK_VOX;
 use super::cell_mask::{is_set, CellMask};
 use super::march::RayMarch;
 use super::sample::SampleGrid;
-use super::trilinear_root::CellCubic;
+use super::trilinear_root::{range_over_box, CellCubic};
 use super::voxel_grid::VoxelGrid;
 use glam::Vec3;
 
@@ -132,7 +132,17 @@ impl CellWalk<'_> {
         let index = cell[0] as usize * sx + cell[1] as usize * sy + cell[2] as usize * sz;
         let corners = self.voxels.corners(index);
         let base = Vec3::new(cell[0] as f32, cell[1] as f32, cell[2] as f32);
-        let cubic = CellCubic::new(corners, line.at(ta) - base, line.direction);
+        let entry = line.at(ta) - base;
+        if let Some(above) = self.one_side(corners, (entry, line.at(tb) - base)) {
+            let past = above == side.rising;
+            // No crossing in the segment, and none at its entry face unless the walk comes
+            // from the near side into values past the isovalue (the face rule below).
+            if !(past && side.before) {
+                side.before = !past;
+                return None;
+            }
+        }
+        let cubic = CellCubic::new(corners, entry, line.direction);
         let (iso, len) = (f64::from(self.iso), f64::from(tb - ta));
         // Where the walk was on the near side and this cell's entry is past the isovalue, the
         // crossing is the shared face: the neighbours' cubics, each from its own entry point,
@@ -156,6 +166,29 @@ impl CellWalk<'_> {
         }
         side.before = !cubic.is_past(iso, side.rising, len);
         None
+    }
+}
+
+impl CellWalk<'_> {
+    /// Whether the field on the segment `(a, b)` (cell-local) of the cell with corners
+    /// `corners` lies wholly above the isovalue (`Some(true)`) or wholly below it
+    /// (`Some(false)`), clear of it by more than the
+    /// rounding of the segment's ends and values; `None` where it may cross. The cheap test
+    /// ahead of the cubic: a cell whose corners straddle the isovalue often holds no crossing on
+    /// the ray's short segment through it (a corner clipped, a wall grazed).
+    #[inline]
+    fn one_side(&self, corners: [glam::Vec4; 2], (a, b): (Vec3, Vec3)) -> Option<bool> {
+        let (least, greatest) = range_over_box(corners, a, b);
+        let spread =
+            corners[0].max(corners[1]).max_element() - corners[0].min(corners[1]).min_element();
+        let margin = 1e-3 * (spread + self.iso.abs()) + 1e-3;
+        if greatest < self.iso - margin {
+            Some(false)
+        } else if least >= self.iso + margin {
+            Some(true)
+        } else {
+            None
+        }
     }
 }
 
