@@ -32,7 +32,7 @@ pub(crate) struct CellMask {
 impl CellMask {
     /// The cells of `volume` whose corner range holds `iso` (stored units: some corner below it
     /// and some at or above it), for the bricks set in `activity.iso`; a brick none of whose
-    /// cells holds it gets no entry (the brick walk skips it).
+    /// cells holds it gets no entry (the cell walk leaves it in one jump).
     pub fn new(volume: &Volume, grid: &BrickGrid, activity: &Activity, iso: f32) -> Self {
         let bricks = grid.bricks();
         let found: Vec<(usize, BrickCells)> = (0..grid.len())

@@ -267,7 +267,7 @@ impl RayMarch {
     /// count as skipped (no sample was taken in them).
     pub(crate) fn found_at(&mut self, t: f32) {
         debug_assert!(self.pending.is_none());
-        while let Some(segment) = self.dda.next() {
+        for segment in self.dda.by_ref() {
             if segment.t1 > t {
                 self.stats.bricks_visited += 1;
                 self.pending = Some(segment);

@@ -168,12 +168,17 @@ struct Walk8 {
     /// Lanes that move along each axis, and those that move up it.
     moving: [Mask; 3],
     rising: [Mask; 3],
+    /// −1, 0 or +1 per axis.
     step: [__m256i; 3],
+    /// The cell each lane is in (its lowest voxel).
     cell: [__m256i; 3],
+    /// Where each ray meets its next cell face per axis, and the distance between faces, mm.
     t_next: [__m256; 3],
     t_delta: [__m256; 3],
+    /// Where each walk is and where it ends, mm.
     t: __m256,
     t_end: __m256,
+    /// The volume's last cell per axis.
     max_base: [__m256i; 3],
 }
 
