@@ -22,11 +22,9 @@ pub(crate) const BRICK_SHIFT: u32 = BRICK_VOX.trailing_zeros();
 /// The cells of the iso-active bricks whose trilinear field can reach the isovalue.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct CellMask {
-    /// Per brick, its entry in `cells` and `blocks`, or [`NONE`].
+    /// Per brick, its entry in `cells`, or [`NONE`].
     slot: Vec<u32>,
     cells: Vec<BrickCells>,
-    /// Per entry, a bit per 2×2×2 block of cells ([`block_bit`]): set where any of its cells is.
-    blocks: Vec<u64>,
     /// Bricks per axis.
     bricks: [i32; 3],
 }
@@ -55,14 +53,12 @@ impl CellMask {
             // Fewer bricks than `u32::MAX`: `BrickDda` numbers them in `u32` already.
             slot[b] = n as u32;
         }
-        let cells: Vec<BrickCells> = found.into_iter().map(|(_, cells)| cells).collect();
-        let blocks = cells.iter().map(blocks_of).collect();
+        let cells = found.into_iter().map(|(_, cells)| cells).collect();
         // Bricks per axis fit `i32`: their product is numbered in `u32` above.
         let bricks = bricks.map(|n| i32::try_from(n).unwrap_or(i32::MAX));
         Self {
             slot,
             cells,
-            blocks,
             bricks,
         }
     }
@@ -94,21 +90,11 @@ impl CellMask {
         self.cells.as_flattened()
     }
 
-    /// Every brick's blocks of cells (a `u64` each, [`block_bit`]) in slot order.
+    /// The cells of brick `brick`, or `None` where no crossing can lie in it.
     #[inline]
-    pub fn block_words(&self) -> &[u64] {
-        &self.blocks
-    }
-
-    /// The cells of brick `brick` and its blocks of cells, or `None` where no crossing can lie
-    /// in it.
-    #[inline]
-    pub fn of(&self, brick: u32) -> Option<(&BrickCells, u64)> {
+    pub fn of(&self, brick: u32) -> Option<&BrickCells> {
         match self.slot.get(brick as usize) {
-            Some(&n) if n != NONE => self
-                .cells
-                .get(n as usize)
-                .zip(self.blocks.get(n as usize).copied()),
+            Some(&n) if n != NONE => self.cells.get(n as usize),
             _ => None,
         }
     }
@@ -119,26 +105,6 @@ impl CellMask {
 #[inline]
 pub(crate) fn is_set(cells: &BrickCells, bit: usize) -> bool {
     cells[bit / 64] >> (bit % 64) & 1 == 1
-}
-
-/// The place of the 2×2×2 block holding the cell at `(i, j, k)` (inside its brick) in the
-/// brick's block word: `i/2 + 4 j/2 + 16 k/2`.
-#[inline]
-pub(crate) fn block_bit([i, j, k]: [usize; 3]) -> usize {
-    i / 2 + BRICK_VOX / 2 * (j / 2 + BRICK_VOX / 2 * (k / 2))
-}
-
-/// The blocks of `cells` that hold a set cell.
-fn blocks_of(cells: &BrickCells) -> u64 {
-    let mut blocks = 0;
-    for (k, word) in cells.iter().enumerate() {
-        for place in 0..64 {
-            if word >> place & 1 == 1 {
-                blocks |= 1 << block_bit([place % BRICK_VOX, place / BRICK_VOX, k]);
-            }
-        }
-    }
-    blocks
 }
 
 /// The cells of brick `brick` whose corner range holds `iso`. A cell past the volume's last

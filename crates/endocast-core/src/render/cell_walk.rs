@@ -1,15 +1,15 @@
 //! The exact isosurface search: a cell walk (Amanatides and Woo, over the trilinear cells of the
-//! whole volume) visits the cells along a ray in order, steps over each brick and each 2×2×2
-//! block whose cells cannot hold the isovalue at once (the upper levels of the [`CellMask`]),
-//! skips the cells whose bit is clear, and in each remaining cell solves the trilinear field
-//! along the ray exactly for its first crossing ([`CellCubic`]). No crossing is missed whatever the step, however thin the
+//! whole volume) visits the cells along a ray in order, steps over each brick whose cells cannot
+//! hold the isovalue at once (the brick level of the [`CellMask`]), skips the cells whose bit is
+//! clear, and in each remaining cell solves the trilinear field along the ray exactly for its
+//! first crossing ([`CellCubic`]). No crossing is missed whatever the step, however thin the
 //! feature, and the depth is the trilinear field's own to `f32` precision.
 //!
 //! [`CellDda`] is the walk of one ray; `simd::cells8` walks eight rays at once, one per lane,
 //! operation for operation the same (the same cells, the same distances, the same bits).
 
 use super::bricks::BRICK_VOX;
-use super::cell_mask::{block_bit, is_set, CellMask};
+use super::cell_mask::{is_set, CellMask};
 use super::march::RayMarch;
 use super::sample::SampleGrid;
 use super::trilinear_root::{range_over_box, CellCubic};
@@ -102,16 +102,12 @@ impl CellWalk<'_> {
         let mut dda = self.dda(march);
         let mut side = Side::new(side);
         while dda.running() {
-            let Some((cells, blocks)) = self.cells.of(self.cells.brick_of(dda.cell)) else {
-                dda.leave_block(&line, self.voxels.max_base, BRICK_VOX as i32);
+            let Some(cells) = self.cells.of(self.cells.brick_of(dda.cell)) else {
+                dda.leave_brick(&line, self.voxels.max_base);
                 continue;
             };
-            let [i, j, k] = dda.cell.map(|c| c as usize % BRICK_VOX);
-            if blocks >> block_bit([i, j, k]) & 1 == 0 {
-                dda.leave_block(&line, self.voxels.max_base, 2);
-                continue;
-            }
             let (cell, span) = dda.step(self.voxels.max_base);
+            let [i, j, k] = cell.map(|c| c as usize % BRICK_VOX);
             if is_set(cells, i + BRICK_VOX * (j + BRICK_VOX * k)) {
                 if let Some(hit) = self.in_cell(&line, cell, span, &mut side, &mut stop) {
                     return Some(hit);
@@ -197,8 +193,8 @@ impl CellWalk<'_> {
 }
 
 /// One ray's walk over the trilinear cells of the volume (Amanatides and Woo), in the order the
-/// ray meets them; a brick or a 2×2×2 block at a time where its cells need not be visited
-/// ([`Self::leave_block`]).
+/// ray meets them; a brick at a time where its cells need not be visited
+/// ([`Self::leave_brick`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct CellDda {
     /// The cell the walk is in (its lowest voxel).
@@ -264,10 +260,10 @@ impl CellDda {
         (cell, (t, t_exit))
     }
 
-    /// Leaves the block of `edge`³ cells (a power of two: a brick, or a 2×2×2 block) the walk
-    /// is in at once, through the face the ray meets first: the walk is then in the cell behind
-    /// that face (and ends where that lies past the volume).
-    pub fn leave_block(&mut self, line: &SampleGrid, max_base: [i32; 3], edge: i32) {
+    /// Leaves the brick the walk is in at once, through the face the ray meets first: the walk
+    /// is then in the cell behind that face (and ends where that lies past the volume).
+    pub fn leave_brick(&mut self, line: &SampleGrid, max_base: [i32; 3]) {
+        let edge = BRICK_VOX as i32;
         let first = self.cell.map(|c| c & !(edge - 1));
         let exits: [f32; 3] = std::array::from_fn(|axis| {
             let face = first[axis] + if self.step[axis] > 0 { edge } else { 0 };

@@ -33,12 +33,8 @@ pub(super) fn first_hits8(
     sides: [(bool, bool); 8],
 ) -> [Option<f32>; 8] {
     let mut hits = [None; 8];
-    let (slots, words, blocks) = (
-        walk.cells.slots(),
-        walk.cells.words(),
-        walk.cells.block_words(),
-    );
-    if slots.is_empty() || words.is_empty() || blocks.is_empty() {
+    let (slots, words) = (walk.cells.slots(), walk.cells.words());
+    if slots.is_empty() || words.is_empty() {
         // No brick can hold the isovalue.
         return hits;
     }
@@ -57,9 +53,7 @@ pub(super) fn first_hits8(
         }
         let slot = slot_of(slots, lanes.brick(walk.cells.bricks()), live);
         let empty = _mm256_and_si256(live, _mm256_cmpeq_epi32(slot, all()));
-        let in_brick = _mm256_andnot_si256(empty, live);
-        let busy = _mm256_and_si256(in_brick, in_set_block(blocks, slot, lanes.cell, in_brick));
-        let leaving = _mm256_andnot_si256(busy, live);
+        let busy = _mm256_andnot_si256(empty, live);
         if any(busy) {
             let next = lanes.next_face();
             let flagged = _mm256_and_si256(busy, is_flagged(words, slot, lanes.cell, busy));
@@ -75,14 +69,8 @@ pub(super) fn first_hits8(
             }
             lanes.step(&next, _mm256_andnot_si256(done, busy));
         }
-        if any(leaving) {
-            // Bricks without set cells, and blocks without set cells in the others.
-            let edge = _mm256_blendv_epi8(
-                _mm256_set1_epi32(2),
-                _mm256_set1_epi32(BRICK_VOX as i32),
-                empty,
-            );
-            lanes.leave_block(leaving, edge);
+        if any(empty) {
+            lanes.leave_brick(empty);
         }
     }
 }
@@ -148,32 +136,6 @@ fn is_flagged(words: &[u64], slot: __m256i, cell: [__m256i; 3], on: Mask) -> Mas
         _mm256_srli_epi32::<5>(place),
     );
     let word = _mm256_add_epi32(_mm256_mullo_epi32(slot, per_brick), layer);
-    bit_of(words, word, place, on)
-}
-
-/// Whether each lane's cell lies in a set 2×2×2 block of its brick (whose blocks are at place
-/// `slot` of `blocks`), for the lanes of `on`.
-#[target_feature(enable = "avx2")]
-#[inline]
-fn in_set_block(blocks: &[u64], slot: __m256i, cell: [__m256i; 3], on: Mask) -> Mask {
-    // `block_bit`: i/2 + 4 j/2 + 16 k/2 of the cell inside its brick.
-    let half = cell.map(|c| {
-        let local = _mm256_and_si256(c, _mm256_set1_epi32(BRICK_VOX as i32 - 1));
-        _mm256_srli_epi32::<1>(local)
-    });
-    let place = _mm256_add_epi32(
-        half[0],
-        _mm256_slli_epi32::<2>(_mm256_add_epi32(half[1], _mm256_slli_epi32::<2>(half[2]))),
-    );
-    let word = _mm256_add_epi32(_mm256_slli_epi32::<1>(slot), _mm256_srli_epi32::<5>(place));
-    bit_of(blocks, word, place, on)
-}
-
-/// Bit `place % 32` of 32-bit word `word` of `words` per lane, for the lanes of `on` (the
-/// index clamped to the words).
-#[target_feature(enable = "avx2")]
-#[inline]
-fn bit_of(words: &[u64], word: __m256i, place: __m256i, on: Mask) -> Mask {
     let last = i32::try_from(words.len() * 2 - 1).unwrap_or(i32::MAX);
     let word = _mm256_min_epu32(word, _mm256_set1_epi32(last));
     // SAFETY: every lane's index lies in [0, 2 · words.len() − 1] (unsigned minimum above), and
@@ -296,11 +258,13 @@ impl Walk8 {
         self.t = blend_ps(self.t, t, on);
     }
 
-    /// `CellDda::leave_block` in the lanes of `on`, each lane's block `edge` cells wide.
+    /// `CellDda::leave_brick` in the lanes of `on`.
     #[target_feature(enable = "avx2")]
-    fn leave_block(&mut self, on: Mask, edge: __m256i) {
-        let low_bits = _mm256_sub_epi32(edge, _mm256_set1_epi32(1));
-        let first = self.cell.map(|c| _mm256_andnot_si256(low_bits, c));
+    fn leave_brick(&mut self, on: Mask) {
+        let edge = _mm256_set1_epi32(BRICK_VOX as i32);
+        let first = self
+            .cell
+            .map(|c| _mm256_and_si256(c, _mm256_set1_epi32(!(BRICK_VOX as i32 - 1))));
         let exits: [__m256; 3] = std::array::from_fn(|a| {
             let face = _mm256_add_epi32(first[a], _mm256_and_si256(edge, self.rising[a]));
             self.face_t(a, _mm256_cvtepi32_ps(face))
