@@ -48,7 +48,7 @@ pub struct LookArgs {
     #[arg(long)]
     shade_dvr: bool,
     /// Iso and hybrid: find the surface exactly, cell by cell (no thin feature missed at any
-    /// step; about twice the search's time).
+    /// step; about 1.4× the sampled search's work).
     #[arg(long)]
     exact: bool,
     /// Skip empty bricks (the image is the same either way, only slower without).

@@ -9,12 +9,15 @@ use super::bricks::{Activity, BrickGrid, BRICK_VOX};
 use crate::Volume;
 use rayon::prelude::*;
 
-/// Bricks without a cell mask (no crossing can lie in them) in [`CellMask::slot`].
-const NONE: u32 = u32::MAX;
+/// Bricks without a cell mask (no crossing can lie in them) in [`CellMask::slots`].
+pub(crate) const NONE: u32 = u32::MAX;
 
 /// One brick's cells: word `k` holds the cells of z-layer `k`, bit `i + 8 j` the cell `(i, j)`
 /// (all inside the brick).
 pub(crate) type BrickCells = [u64; BRICK_VOX];
+
+/// `log2(BRICK_VOX)`: a cell's brick is its index shifted right by this.
+pub(crate) const BRICK_SHIFT: u32 = BRICK_VOX.trailing_zeros();
 
 /// The cells of the iso-active bricks whose trilinear field can reach the isovalue.
 #[derive(Debug, Clone, Default)]
@@ -22,12 +25,14 @@ pub(crate) struct CellMask {
     /// Per brick, its entry in `cells`, or [`NONE`].
     slot: Vec<u32>,
     cells: Vec<BrickCells>,
+    /// Bricks per axis.
+    bricks: [i32; 3],
 }
 
 impl CellMask {
     /// The cells of `volume` whose corner range holds `iso` (stored units: some corner below it
     /// and some at or above it), for the bricks set in `activity.iso`; a brick none of whose
-    /// cells holds it gets no entry (the brick walk skips it).
+    /// cells holds it gets no entry (the cell walk leaves it in one jump).
     pub fn new(volume: &Volume, grid: &BrickGrid, activity: &Activity, iso: f32) -> Self {
         let bricks = grid.bricks();
         let found: Vec<(usize, BrickCells)> = (0..grid.len())
@@ -49,7 +54,40 @@ impl CellMask {
             slot[b] = n as u32;
         }
         let cells = found.into_iter().map(|(_, cells)| cells).collect();
-        Self { slot, cells }
+        // Bricks per axis fit `i32`: their product is numbered in `u32` above.
+        let bricks = bricks.map(|n| i32::try_from(n).unwrap_or(i32::MAX));
+        Self {
+            slot,
+            cells,
+            bricks,
+        }
+    }
+
+    /// Bricks per axis.
+    #[inline]
+    pub fn bricks(&self) -> [i32; 3] {
+        self.bricks
+    }
+
+    /// The brick holding cell `cell` (its lowest voxel, inside the volume).
+    #[inline]
+    pub fn brick_of(&self, cell: [i32; 3]) -> u32 {
+        let [i, j, k] = cell.map(|c| c >> BRICK_SHIFT);
+        let [bx, by, _] = self.bricks;
+        // Cells inside the volume lie in bricks of the grid, numbered in `u32`.
+        (i + bx * (j + by * k)) as u32
+    }
+
+    /// Per brick, the place of its cells in [`Self::words`] (in bricks), or [`NONE`].
+    #[inline]
+    pub fn slots(&self) -> &[u32] {
+        &self.slot
+    }
+
+    /// Every brick's cells ([`BrickCells`]) in slot order.
+    #[inline]
+    pub fn words(&self) -> &[u64] {
+        self.cells.as_flattened()
     }
 
     /// The cells of brick `brick`, or `None` where no crossing can lie in it.

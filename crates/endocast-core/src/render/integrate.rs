@@ -156,11 +156,7 @@ impl Integrator<'_> {
             self.search_group(tasks, surface.iso);
             self.refine_group(tasks, surface.iso);
         } else {
-            // The exact search, ray by ray.
-            for task in tasks.iter_mut() {
-                let hit = self.first_hit(&mut task.march, &mut ());
-                task.out.depth_mm = hit.unwrap_or(f32::NAN);
-            }
+            self.exact_group(tasks, volume_behind);
         }
         if !shade && !volume_behind {
             return;
@@ -202,6 +198,35 @@ impl Integrator<'_> {
         }
         for task in tasks.iter_mut() {
             task.bracket = self.search(&mut task.march, iso, &mut ());
+        }
+    }
+
+    /// [`Self::first_hit`] by the cell walk for each ray of a group, into its depth, eight at once
+    /// on AVX2 ([`super::simd::Avx2::first_hits8`]); the marches are left for the volume behind
+    /// the hits only where `volume_behind`.
+    fn exact_group(&self, tasks: &mut [RayTask], volume_behind: bool) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx2) = self.sampler.avx2() {
+            let walk = self.cell_walk();
+            let iso = self.params.lower.iso;
+            for chunk in tasks.chunks_mut(8) {
+                let mut sides = [(true, true); 8];
+                for (side, task) in sides.iter_mut().zip(chunk.iter()) {
+                    *side = self.side(&task.march, iso);
+                }
+                let hits = avx2.first_hits8(&walk, chunk, sides);
+                for (task, hit) in chunk.iter_mut().zip(hits) {
+                    task.out.depth_mm = hit.unwrap_or(f32::NAN);
+                    if let (Some(t), true) = (hit, volume_behind) {
+                        task.march.found_at(t);
+                    }
+                }
+            }
+            return;
+        }
+        for task in tasks.iter_mut() {
+            let hit = self.first_hit(&mut task.march, &mut ());
+            task.out.depth_mm = hit.unwrap_or(f32::NAN);
         }
     }
 

@@ -261,31 +261,22 @@ impl RayMarch {
         self.stats = stats;
     }
 
-    /// Hands the bricks, in order, to an exact search ([`super::cell_walk`]): `active(brick)`
-    /// gives what the search reads of a brick (`None`: nothing can be found there, skipped) and
-    /// `visit` searches the brick's segment with it, until it returns a hit (mm). The march is
-    /// then left as a search walk leaves it: the brick of the hit pending, its next sample the
-    /// first at or past the hit. For a march not yet walked.
-    pub(crate) fn find<T>(
-        &mut self,
-        mut active: impl FnMut(u32) -> Option<T>,
-        mut visit: impl FnMut(Segment, T) -> Option<f32>,
-    ) -> Option<f32> {
+    /// Leaves a march not yet walked as a search walk leaves it after a crossing at `t` mm found
+    /// outside it (the exact search, [`super::cell_walk`]): the brick walk past the brick holding
+    /// `t`, that brick pending, the next sample the first at or past `t`. The bricks before it
+    /// count as skipped (no sample was taken in them).
+    pub(crate) fn found_at(&mut self, t: f32) {
         debug_assert!(self.pending.is_none());
-        while let Some(segment) = self.dda.next() {
-            let Some(found) = active(segment.brick) else {
-                self.stats.bricks_skipped += 1;
-                continue;
-            };
-            self.stats.bricks_visited += 1;
-            if let Some(t) = visit(segment, found) {
-                self.next = self.next.max(self.index_at(t));
-                self.has_previous = false;
+        for segment in self.dda.by_ref() {
+            if segment.t1 > t {
+                self.stats.bricks_visited += 1;
                 self.pending = Some(segment);
-                return Some(t);
+                break;
             }
+            self.stats.bricks_skipped += 1;
         }
-        None
+        self.next = self.next.max(self.index_at(t));
+        self.has_previous = false;
     }
 
     /// Samples, in order, the bricks for which `active(brick)` holds, handing each sample to

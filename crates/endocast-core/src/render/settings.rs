@@ -216,8 +216,9 @@ pub struct RenderSettings {
     /// [`Mode::Iso`] and [`Mode::Hybrid`]: find the surface exactly instead of by samples and
     /// bisection — a walk over the trilinear cells that can hold the isovalue, each solved for
     /// its crossing (Marmitt et al. 2004), so that no feature thinner than a step is missed and
-    /// the depth is the trilinear field's own (`refine_steps` then does not apply). About twice
-    /// the search's time on the colon phantom (BENCHMARKS.md). Disabled by default.
+    /// the depth is the trilinear field's own (`refine_steps` then does not apply). About 1.4×
+    /// the sampled search's frame instructions on the colon phantom and a chest CT
+    /// (BENCHMARKS.md). Disabled by default.
     pub exact_hits: bool,
     /// Material and light weights. Default the VTK peer's.
     pub lighting: Lighting,

@@ -157,6 +157,26 @@ impl CellCubic {
     }
 }
 
+/// The least and greatest value of the trilinear field of the cell with corners `[low, high]`
+/// (ordered as [`CellCubic::new`] takes them) over the axis-aligned box with opposite corners
+/// `a` and `b` (cell-local): the field is linear along each axis, so they are among the box's
+/// eight corners. A ray segment from `a` to `b` lies in that box.
+pub(crate) fn range_over_box([low, high]: [Vec4; 2], a: Vec3, b: Vec3) -> (f32, f32) {
+    let along_x = |x: f32| low + (high - low) * x;
+    let (mut least, mut greatest) = (f32::INFINITY, f32::NEG_INFINITY);
+    for e in [along_x(a.x), along_x(b.x)] {
+        // The edges along y at z = 0 and z = 1, at y = a.y and y = b.y.
+        let (y0, y1) = (Vec4::new(e.x, e.z, e.x, e.z), Vec4::new(e.y, e.w, e.y, e.w));
+        let r = y0 + (y1 - y0) * Vec4::new(a.y, a.y, b.y, b.y);
+        // Along z at z = a.z and z = b.z.
+        let (z0, z1) = (Vec4::new(r.x, r.x, r.z, r.z), Vec4::new(r.y, r.y, r.w, r.w));
+        let v = z0 + (z1 - z0) * Vec4::new(a.z, b.z, a.z, b.z);
+        least = least.min(v.min_element());
+        greatest = greatest.max(v.max_element());
+    }
+    (least, greatest)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,6 +213,31 @@ mod tests {
                 let expected = trilinear(cell, p);
                 assert!((cubic.at(s) - expected).abs() < 1e-3, "{seed} {s}");
             }
+        }
+    }
+
+    #[test]
+    fn the_box_range_holds_the_field_inside_the_box_and_reaches_its_ends() {
+        for seed in 0..100 {
+            let cell = corners(seed);
+            let a = Vec3::new(0.1, 0.8, 0.3);
+            let b = Vec3::new(0.6, 0.2 + seed as f32 * 5e-3, 0.9);
+            let (least, greatest) = range_over_box(cell, a, b);
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for n in 0..27 {
+                let f = [n % 3, n / 3 % 3, n / 9].map(|i| f64::from(i as u8) / 2.0);
+                let p: [f64; 3] = std::array::from_fn(|k| {
+                    f64::from(a[k]) + (f64::from(b[k]) - f64::from(a[k])) * f[k]
+                });
+                let v = trilinear(cell, p);
+                (lo, hi) = (lo.min(v), hi.max(v));
+            }
+            // Inside, and its corners are where the extremes lie.
+            assert!((f64::from(least) - lo).abs() < 1e-2, "{seed}: {least} {lo}");
+            assert!(
+                (f64::from(greatest) - hi).abs() < 1e-2,
+                "{seed}: {greatest} {hi}"
+            );
         }
     }
 

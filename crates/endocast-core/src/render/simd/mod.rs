@@ -6,6 +6,7 @@
 //! tests compare both paths lane by lane.
 //!
 //! - [`rays4`]: ray set-up for four pixels of a row (AVX2, `f64`);
+//! - `cells8`: the exact isosurface search (the cell walk) for eight rays, one per lane (AVX2);
 //! - [`packet`]: the isosurface search and its refinement for eight rays, one per lane (AVX2);
 //! - [`sample`]: eight trilinear samples by gathers (AVX2);
 //! - [`sse`]: small SSE/SSE2 batches on eight values (crossing sides, transfer-table lookups)
@@ -32,6 +33,8 @@
 #![allow(unsafe_code)]
 
 #[cfg(target_arch = "x86_64")]
+mod cells8;
+#[cfg(target_arch = "x86_64")]
 pub(super) mod packet;
 #[cfg(target_arch = "x86_64")]
 pub(super) mod rays4;
@@ -42,6 +45,7 @@ mod unchecked;
 
 #[cfg(target_arch = "x86_64")]
 use super::{
+    cell_walk::CellWalk,
     ray_task::{Bracket, RayTask},
     voxel_grid::{Lanes, SampleGrid, VoxelGrid},
 };
@@ -118,6 +122,19 @@ impl Avx2 {
     ) -> [Option<Bracket>; 8] {
         // SAFETY: the token exists, so the CPU has AVX2.
         unsafe { packet::search8(sampler, active, iso, tasks, rising) }
+    }
+
+    /// [`cells8::first_hits8`]: the exact first crossings of up to eight rays, each from its
+    /// side `(rising, before)`.
+    #[inline]
+    pub(crate) fn first_hits8(
+        self,
+        walk: &CellWalk<'_>,
+        tasks: &[RayTask],
+        sides: [(bool, bool); 8],
+    ) -> [Option<f32>; 8] {
+        // SAFETY: the token exists, so the CPU has AVX2.
+        unsafe { cells8::first_hits8(walk, tasks, sides) }
     }
 
     /// [`packet::refine8`]: `steps` bisection steps of up to eight rays' brackets.

@@ -29,7 +29,7 @@ use std::arch::x86_64::{
 };
 
 /// A lane mask: all bits set in a lane that is on.
-type Mask = __m256i;
+pub(super) type Mask = __m256i;
 
 /// The first crossings of `iso` of up to eight rays whose marches have not been walked yet, as
 /// [`crate::render::integrate::Integrator::search`] finds them one ray at a time.
@@ -506,28 +506,28 @@ fn along(origin: __m256, direction: __m256, t: __m256) -> __m256 {
 /// `b` in the lanes of `on`, else `a`.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn blend_ps(a: __m256, b: __m256, on: Mask) -> __m256 {
+pub(super) fn blend_ps(a: __m256, b: __m256, on: Mask) -> __m256 {
     _mm256_blendv_ps(a, b, _mm256_castsi256_ps(on))
 }
 
 /// Whether any lane of `m` is on.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn any(m: Mask) -> bool {
+pub(super) fn any(m: Mask) -> bool {
     _mm256_movemask_ps(_mm256_castsi256_ps(m)) != 0
 }
 
 /// The lanes `k` for which `on(k)` holds.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn mask(on: impl Fn(usize) -> bool) -> Mask {
+pub(super) fn mask(on: impl Fn(usize) -> bool) -> Mask {
     lanes_i32_from(std::array::from_fn(|k| -i32::from(on(k))))
 }
 
 /// The lanes of `m` as bits.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn bits(m: Mask) -> u32 {
+pub(super) fn bits(m: Mask) -> u32 {
     _mm256_movemask_ps(_mm256_castsi256_ps(m)) as u32
 }
 
@@ -550,7 +550,7 @@ fn columns<T: Copy + Default, const N: usize>(
 /// Eight floats as lanes.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn lanes_f32_from(lanes: [f32; 8]) -> __m256 {
+pub(super) fn lanes_f32_from(lanes: [f32; 8]) -> __m256 {
     // SAFETY: eight f32 are read from an array of eight.
     unsafe { _mm256_loadu_ps(lanes.as_ptr()) }
 }
@@ -558,7 +558,7 @@ fn lanes_f32_from(lanes: [f32; 8]) -> __m256 {
 /// Eight integers as lanes.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn lanes_i32_from(lanes: [i32; 8]) -> __m256i {
+pub(super) fn lanes_i32_from(lanes: [i32; 8]) -> __m256i {
     // SAFETY: 32 bytes are read from an array of 32 bytes.
     unsafe { _mm256_loadu_si256(lanes.as_ptr().cast()) }
 }
@@ -566,7 +566,7 @@ fn lanes_i32_from(lanes: [i32; 8]) -> __m256i {
 /// The lanes of `v`.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn floats(v: __m256) -> [f32; 8] {
+pub(super) fn floats(v: __m256) -> [f32; 8] {
     let mut lanes = [0.0f32; 8];
     // SAFETY: eight f32 are written to an array of eight.
     unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), v) };
@@ -576,7 +576,7 @@ fn floats(v: __m256) -> [f32; 8] {
 /// The lanes of `v`.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn ints(v: __m256i) -> [i32; 8] {
+pub(super) fn ints(v: __m256i) -> [i32; 8] {
     let mut lanes = [0i32; 8];
     // SAFETY: 32 bytes are written to an array of 32 bytes.
     unsafe { _mm256_storeu_si256(lanes.as_mut_ptr().cast(), v) };
