@@ -51,6 +51,15 @@ pub struct LookArgs {
     /// step; about 1.4× the sampled search's work).
     #[arg(long)]
     exact: bool,
+    /// DVR and the volume behind a surface: classify each segment between samples as a whole
+    /// (pre-integrated, Engel et al. 2001) instead of each sample by its value (default: true
+    /// when --dvr-stride is above 1, else the preset's).
+    #[arg(long, action = clap::ArgAction::Set, value_name = "true|false")]
+    preintegrate: Option<bool>,
+    /// DVR and the volume behind a surface: composite every N-th sample of the step grid, each
+    /// segment pre-integrated (1–16; the isosurface search keeps --step).
+    #[arg(long, value_name = "N")]
+    dvr_stride: Option<u32>,
     /// Skip empty bricks (the image is the same either way, only slower without).
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "true|false")]
     skip_empty: bool,
@@ -122,6 +131,17 @@ impl LookArgs {
         };
         let mut s = options.apply(s).map_err(flag_error)?;
         s.exact_hits |= self.exact;
+        if let Some(stride) = self.dvr_stride {
+            s.dvr_stride = stride;
+            s.preintegrated |= stride > 1;
+        }
+        if let Some(preintegrate) = self.preintegrate {
+            s.preintegrated = preintegrate;
+            if !preintegrate && self.dvr_stride.is_none() {
+                s.dvr_stride = 1;
+            }
+        }
+        s.validate()?;
         Ok(s)
     }
 }

@@ -191,6 +191,25 @@ impl RayMarch {
         self.end = self.index_at(self.dda.t_end).max(0);
     }
 
+    /// Keeps only every `stride`-th sample of a grid from here on (a grid `stride` times
+    /// coarser): from `from` mm when given, a point taken (the new grid's sample 0: the next
+    /// walk goes on from it, not fresh), else from the first sample not yet taken, the one
+    /// before forgotten (the next walk's first sample is fresh). Pre-integrated compositing.
+    pub(crate) fn every(&mut self, stride: u32, from: Option<f32>) {
+        let grid = &mut self.grid;
+        grid.t_start = from.unwrap_or_else(|| grid.t_of(self.next));
+        grid.offset = 0.0;
+        grid.step *= stride as f32;
+        self.next = i32::from(from.is_some());
+        self.has_previous = from.is_some();
+        self.end = self.index_at(self.dda.t_end).max(self.next);
+    }
+
+    /// The first sample index not yet taken.
+    pub(crate) fn next_index(&self) -> i32 {
+        self.next
+    }
+
     /// The part of this march's ray from `t0` to `t1` mm (samples `t0 ≤ t_n < t1` of the same
     /// grid, none this march has taken), to walk next: a ray split at a translucent surface
     /// walks its parts in turn (`scene_pass`). The part starts one sample before `t0` where
@@ -368,9 +387,9 @@ impl RayMarch {
                     self.stats.samples += samples + stopped.taken as u64;
                     if long {
                         self.end = (batch + stopped.taken as i32).min(self.end);
-                    } else {
-                        self.pending = Some(run.segment);
                     }
+                    // Where the walk may go on after all (a coarser grid, `every`).
+                    self.pending = Some(run.segment);
                     return true;
                 }
                 samples += count as u64;

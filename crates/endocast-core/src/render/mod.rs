@@ -51,6 +51,7 @@ mod frame;
 mod integrate;
 mod march;
 mod options;
+mod preintegrate;
 pub mod progressive;
 pub mod quality;
 mod ray_task;
@@ -76,6 +77,8 @@ mod exact_tests;
 mod interactive_tests;
 #[cfg(test)]
 mod peel_tests;
+#[cfg(test)]
+mod preintegrate_tests;
 #[cfg(test)]
 mod scene_tests;
 #[cfg(test)]
@@ -268,6 +271,7 @@ impl Derived {
             refine_steps: settings.refine_steps,
             exact_hits: settings.exact_hits,
             shade_dvr: settings.shade_dvr,
+            dvr_stride: settings.preintegrated.then_some(settings.dvr_stride),
             skip_empty: settings.skip_empty,
             peel: PeelParams {
                 nth: match settings.peel.layer {

@@ -6,6 +6,7 @@
 //! size and on any voxel spacing; [`TfTable`] corrects it for the actual step:
 //! α' = 1 − (1 − α)^(Δs / Δs₀).
 
+use super::preintegrate::SegmentTable;
 use super::simd::sse;
 use crate::ValueMap;
 use glam::Vec4;
@@ -311,6 +312,8 @@ pub struct TfTable {
     colors: Vec<[f32; 3]>,
     /// `opaque_before[i]` = number of entries below `i` with non-zero opacity.
     opaque_before: Vec<u32>,
+    /// The same transfer function for whole segments between samples (pre-integrated).
+    segments: SegmentTable,
 }
 
 impl TfTable {
@@ -327,11 +330,16 @@ impl TfTable {
             stored_range.0.max(stored_range.1),
         );
         let exponent = step_mm / OPACITY_UNIT_MM;
-        let (mut entries, colors): (Vec<Vec4>, Vec<[f32; 3]>) = (lo..=hi)
+        let points: Vec<(f32, [f32; 3])> = (lo..=hi)
             .map(|stored| {
                 let value = value_map.physical(stored);
-                let alpha = corrected_opacity(tf.opacity_at(value), exponent);
-                let [r, g, b] = tf.color_at(value);
+                (tf.opacity_at(value), tf.color_at(value))
+            })
+            .collect();
+        let (mut entries, colors): (Vec<Vec4>, Vec<[f32; 3]>) = points
+            .iter()
+            .map(|&(alpha, [r, g, b])| {
+                let alpha = corrected_opacity(alpha, exponent);
                 (Vec4::new(r * alpha, g * alpha, b * alpha, alpha), [r, g, b])
             })
             .unzip();
@@ -341,6 +349,7 @@ impl TfTable {
             entries,
             colors,
             opaque_before: Vec::new(),
+            segments: SegmentTable::new(lo, points.into_iter()),
         };
         table.count_opaque();
         table
@@ -369,6 +378,7 @@ impl TfTable {
         let last = self.colors.len() - 1;
         self.entries[last + 1] = self.entries[last];
         self.count_opaque();
+        self.segments.make_transparent_between(lo, hi);
     }
 
     /// True when some stored value in `[stored_lo, stored_hi]` has non-zero opacity. One stored
@@ -410,6 +420,24 @@ impl TfTable {
     pub fn lookup8(&self, values: &[f32; 8]) -> [Vec4; 8] {
         let top = self.colors.len() - 1;
         sse::lookup8(&self.entries, f32::from(self.first), top, values)
+    }
+
+    /// Premultiplied colour and opacity of a ray segment `length_mm` long whose stored value
+    /// runs linearly from `front` to `back`, pre-integrated ([`super::preintegrate`]).
+    #[inline(always)]
+    pub(crate) fn segment(&self, front: f32, back: f32, length_mm: f32) -> Vec4 {
+        self.segments.segment(front, back, length_mm)
+    }
+
+    /// [`Self::segment`] of eight segments at once: the same bits as one at a time.
+    #[inline(always)]
+    pub(crate) fn segments8(
+        &self,
+        fronts: &[f32; 8],
+        backs: &[f32; 8],
+        length_mm: f32,
+    ) -> [Vec4; 8] {
+        self.segments.segments8(fronts, backs, length_mm)
     }
 
     /// Plain colour at a continuous stored value (for maximum/minimum intensity projections).

@@ -91,7 +91,9 @@ impl Integrator<'_> {
         let lit = self.surface(march.grid().at(out.depth_mm), surface.color, dir_world);
         out.accum.under_surface(lit, surface.opacity);
         let shade = self.params.shade_dvr;
-        self.composite_with(self.after, march, &mut out, (dir_world, shade), probe);
+        let front = Some((out.depth_mm, surface.iso));
+        let ray = (dir_world, shade);
+        self.composite_with(self.after, march, &mut out, ray, front, probe);
         out
     }
 
