@@ -36,7 +36,7 @@
 use super::frame::{Frame, Layers};
 use super::options::{Cancelled, Progress, Quality, RenderOptions};
 use super::still::Still;
-use super::{Camera, FrameReuse, Prepared};
+use super::{Camera, Prepared};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
 
@@ -84,40 +84,6 @@ pub fn progressive(
     generation: &AtomicU64,
     seen: u64,
     options: &ProgressiveOptions,
-    deliver: impl FnMut(Stage, &Frame),
-) -> Result<(), Cancelled> {
-    let watched = (generation, seen);
-    levels(prepared, camera, watched, options, None, deliver)
-}
-
-/// [`progressive`] with its full frame rendered by [`Prepared::render_reusing_with`]: its
-/// searches bounded by the last full frame `reuse` kept (a view that moved a little), the same
-/// images, and the full frame kept in `reuse` for the next view.
-pub fn progressive_reusing(
-    prepared: &Prepared,
-    camera: &Camera,
-    (generation, seen): (&AtomicU64, u64),
-    options: &ProgressiveOptions,
-    reuse: &mut FrameReuse,
-    deliver: impl FnMut(Stage, &Frame),
-) -> Result<(), Cancelled> {
-    levels(
-        prepared,
-        camera,
-        (generation, seen),
-        options,
-        Some(reuse),
-        deliver,
-    )
-}
-
-/// The levels of [`progressive`], the full frame with `reuse` where given.
-fn levels(
-    prepared: &Prepared,
-    camera: &Camera,
-    (generation, seen): (&AtomicU64, u64),
-    options: &ProgressiveOptions,
-    reuse: Option<&mut FrameReuse>,
     mut deliver: impl FnMut(Stage, &Frame),
 ) -> Result<(), Cancelled> {
     let cancel = AtomicBool::new(false);
@@ -139,10 +105,7 @@ fn levels(
         deliver(Stage::Preview(quality), &frame);
     }
     check()?;
-    match reuse {
-        Some(reuse) => prepared.render_reusing_with(camera, &base, reuse, &mut frame)?,
-        None => prepared.render_with(camera, &base, &mut frame)?,
-    }
+    prepared.render_with(camera, &base, &mut frame)?;
     deliver(Stage::Full, &frame);
     let mut still = Still::new();
     still.add(&frame);

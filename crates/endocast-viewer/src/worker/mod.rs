@@ -14,12 +14,10 @@ mod look_frames;
 
 use endocast_core::camera::StereoRig;
 use endocast_core::look::Look;
-use endocast_core::render::progressive::{
-    progressive_reusing, PreviewPlanner, ProgressiveOptions, Stage,
-};
+use endocast_core::render::progressive::{progressive, PreviewPlanner, ProgressiveOptions, Stage};
 use endocast_core::render::{
-    Camera, Cancelled, Frame, FrameReuse, Layers, Prepared, Progress, Quality, RenderOptions,
-    RenderSettings, Renderer,
+    Camera, Cancelled, Frame, Layers, Prepared, Progress, Quality, RenderOptions, RenderSettings,
+    Renderer,
 };
 use endocast_core::views::stereo::{combine, StereoOutput};
 use endocast_core::views::Image;
@@ -224,8 +222,6 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
     let mut prepared: Option<Prepared> = None;
     let mut scene = SceneRef::default();
     let mut planner = PreviewPlanner::default();
-    // The last full frame: it bounds the searches of the next view's full frame.
-    let mut reuse = FrameReuse::new();
     let mut look_pass = LookPass::default();
     while let Some(request) = next_request(shared) {
         if let Some(look) = &request.view.look {
@@ -258,7 +254,7 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
         }
         if let Some(p) = &prepared {
             // A superseded frame simply ends; the next request is already waiting.
-            let _ = render_request(shared, p, &request, (&mut planner, &mut reuse));
+            let _ = render_request(shared, p, &request, &mut planner);
         }
     }
 }
@@ -304,13 +300,11 @@ fn deliverer<'a>(
     }
 }
 
-/// Renders `request` level by level (one eye's full frame with `reuse`, see
-/// [`progressive_reusing`]), the previews planned by `planner`.
 fn render_request(
     shared: &Shared,
     prepared: &Prepared,
     request: &Request,
-    (planner, reuse): (&mut PreviewPlanner, &mut FrameReuse),
+    planner: &mut PreviewPlanner,
 ) -> Result<(), Cancelled> {
     let view = &request.view;
     let deliver = deliverer(shared, request);
@@ -326,12 +320,12 @@ fn render_request(
                 still_frames: if view.moving { 1 } else { STILL_FRAMES },
                 layers: Layers::NONE,
             };
-            progressive_reusing(
+            progressive(
                 prepared,
                 &view.camera,
-                (&shared.generation, request.generation),
+                &shared.generation,
+                request.generation,
                 &options,
-                reuse,
                 |stage, frame| {
                     planner.observe(stage, frame);
                     if let Ok(image) = Image::from_frame(frame, background) {
