@@ -8,8 +8,7 @@ use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
 use crate::look::{shade_with_scene, Look, RayPass};
 use crate::render::{
-    Camera, Frame, FrameReuse, Prepared, Quality, RenderSettings, RenderStats, Renderer,
-    StereoFrames,
+    Camera, Frame, Prepared, Quality, RenderSettings, RenderStats, Renderer, StereoFrames,
 };
 use crate::scene::Scene;
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
@@ -84,8 +83,6 @@ pub struct Flight {
     /// The frames rendered into (the second for a stereo pair's right eye), their buffers
     /// reused from shot to shot.
     frames: StereoFrames,
-    /// The previous one-eye frame's depths, which bound the next frame's searches.
-    reuse: FrameReuse,
     /// The clinical or realistic look of the endoscope frames, if any.
     look: Option<Look>,
     /// The look's ray pass and the settings it was made for.
@@ -105,7 +102,6 @@ impl Flight {
             scene: None,
             marks: None,
             frames: StereoFrames::default(),
-            reuse: FrameReuse::new(),
             look: None,
             look_pass: None,
         }
@@ -251,10 +247,7 @@ impl Flight {
                         self.frames.eyes[0] =
                             shade_with_scene(&gbuffer, &camera, &look.shading, scene)?;
                     }
-                    None => {
-                        let frame = &mut self.frames.eyes[0];
-                        prepared.render_reusing(&camera, &mut self.reuse, frame);
-                    }
+                    None => prepared.render_into(&camera, &mut self.frames.eyes[0]),
                 }
                 (camera, None)
             }
