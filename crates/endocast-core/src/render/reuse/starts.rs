@@ -80,14 +80,14 @@ impl Reprojection<'_> {
     fn extend(&self, dir: DVec3, mut t: f64, min_gain: f64) -> f64 {
         let p = &self.camera.rays;
         let (a, b, c) = (dir.dot(p.right), dir.dot(p.up), dir.dot(p.forward));
-        if !(c > 1e-6) {
+        if c.is_nan() || c <= 1e-6 {
             return t;
         }
         let far = self.pixel(a / c, b / c);
         let m = self.moved;
         for _ in 0..ROUNDS {
             let z = m.z + t * c;
-            if !(z > 0.0) {
+            if z.is_nan() || z <= 0.0 {
                 break;
             }
             let near = self.pixel((m.x + t * a) / z, (m.y + t * b) / z);
@@ -95,7 +95,7 @@ impl Reprojection<'_> {
                 break;
             };
             let s = (f64::from(self.depths.min_in(xs, ys)) - m.z) / c;
-            if !(s > t + min_gain) {
+            if s.is_nan() || s <= t + min_gain {
                 break;
             }
             t = s;

@@ -138,7 +138,7 @@ fn turns_jumps_and_structures_entering_the_view_give_the_same_frames() {
         DVec3::new(a.sin(), 0.0, a.cos())
     };
     let mut cameras: Vec<Camera> = (0..5)
-        .map(|k| look(eye, turn(-20.0 + 12.0 * k as f64)))
+        .map(|k| look(eye, turn(-20.0 + 12.0 * f64::from(k))))
         .collect();
     cameras.push(look(eye, turn(110.0)));
     cameras.push(look(eye + DVec3::new(0.0, 0.0, 12.0), DVec3::Z));
