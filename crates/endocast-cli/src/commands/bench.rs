@@ -18,8 +18,8 @@ use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{
-    Camera, Frame, Layers, Mode, PeelLayer, Prepared, Quality, RenderOptions, RenderSettings,
-    Renderer, StereoFrames,
+    Camera, Frame, FrameReuse, Layers, Mode, PeelLayer, Prepared, Quality, RenderOptions,
+    RenderSettings, Renderer, StereoFrames,
 };
 use endocast_core::scene::Scene;
 use endocast_core::Volume;
@@ -69,6 +69,11 @@ pub struct BenchArgs {
     /// the pair's cost against one eye's.
     #[command(flatten)]
     stereo: StereoArgs,
+    /// Also render each camera with frame-to-frame reuse (its searches bounded by the previous
+    /// camera's depths: the same images), interleaved with the plain frames, and report the
+    /// reused frame's time over the plain one's.
+    #[arg(long)]
+    reuse: bool,
     /// Print one JSON line per measured setting instead of the table.
     #[arg(long)]
     json: bool,
@@ -195,6 +200,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 "with geometry ÷ without",
                 "scene_over_without",
             ),
+            (
+                timed.reused,
+                "with frame-to-frame reuse",
+                "reused ÷ plain",
+                "reused_over_plain",
+            ),
         ];
         for (paired, suffix, label, key) in against {
             let Some((measured, mut ratios)) = paired else {
@@ -218,17 +229,21 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 }
 
 /// The timings of one setting along the path: one eye, and where asked for, each camera as a
-/// stereo pair (with the per-frame ratio of a pair's time to one eye's) and without the
-/// geometry (with the per-frame ratio of one eye's time, geometry included, to that).
+/// stereo pair (with the per-frame ratio of a pair's time to one eye's), without the
+/// geometry (with the per-frame ratio of one eye's time, geometry included, to that) and with
+/// frame-to-frame reuse (with the per-frame ratio of its time to the plain frame's).
 struct Timed {
     mono: Result<Measured>,
     pair: Option<(Measured, Vec<f64>)>,
     plain: Option<(Measured, Vec<f64>)>,
+    reused: Option<(Measured, Vec<f64>)>,
 }
 
 /// Renders every camera with `prepared` (one eye); with `plain` (the same settings without
 /// the geometry) also without it, just before or after in turn (so that neither profits from
-/// the caches the other warmed); with `--stereo` also as a stereo pair right after it. The
+/// the caches the other warmed); with `--reuse` also with frame-to-frame reuse (whose state sees
+/// only its own frames), before or after the plain frame in turn; with `--stereo` also as a
+/// stereo pair right after it. The
 /// pairs' timings are the whole [`Prepared::render_stereo_into`], from the pair's shared
 /// start-up to its second eye.
 fn measure(
@@ -241,6 +256,8 @@ fn measure(
     let paired = || (Measured::default(), Vec::new());
     let mut pair = args.stereo.stereo.map(|_| paired());
     let mut without = plain.map(|_| paired());
+    let mut reused = args.reuse.then(paired);
+    let mut reuse = (FrameReuse::new(), Frame::default());
     let mut pair_frames = StereoFrames::default();
     let mut render = |prepared: &Prepared, camera, measured: &mut Measured| {
         // Nothing cancels it.
@@ -251,7 +268,12 @@ fn measure(
         ms
     };
     for (k, camera) in cameras.iter().enumerate() {
-        let (mut one_ms, mut plain_ms) = (f64::NAN, f64::NAN);
+        let (mut one_ms, mut plain_ms, mut reused_ms) = (f64::NAN, f64::NAN, f64::NAN);
+        // Every other camera with reuse first.
+        let reuse_first = k % 2 == 1;
+        if let (true, Some((measured, _))) = (reuse_first, &mut reused) {
+            reused_ms = render_reusing(prepared, camera, options, &mut reuse, measured);
+        }
         // Every other camera without the geometry first.
         for with_scene in [k % 2 == 0, k % 2 == 1] {
             if with_scene {
@@ -263,6 +285,12 @@ fn measure(
         if let Some((_, ratios)) = &mut without {
             ratios.push(one_ms / plain_ms);
         }
+        if let Some((measured, ratios)) = &mut reused {
+            if !reuse_first {
+                reused_ms = render_reusing(prepared, camera, options, &mut reuse, measured);
+            }
+            ratios.push(reused_ms / one_ms);
+        }
         let Some((pair, ratios)) = &mut pair else {
             continue;
         };
@@ -271,6 +299,7 @@ fn measure(
             mono: Err(error),
             pair: None,
             plain: None,
+            reused: None,
         };
         let rig = match StereoRig::for_view(args.stereo.eye_separation, args.stereo.focus, nearest)
         {
@@ -293,7 +322,25 @@ fn measure(
         mono: Ok(mono),
         pair,
         plain: without,
+        reused,
     }
+}
+
+/// Renders `camera` with `prepared` and the reuse state and frame of `reuse`, adds its time
+/// and samples to `measured` and returns its time (ms).
+fn render_reusing(
+    prepared: &Prepared,
+    camera: &Camera,
+    options: &RenderOptions<'_>,
+    (reuse, frame): &mut (FrameReuse, Frame),
+    measured: &mut Measured,
+) -> f64 {
+    // Nothing cancels it.
+    let _ = prepared.render_reusing_with(camera, options, reuse, frame);
+    let ms = frame.stats.time.as_secs_f64() * 1e3;
+    measured.ms.push(ms);
+    measured.samples += frame.stats.samples;
+    ms
 }
 
 /// The timings of a look along the path: whole frames, their deferred stage alone, and with

@@ -55,6 +55,7 @@ mod preintegrate;
 pub mod progressive;
 pub mod quality;
 mod ray_task;
+mod reuse;
 mod sample;
 mod scene_pass;
 mod settings;
@@ -94,6 +95,7 @@ use cell_mask::CellMask;
 pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
 pub use options::{Cancelled, Progress, Quality, RenderOptions};
 pub use progressive::{progressive, PreviewPlanner};
+pub use reuse::FrameReuse;
 pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
 pub use settings::{
     Crossing, Mode, PeelLayer, PeelSettings, RenderSettings, SettingsError, Unpeeled,

@@ -30,6 +30,8 @@
 mod clear;
 mod starts;
 
+pub(super) use starts::forward_depths as forward_depths_f32;
+
 #[cfg(target_arch = "x86_64")]
 use super::simd::rays4::LateStarts;
 use super::{Frame, Mode, Prepared, RenderOptions, BRICK_VOX};
@@ -90,6 +92,24 @@ impl SearchStarts {
             clear: self.clear.1,
             step,
         }
+    }
+
+    /// Starts for an image `width` pixels wide, every pixel's set by `fill` (over the rows in
+    /// parallel: the row's index and its `[check, start]`, NaN where the search starts at the
+    /// eye), and the clear ball `clear` around the eye.
+    pub(super) fn fill_rows(
+        &mut self,
+        [width, height]: [usize; 2],
+        clear: (Vec3, f32),
+        fill: impl Fn(usize, &mut [[f32; 2]]) + Sync,
+    ) {
+        self.clear = clear;
+        self.width = width;
+        self.starts.resize(width * height, [f32::NAN; 2]);
+        self.starts
+            .par_chunks_mut(width)
+            .enumerate()
+            .for_each(|(y, row)| fill(y, row));
     }
 
     /// The check distance and the start of pixel `(x, y)`, if it has a start past the eye.
@@ -191,29 +211,35 @@ impl Prepared {
 
     /// Whether the right eye's searches may start from the left eye's emptiness.
     fn shares_emptiness(&self, left: &Camera, right: &Camera) -> bool {
-        let pinhole = |c: &Camera| c.projection() == Projection::Pinhole && c.lens().is_ideal();
-        let integrator = self.integrator(left);
-        // The exact search walks cells, not samples: it has no samples to start late.
+        [left, right].into_iter().all(|c| self.eye_starts_late(c))
+    }
+
+    /// Whether `camera`'s isosurface searches may start late, past space shown to be empty: the
+    /// mode walks samples from the eye up to the surface (iso and hybrid; the exact search
+    /// walks cells, not samples, and has no samples to start late), the camera is a pinhole
+    /// with an ideal lens and no near plane, and its eye lies inside the volume on the side of
+    /// the isovalue its searches start from.
+    pub(super) fn eye_starts_late(&self, camera: &Camera) -> bool {
+        let integrator = self.integrator(camera);
         let surface_first = matches!(self.settings.mode, Mode::Iso | Mode::Hybrid);
+        let pinhole = camera.projection() == Projection::Pinhole && camera.lens().is_ideal();
         let sampled = surface_first && integrator.sampled_hits();
-        if !(sampled && pinhole(left) && left.near_mm() == 0.0) {
+        let Some(eye) = camera
+            .shared_origin()
+            .filter(|_| sampled && pinhole && camera.near_mm() == 0.0)
+        else {
             return false;
-        }
+        };
         let iso = self.params.lower.iso;
         let dims = self.renderer.volume.dims();
         let extent = DVec3::from(dims.map(|n| (n - 1) as f64));
-        [left, right].into_iter().all(|camera| {
-            let Some(eye) = camera.shared_origin() else {
-                return false;
-            };
-            let eye = self.voxel_from_world.transform_point3(eye);
-            let inside = eye.cmpge(DVec3::ZERO).all() && eye.cmple(extent).all();
-            // The search's crossing direction is the one the eye's own value implies.
-            inside && {
-                let eye = eye.as_vec3();
-                integrator.rising_at(eye, iso) == (integrator.sampler.value(eye) < iso)
-            }
-        })
+        let eye = self.voxel_from_world.transform_point3(eye);
+        let inside = eye.cmpge(DVec3::ZERO).all() && eye.cmple(extent).all();
+        // The search's crossing direction is the one the eye's own value implies.
+        inside && {
+            let eye = eye.as_vec3();
+            integrator.rising_at(eye, iso) == (integrator.sampler.value(eye) < iso)
+        }
     }
 
     /// The right eye's per-pixel search starts from the left eye's depth image, and the clear
@@ -227,23 +253,37 @@ impl Prepared {
     ) {
         let [_, h] = right.size();
         let tan_half = (right.fov_deg().to_radians() / 2.0).tan();
-        let spacing = self.renderer.volume.geometry().spacing_mm().max_element();
         let geometry = starts::Geometry {
             k: rig.eye_separation_mm / tan_half * h as f64 / 2.0,
             focus_mm: rig.focus_mm,
-            margin: 0.5 * spacing + 2.0 * self.step_mm,
+            margin: self.emptiness_margin_mm(),
             min_gain: 2.0 * self.step_mm,
         };
         let left = (left, left_frame);
         starts::fill(left, right, geometry, &mut out.buffers, &mut out.starts);
-        let eye = right.shared_origin().unwrap_or_else(|| right.eye_mm());
+        out.clear = self.clear_ball(right);
+        out.width = right.size()[0];
+    }
+
+    /// What the depths of a frame lose before they bound another camera's searches, mm: half a
+    /// voxel and two sample steps (the refined hit's error, and surfaces bulging between
+    /// neighbouring rays).
+    pub(super) fn emptiness_margin_mm(&self) -> f64 {
+        let spacing = self.renderer.volume.geometry().spacing_mm().max_element();
+        0.5 * spacing + 2.0 * self.step_mm
+    }
+
+    /// `camera`'s eye in voxel space and the radius (voxels) of a ball around it in which every
+    /// sample lies on the eye's side of the isovalue: no iso-active brick in it, or its voxels
+    /// all on that side (see `clear`).
+    pub(super) fn clear_ball(&self, camera: &Camera) -> (Vec3, f32) {
+        let eye = camera.shared_origin().unwrap_or_else(|| camera.eye_mm());
         let eye = self.voxel_from_world.transform_point3(eye).as_vec3();
-        // The eye's side: the one its searches start from (`shares_emptiness`).
+        // The eye's side: the one its searches start from (`eye_starts_late`).
         let iso = self.params.lower.iso;
         let below = self.renderer.sampler().value(eye) < iso;
         let voxels = clear::clear_radius(&self.renderer.volume, eye, iso, below);
-        out.clear = (eye, self.clear_radius_vox(eye).max(voxels));
-        out.width = right.size()[0];
+        (eye, self.clear_radius_vox(eye).max(voxels))
     }
 }
 

@@ -102,6 +102,7 @@ pub(super) struct PinholeSecants {
 }
 
 impl PinholeSecants {
+    /// The secants of `camera`'s pixel rays.
     pub fn of(camera: &Camera) -> Self {
         let [w, h] = camera.size().map(|n| n as f64);
         let tan = (camera.fov_deg().to_radians() / 2.0).tan();
@@ -126,7 +127,7 @@ impl PinholeSecants {
 
 /// A pinhole's hit depths along its view axis (mm), rounded down, into `out`; `+∞` where a ray
 /// hit nothing.
-fn forward_depths(camera: &Camera, frame: &Frame, out: &mut Vec<f32>) {
+pub(in crate::render) fn forward_depths(camera: &Camera, frame: &Frame, out: &mut Vec<f32>) {
     let [w, _] = camera.size();
     let secants = PinholeSecants::of(camera);
     let sx2: Vec<f32> = secants.sx2.iter().map(|&s| s as f32).collect();
