@@ -4,8 +4,9 @@
 //! off with distance; a tri-planar detail texture modulating the tissue colour; wetness as a
 //! low-power view-dependent darkening (wet tissue turns dark where it turns away) plus sharp
 //! highlights where it faces the tip, stronger on the texture's darker texels and where there is
-//! secretion; and the secretion as fog, blending the tissue toward the secretion colour with
-//! its thickness.
+//! secretion (its density and the nearness of its first layer); and the secretion as fog,
+//! blending the tissue toward the secretion colour with its thickness, under a glossy film lit
+//! and highlighted by the secretion surface's own normal, fading in where the layer thins.
 
 use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
 use super::texture::Texture;
