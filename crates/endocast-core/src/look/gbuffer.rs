@@ -181,15 +181,14 @@ impl RayPass {
 
     /// Carries every ray of `frame` (traced by `camera` to its secretion hit) on to the tissue:
     /// replaces its depth with the tissue's, fills its hit positions and normals, and returns
-    /// the secretion per pixel and the normals of the secretion's surface (the frame's normals
-    /// at the secretion hits; NaN where no tissue lies behind).
+    /// the secretion per pixel and the normals of the secretion's surface at the secretion hits
+    /// (NaN where no tissue lies behind).
     fn continue_to_tissue(&self, camera: &Camera, frame: &mut Frame) -> (Vec<f32>, Vec<[f32; 3]>) {
         let renderer = self.prepared.renderer();
         let on = Continuation::new(renderer, &self.settings);
         let (w, n) = (frame.width, frame.len());
-        let mut surface = std::mem::replace(&mut frame.normal, vec![[f32::NAN; 3]; n]);
-        surface.resize(n, [f32::NAN; 3]);
-        frame.hit_mm = vec![[f32::NAN; 3]; n];
+        (frame.hit_mm, frame.normal) = (vec![[f32::NAN; 3]; n], vec![[f32::NAN; 3]; n]);
+        let mut surface = vec![[f32::NAN; 3]; n];
         let mut secretion = vec![0.0; n];
         frame
             .depth_mm
@@ -210,14 +209,12 @@ impl RayPass {
                     });
                     for (x, found) in lanes.zip(on.tissue_after8(&rays)) {
                         depth[x] = f32::NAN;
-                        if found.is_none() {
-                            surface[x] = [f32::NAN; 3];
-                        }
                         if let Some(found) = found {
                             depth[x] = found.depth_mm;
                             hit[x] = found.hit_mm;
                             normal[x] = found.normal;
                             secretion[x] = found.secretion_mm;
+                            surface[x] = found.secretion_normal;
                         }
                     }
                 }

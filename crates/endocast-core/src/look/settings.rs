@@ -73,13 +73,13 @@ impl Default for RayPassSettings {
 
 impl RayPassSettings {
     /// The optional layers the pass renders its frame with: the tissue's hit positions and
-    /// normals, or with secretion the normals of the secretion's surface (the search from it to
-    /// the tissue finds the tissue's).
+    /// normals, or none with secretion (the secretion's search to the tissue finds them, and
+    /// the secretion surface's normal).
     pub fn traced_layers(&self) -> Layers {
         if self.secretion == SecretionMode::Off {
             Layers::HIT_POSITION | Layers::NORMAL
         } else {
-            Layers::NORMAL
+            Layers::NONE
         }
     }
 
