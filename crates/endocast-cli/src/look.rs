@@ -161,7 +161,9 @@ pub struct RealismArgs {
     /// Secretion threshold, physical units (between the lumen's value and the tissue's).
     #[arg(long, value_name = "VALUE", allow_negative_numbers = true)]
     secretion_iso: Option<f64>,
-    /// Wetness, 0 (dry) to 1: darkening where the tissue turns away, sharp highlights.
+    /// Wetness, 0 (dry: no highlight at all) to 1: darkening where the tissue turns away, wet
+    /// highlights strongest on the texture's darker texels, glossy highlights on the mucus's
+    /// own surface; secretion raises it (default: the preset's, 0.8 for CT).
     #[arg(long, value_name = "0..1", allow_negative_numbers = true)]
     wetness: Option<f32>,
     /// Detail texture: mucosa, grid, none, or a PNG file (its luminance).

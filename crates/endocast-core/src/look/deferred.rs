@@ -3,7 +3,7 @@
 //! is in the cache.
 
 use super::gbuffer::GBuffer;
-use super::lanes::{load, map, map3, LANES};
+use super::lanes::{load, map, map3, Lanes, LANES};
 use super::shading::{Shading, Surface8};
 use super::smooth::{Planes, SmoothBands, BAND_ROWS, DEPTH, HIT, NORMAL, SECRETION};
 use super::LookError;
@@ -33,7 +33,11 @@ pub fn shade(gbuffer: &GBuffer, camera: &Camera, shading: &Shading) -> Result<Fr
     let w = size[0];
     let bands = SmoothBands::new(gbuffer, shading.smoothing_px);
     let band = bands.band_pixels();
-    let rows = Rows { shading, camera };
+    let rows = Rows {
+        shading,
+        camera,
+        secretion_normal: &gbuffer.secretion_normal,
+    };
     frame
         .color
         .par_chunks_mut(band)
@@ -61,6 +65,8 @@ pub fn shade(gbuffer: &GBuffer, camera: &Camera, shading: &Shading) -> Result<Fr
 struct Rows<'a> {
     shading: &'a Shading,
     camera: &'a Camera,
+    /// The G-buffer's secretion surface normals, unsmoothed (empty: none).
+    secretion_normal: &'a [[f32; 3]],
 }
 
 impl Rows<'_> {
@@ -78,6 +84,7 @@ impl Rows<'_> {
                 hit: [lanes(HIT), lanes(HIT + 1), lanes(HIT + 2)],
                 normal: [lanes(NORMAL), lanes(NORMAL + 1), lanes(NORMAL + 2)],
                 secretion: lanes(SECRETION),
+                secretion_normal: self.secretion_normals(y * w, x0, w),
             };
             let out = &mut color[x0..(x0 + LANES).min(w)];
             if surface.depth.iter().all(|d| d.is_nan()) {
@@ -106,5 +113,17 @@ impl Rows<'_> {
                 };
             }
         }
+    }
+
+    /// The secretion surface normals of pixels `x0 ..` of the row starting at pixel `row` of a
+    /// `w` pixels wide G-buffer, by axis (NaN past the row's end or without any).
+    #[inline(always)]
+    fn secretion_normals(&self, row: usize, x0: usize, w: usize) -> [Lanes; 3] {
+        let normals = self.secretion_normal;
+        map3(|a, k| {
+            let x = x0 + k;
+            let normal = normals.get(row + x).filter(|_| x < w);
+            normal.map_or(f32::NAN, |n| n[a])
+        })
     }
 }

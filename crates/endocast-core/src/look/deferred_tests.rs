@@ -2,7 +2,10 @@
 //! look first shaded): the same bits, on a G-buffer with misses, silhouettes, secretion and an
 //! odd size (lane sets and bands cut off at the edges).
 
-use super::shading::WET_DARKENING;
+use super::shading::{
+    smoothstep, FILM_GLOSS, FILM_MM, FILM_SHININESS, SPECULAR_MAP_BASE, SPECULAR_MAP_GAIN,
+    WET_DARKENING,
+};
 use super::smooth::DEPTH_EDGE;
 use super::*;
 use crate::render::{Camera, Premultiplied, RenderStats};
@@ -20,7 +23,8 @@ fn hash(i: usize, salt: u64) -> f32 {
 }
 
 /// A G-buffer seen by `camera`: a near fold over the left third in front of a far wall, noisy
-/// depths and normals, secretion in a band, no hit in a corner.
+/// depths and normals, secretion in a band (its surface's normal given on most of it), no hit
+/// in a corner.
 fn gbuffer(camera: &Camera) -> GBuffer {
     let [w, h] = camera.size();
     let mut g = GBuffer {
@@ -45,6 +49,13 @@ fn gbuffer(camera: &Camera) -> GBuffer {
         g.hit_mm.push(if miss { nan } else { hit.to_array() });
         g.normal.push(if miss { nan } else { normal.to_array() });
         g.secretion_mm.push(if miss { 0.0 } else { secretion });
+        let surface = Vec3::new(hash(i, 5) - 0.5, -0.2, -1.0).normalize();
+        let surface = if secretion > 0.0 && x % 7 != 0 {
+            surface.to_array()
+        } else {
+            nan
+        };
+        g.secretion_normal.push(surface);
     }
     g.stats = RenderStats::default();
     g
@@ -101,38 +112,70 @@ fn smooth_by_pixel(g: &GBuffer, radius: usize) -> Vec<[f32; 8]> {
     out
 }
 
-/// The shading of one smoothed texel, as the look first did it.
-fn shade_pixel(s: &Shading, t: [f32; 8], tip: Vec3) -> Premultiplied {
+/// The Phong highlight of strength `gloss` (times the shading's specular) on a surface at
+/// cosine `cos` to the tip's light, exponent `shininess`.
+fn highlight(s: &Shading, gloss: f32, cos: f32, shininess: f32) -> f32 {
+    let mirror = (2.0 * cos * cos - 1.0).max(0.0);
+    let strength = gloss * s.specular;
+    if strength > 0.0 && mirror > 0.0 {
+        strength * mirror.powf(shininess)
+    } else {
+        0.0
+    }
+}
+
+/// The shading of one smoothed texel, one pixel at a time (`surface`: the secretion surface's
+/// normal, NaN for none).
+fn shade_pixel(s: &Shading, t: [f32; 8], surface: Vec3, tip: Vec3) -> Premultiplied {
     if t[0].is_nan() {
         return Premultiplied::default();
     }
     let (p, n) = (Vec3::new(t[1], t[2], t[3]), Vec3::new(t[4], t[5], t[6]));
     let to_tip = (tip - p).normalize_or_zero();
-    let n = if n.dot(to_tip) < 0.0 { -n } else { n };
-    let cos = n.dot(to_tip).clamp(0.0, 1.0);
+    // At most 1, NaN kept (no secretion surface).
+    let cosine = |n: Vec3| {
+        let c = n.dot(to_tip).abs();
+        if c > 1.0 {
+            1.0
+        } else {
+            c
+        }
+    };
+    let cos = cosine(n);
+    let film_cos = cosine(surface);
+    let film_cos = if film_cos.is_nan() { cos } else { film_cos };
     let texel = s
         .texture
         .as_ref()
         .map_or(0.5, |tex| tex.triplanar(p / s.texture_mm, n));
     let detail = 1.0 + s.texture_strength * (2.0 * texel - 1.0);
     let fog = s.fog(t[7]);
-    let wet = (s.wetness + (1.0 - s.wetness) * fog * s.wetness.min(0.5) * 2.0).clamp(0.0, 1.0);
-    let lit = s.ambient + s.diffuse * cos;
-    let darkening = 1.0 - wet * WET_DARKENING * (1.0 - cos.powf(2.0));
-    let tissue = Vec3::from(s.tissue_color) * (detail * lit * darkening);
-    let mucus = Vec3::from(s.secretion_color) * (lit * darkening);
-    let mirror = (2.0 * cos * cos - 1.0).max(0.0);
-    let strength = wet * s.specular * (1.3 - 0.6 * texel);
-    let highlight = if strength > 0.0 && mirror > 0.0 {
-        strength * mirror.powf(s.shininess)
+    let film = if t[7] > 0.0 {
+        smoothstep(t[7] / FILM_MM)
     } else {
         0.0
     };
-    let falloff = s.attenuation_mm.map_or(1.0, |half| {
-        let r = t[0] / half;
-        1.0 / (1.0 + r * r)
-    });
-    let c = (tissue.lerp(mucus, fog) + Vec3::splat(highlight)) * falloff;
+    let falloff = |d: f32| {
+        s.attenuation_mm.map_or(1.0, |half| {
+            let r = d / half;
+            1.0 / (1.0 + r * r)
+        })
+    };
+    let near = falloff((t[0] - t[7]).max(0.0));
+    let raised = (1.0 - s.wetness) * fog * near * s.wetness.min(0.5) * 2.0;
+    let wet = (s.wetness + raised).clamp(0.0, 1.0);
+    let darkening = |c: f32| 1.0 - wet * WET_DARKENING * (1.0 - c * c);
+    let tissue =
+        Vec3::from(s.tissue_color) * (detail * (s.ambient + s.diffuse * cos) * darkening(cos));
+    let lit = s.ambient + s.diffuse * film_cos;
+    let mucus = Vec3::from(s.secretion_color) * lit;
+    let map = SPECULAR_MAP_BASE + SPECULAR_MAP_GAIN * (1.0 - texel);
+    let glints = [
+        highlight(s, wet * map * (1.0 - fog), cos, s.shininess),
+        highlight(s, wet * FILM_GLOSS * film, film_cos, FILM_SHININESS),
+    ];
+    let c = (tissue * (1.0 - fog) + mucus * fog + Vec3::splat(glints[0]) + Vec3::splat(glints[1]))
+        * falloff(t[0]);
     Premultiplied {
         rgb: c.min(Vec3::ONE).to_array(),
         transmittance: 0.0,
@@ -162,7 +205,8 @@ fn the_vectorised_deferred_stage_matches_its_scalar_form() {
         let texels = smooth_by_pixel(&g, radius);
         let smoothed = smooth::smooth(&g, radius);
         for (i, t) in texels.iter().enumerate() {
-            let expected = shade_pixel(&shading, *t, tip);
+            let surface = Vec3::from(g.secretion_normal[i]);
+            let expected = shade_pixel(&shading, *t, surface, tip);
             assert_eq!(frame.color[i], expected, "radius {radius}, pixel {i}");
             let same = |a: f32, b: f32| a == b || (a.is_nan() && b.is_nan());
             assert!(same(frame.depth_mm[i], t[0]), "pixel {i}");

@@ -35,13 +35,18 @@ pub struct GBuffer {
     /// counted: a last stretch into the tissue no longer than a bare edge's (from the value's
     /// slope at the hit) is left out, so bare walls carry no film of secretion.
     pub secretion_mm: Vec<f32>,
+    /// Unit world normal of the secretion's upper boundary where the ray first met it (the
+    /// paper's Figure 3 alternative: the surface of the viscous material found as the tissue's
+    /// is), up the value gradient; NaN where the ray met no secretion. Empty without secretion
+    /// and below full quality (the shading then takes the tissue's normal).
+    pub secretion_normal: Vec<[f32; 3]>,
     /// The ray pass's counters (its time included).
     pub stats: RenderStats,
 }
 
 impl GBuffer {
-    /// The bytes a pixel takes: depth, hit position, normal and secretion.
-    pub const BYTES_PER_PIXEL: usize = 2 * size_of::<f32>() + 2 * size_of::<[f32; 3]>();
+    /// The bytes a pixel takes: depth, hit position, normal, secretion and its surface's normal.
+    pub const BYTES_PER_PIXEL: usize = 2 * size_of::<f32>() + 3 * size_of::<[f32; 3]>();
 
     /// Number of pixels.
     pub fn len(&self) -> usize {
@@ -152,13 +157,16 @@ impl RayPass {
         let mut frame = Frame::default();
         // Nothing cancels it.
         let _ = self.prepared.render_with(&small, &options, &mut frame);
-        let secretion = if with_secretion {
+        let (secretion, surface) = if with_secretion {
             self.continue_to_tissue(&small, &mut frame)
         } else {
-            vec![0.0; frame.len()]
+            (vec![0.0; frame.len()], Vec::new())
         };
         let mut gbuffer = if quality == Quality::Full {
-            into_gbuffer(frame, secretion)
+            GBuffer {
+                secretion_normal: surface,
+                ..into_gbuffer(frame, secretion)
+            }
         } else {
             // The value layer (NaN in iso mode) carries the secretion through the upsampling.
             frame.value = secretion;
@@ -173,12 +181,14 @@ impl RayPass {
 
     /// Carries every ray of `frame` (traced by `camera` to its secretion hit) on to the tissue:
     /// replaces its depth with the tissue's, fills its hit positions and normals, and returns
-    /// the secretion per pixel.
-    fn continue_to_tissue(&self, camera: &Camera, frame: &mut Frame) -> Vec<f32> {
+    /// the secretion per pixel and the normals of the secretion's surface at the secretion hits
+    /// (NaN where no tissue lies behind).
+    fn continue_to_tissue(&self, camera: &Camera, frame: &mut Frame) -> (Vec<f32>, Vec<[f32; 3]>) {
         let renderer = self.prepared.renderer();
         let on = Continuation::new(renderer, &self.settings);
         let (w, n) = (frame.width, frame.len());
         (frame.hit_mm, frame.normal) = (vec![[f32::NAN; 3]; n], vec![[f32::NAN; 3]; n]);
+        let mut surface = vec![[f32::NAN; 3]; n];
         let mut secretion = vec![0.0; n];
         frame
             .depth_mm
@@ -186,8 +196,9 @@ impl RayPass {
             .zip(frame.hit_mm.par_chunks_mut(w))
             .zip(frame.normal.par_chunks_mut(w))
             .zip(secretion.par_chunks_mut(w))
+            .zip(surface.par_chunks_mut(w))
             .enumerate()
-            .for_each(|(y, (((depth, hit), normal), secretion))| {
+            .for_each(|(y, ((((depth, hit), normal), secretion), surface))| {
                 for x0 in (0..w).step_by(8) {
                     let lanes = x0..(x0 + 8).min(w);
                     let rays: [_; 8] = std::array::from_fn(|k| {
@@ -203,12 +214,13 @@ impl RayPass {
                             hit[x] = found.hit_mm;
                             normal[x] = found.normal;
                             secretion[x] = found.secretion_mm;
+                            surface[x] = found.secretion_normal;
                         }
                     }
                 }
             });
         frame.stats.iso_hits = frame.depth_mm.iter().filter(|d| !d.is_nan()).count() as u64;
-        secretion
+        (secretion, surface)
     }
 }
 
@@ -221,6 +233,7 @@ fn into_gbuffer(frame: Frame, secretion_mm: Vec<f32>) -> GBuffer {
         hit_mm: frame.hit_mm,
         normal: frame.normal,
         secretion_mm,
+        secretion_normal: Vec::new(),
         stats: frame.stats,
     }
 }

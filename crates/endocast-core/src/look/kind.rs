@@ -78,7 +78,7 @@ impl PresetLook {
         tissue: -230.0,
         secretion: -750.0,
         secretion_mode: SecretionMode::On,
-        wetness: 0.6,
+        wetness: 0.8,
         texture: "mucosa",
         texture_mm: 12.0,
         attenuation_mm: 40.0,

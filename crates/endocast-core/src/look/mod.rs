@@ -12,8 +12,11 @@
 //! 2. The **deferred stage** ([`shade`], settings [`Shading`]) reads only the G-buffer:
 //!    depth-aware image-space smoothing of depth, normals and secretion ([`smooth`]), Phong with
 //!    the light at the endoscope's tip and its fall-off with distance, wetness (a low-power
-//!    view-dependent darkening and sharp highlights, raised by secretion), a tri-planar detail
-//!    texture ([`Texture`]) and secretion fog. Changing any of it never marches a ray again:
+//!    view-dependent darkening and highlights, strongest on the detail texture's darker texels:
+//!    a specular map; raised by the secretion's density and nearness), a tri-planar detail
+//!    texture ([`Texture`]) and the secretion as fog under a glossy film: its upper boundary,
+//!    found by the ray pass with its own normal, lit and highlighted, fading in with the
+//!    layer's thickness. Changing any of it never marches a ray again:
 //!    [`shade`] takes a `&GBuffer` and no renderer.
 //!
 //! [`shade_with_scene`] composites scene geometry (meshes, overlays, markers, the grid, the

@@ -32,6 +32,9 @@ pub(crate) struct TissueHit {
     pub normal: [f32; 3],
     /// Secretion in front of the tissue, mm.
     pub secretion_mm: f32,
+    /// Unit world normal of the secretion's surface at the ray's secretion hit, up the value
+    /// gradient.
+    pub secretion_normal: [f32; 3],
 }
 
 /// Everything a continuation needs, shared by the rays of a frame.
@@ -99,6 +102,7 @@ impl<'a> Continuation<'a> {
                 hit_mm: found.hit[k],
                 normal: self.shader.normal(found.gradient[k]).to_array(),
                 secretion_mm: found.secretion_mm[k],
+                secretion_normal: self.shader.normal(found.surface[k]).to_array(),
             })
         })
     }
@@ -141,11 +145,14 @@ impl<'a> Continuation<'a> {
         lanes
     }
 
-    /// What the lanes found at `t_hit`: the world hit, the gradient and the secretion.
+    /// What the lanes found at `t_hit`: the world hit, the gradient and the secretion, and the
+    /// gradient at the secretion hit (the secretion surface's normal).
     #[inline(always)]
     fn measure(&self, lanes: &Lanes8, world: &WorldRays, t_hit: Lanes) -> Found {
         let points = map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * t_hit[k]);
         let [gx, gy, gz] = self.sampler.gradients8_lanes(&points);
+        let at_secretion = map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * world.t_secretion[k]);
+        let [sx, sy, sz] = self.sampler.gradients8_lanes(&at_secretion);
         let secretion_mm = map(|k| {
             let measured = if self.accumulate {
                 let last = self.inside_secretion((lanes.t[k], lanes.v[k]), (t_hit[k], self.tissue));
@@ -165,6 +172,7 @@ impl<'a> Continuation<'a> {
             t_hit,
             hit: std::array::from_fn(|k| [hit[0][k] as f32, hit[1][k] as f32, hit[2][k] as f32]),
             gradient: std::array::from_fn(|k| Vec3::new(gx[k], gy[k], gz[k])),
+            surface: std::array::from_fn(|k| Vec3::new(sx[k], sy[k], sz[k])),
             secretion_mm,
         }
     }
@@ -364,6 +372,8 @@ struct Found {
     t_hit: Lanes,
     hit: [[f32; 3]; LANES],
     gradient: [Vec3; LANES],
+    /// The value gradient at the secretion hit.
+    surface: [Vec3; LANES],
     secretion_mm: Lanes,
 }
 

@@ -73,7 +73,8 @@ impl Default for RayPassSettings {
 
 impl RayPassSettings {
     /// The optional layers the pass renders its frame with: the tissue's hit positions and
-    /// normals, or none with secretion (the secretion's search to the tissue finds them).
+    /// normals, or none with secretion (the secretion's search to the tissue finds them, and
+    /// the secretion surface's normal).
     pub fn traced_layers(&self) -> Layers {
         if self.secretion == SecretionMode::Off {
             Layers::HIT_POSITION | Layers::NORMAL

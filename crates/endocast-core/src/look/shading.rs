@@ -4,8 +4,9 @@
 //! off with distance; a tri-planar detail texture modulating the tissue colour; wetness as a
 //! low-power view-dependent darkening (wet tissue turns dark where it turns away) plus sharp
 //! highlights where it faces the tip, stronger on the texture's darker texels and where there is
-//! secretion; and the secretion as fog, blending the tissue toward the secretion colour with
-//! its thickness.
+//! secretion (its density and the nearness of its first layer); and the secretion as fog,
+//! blending the tissue toward the secretion colour with its thickness, under a glossy film lit
+//! and highlighted by the secretion surface's own normal, fading in where the layer thins.
 
 use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
 use super::texture::Texture;
@@ -15,6 +16,21 @@ use std::sync::Arc;
 
 /// Share of the colour the full wet darkening takes away at grazing view.
 pub(super) const WET_DARKENING: f32 = 0.55;
+
+/// The specular map read from the detail texture (Krüger et al. §4.4: specularity linked to
+/// its darker pixels): `BASE + GAIN · (1 − texel)`, so a mid-grey texel gives 1, the darkest
+/// 1.5 and the brightest 0.5.
+pub(super) const SPECULAR_MAP_BASE: f32 = 0.5;
+/// See [`SPECULAR_MAP_BASE`].
+pub(super) const SPECULAR_MAP_GAIN: f32 = 1.0;
+
+/// Secretion thickness at which the mucus film's gloss is full, mm; thinner, it fades in
+/// smoothly (soft edges where the layer thins).
+pub(super) const FILM_MM: f32 = 1.0;
+/// Strength of the mucus film's highlights against the tissue's (a smooth liquid surface).
+pub(super) const FILM_GLOSS: f32 = 1.3;
+/// Phong exponent of the mucus film's highlights: a liquid's, sharper than the mucosa's.
+pub(super) const FILM_SHININESS: f32 = 30.0;
 
 /// How the G-buffer is shaded; changing any of it marches no ray.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,9 +44,10 @@ pub struct Shading {
     pub ambient: f32,
     /// Diffuse weight of the tip's light, 0–1. Default 0.88.
     pub diffuse: f32,
-    /// Strength of the wet highlights at full wetness, 0–1. Default 0.7.
+    /// Strength of the wet highlights at full wetness, 0–1 (times the specular map, 0.5–1.5).
+    /// Default 1.
     pub specular: f32,
-    /// Sharpness of the wet highlights (Phong exponent), 1–1000. Default 60.
+    /// Sharpness of the mucosa's wet highlights (Phong exponent), 1–1000. Default 10.
     pub shininess: f32,
     /// Wetness, 0 (dry) – 1. Default 0.
     pub wetness: f32,
@@ -56,8 +73,8 @@ impl Default for Shading {
             secretion_color: [0.92, 0.88, 0.62],
             ambient: 0.12,
             diffuse: 0.88,
-            specular: 0.7,
-            shininess: 60.0,
+            specular: 1.0,
+            shininess: 10.0,
             wetness: 0.0,
             texture: None,
             texture_mm: 12.0,
@@ -121,56 +138,99 @@ impl Shading {
 
     /// The colours of eight hits (before the vignetting and the clamp to 1), `tip` the light at
     /// the endoscope's tip; lanes without a hit (NaN) give NaN or anything else.
+    ///
+    /// The tissue: lit (ambient plus diffuse), its texture's detail, darkened by the wetness's
+    /// low-power view term (`1 − wet · WET_DARKENING · (1 − cos²)`), then its highlights added
+    /// (the specular map: stronger on the texture's darker texels). Over it the secretion: a fog
+    /// toward the mucus colour, lit (not darkened) by the secretion surface's own normal, with the glossy
+    /// film's highlights on that surface fading in with the layer's thickness (no hard edge
+    /// where it thins). Secretion raises the wetness with its density (its fog) and the
+    /// nearness of its first layer (the tip's light there).
     #[inline(always)]
     pub(super) fn colors8(&self, s: &Surface8, tip: Vec3) -> [Lanes; 3] {
         let tip = tip.to_array();
         let to_tip = normalize_or_zero(map3(|a, k| tip[a] - s.hit[a][k]));
-        let [nx, ny, nz] = &s.normal;
-        let facing = map(|k| nx[k] * to_tip[0][k] + ny[k] * to_tip[1][k] + nz[k] * to_tip[2][k]);
-        // The normal turned toward the tip: its cosine with the light is |n · to tip|.
-        let cos = map(|k| facing[k].abs().clamp(0.0, 1.0));
+        // The normals turned toward the tip: the cosine with the light is |n · to tip|.
+        let cos = cosines(&s.normal, &to_tip);
+        let film_cos = cosines(&s.secretion_normal, &to_tip);
+        // No surface of its own (no secretion normal): the tissue's.
+        let film_cos = map(|k| {
+            if film_cos[k].is_nan() {
+                cos[k]
+            } else {
+                film_cos[k]
+            }
+        });
         let texel = match &self.texture {
             Some(t) => t.triplanar8(&map3(|a, k| s.hit[a][k] / self.texture_mm), &s.normal),
             None => [0.5; LANES],
         };
-        let fog = if s.secretion.iter().any(|&mm| mm > 0.0) {
-            map(|k| self.fog(s.secretion[k]))
+        let secreted = s.secretion.iter().any(|&mm| mm > 0.0);
+        let (fog, film) = if secreted {
+            let film = map(|k| smoothstep(s.secretion[k] / FILM_MM));
+            (map(|k| self.fog(s.secretion[k])), film)
         } else {
-            [0.0; LANES]
+            ([0.0; LANES], [0.0; LANES])
         };
         let wet = map(|k| {
-            let raised = (1.0 - self.wetness) * fog[k] * self.wetness.min(0.5) * 2.0;
+            let near = self.falloff((s.depth[k] - s.secretion[k]).max(0.0));
+            let raised = (1.0 - self.wetness) * fog[k] * near * self.wetness.min(0.5) * 2.0;
             (self.wetness + raised).clamp(0.0, 1.0)
         });
         let lit = map(|k| self.ambient + self.diffuse * cos[k]);
+        let film_lit = map(|k| self.ambient + self.diffuse * film_cos[k]);
         let darkening = map(|k| 1.0 - wet[k] * WET_DARKENING * (1.0 - cos[k] * cos[k]));
         let tissue = map(|k| (1.0 + self.texture_strength * (2.0 * texel[k] - 1.0)) * lit[k]);
         let tissue = map(|k| tissue[k] * darkening[k]);
-        let mucus = map(|k| lit[k] * darkening[k]);
-        let highlight = self.highlights8(&wet, &cos, &texel);
+        // The mucus is a translucent liquid, not the wet mucosa: lit, not darkened.
+        let mucus = film_lit;
+        let specular_map = map(|k| SPECULAR_MAP_BASE + SPECULAR_MAP_GAIN * (1.0 - texel[k]));
+        let tissue_gloss = map(|k| wet[k] * specular_map[k] * (1.0 - fog[k]));
+        let film_gloss = map(|k| wet[k] * FILM_GLOSS * film[k]);
+        let highlight = self.highlights8(&tissue_gloss, &cos, self.shininess);
+        let glints = if secreted {
+            self.highlights8(&film_gloss, &film_cos, FILM_SHININESS)
+        } else {
+            [0.0; LANES]
+        };
         let falloff = map(|k| self.falloff(s.depth[k]));
         map3(|c, k| {
             let (t, m) = (self.tissue_color[c], self.secretion_color[c]);
             let mixed = t * tissue[k] * (1.0 - fog[k]) + m * mucus[k] * fog[k];
-            (mixed + highlight[k]) * falloff[k]
+            (mixed + highlight[k] + glints[k]) * falloff[k]
         })
     }
 
-    /// The wet highlights of eight hits: sharp (the Phong exponent [`Self::shininess`]) where the
-    /// light reflects toward the tip (for a light at the eye, `2 cos² − 1` with the normal),
-    /// stronger on the texture's darker `texel`s and with wetness `wet`.
+    /// Highlights of eight hits: sharp (Phong exponent `shininess`) where the light reflects
+    /// toward the tip (for a light at the eye, `2 cos² − 1` with the normal), times
+    /// [`Self::specular`] and `gloss`.
     #[inline(always)]
-    fn highlights8(&self, wet: &Lanes, cos: &Lanes, texel: &Lanes) -> Lanes {
+    fn highlights8(&self, gloss: &Lanes, cos: &Lanes, shininess: f32) -> Lanes {
         let mirror = map(|k| (2.0 * cos[k] * cos[k] - 1.0).max(0.0));
-        let strength = map(|k| wet[k] * self.specular * (1.3 - 0.6 * texel[k]));
+        let strength = map(|k| gloss[k] * self.specular);
         let mut highlight = [0.0; LANES];
         for k in 0..LANES {
             if strength[k] > 0.0 && mirror[k] > 0.0 {
-                highlight[k] = strength[k] * mirror[k].powf(self.shininess);
+                highlight[k] = strength[k] * mirror[k].powf(shininess);
             }
         }
         highlight
     }
+}
+
+/// `|n · v|` per lane, at most 1 (NaN where the normal is NaN).
+#[inline(always)]
+fn cosines(n: &[Lanes; 3], v: &[Lanes; 3]) -> Lanes {
+    let [nx, ny, nz] = n;
+    let cos = map(|k| (nx[k] * v[0][k] + ny[k] * v[1][k] + nz[k] * v[2][k]).abs());
+    map(|k| if cos[k] > 1.0 { 1.0 } else { cos[k] })
+}
+
+/// `3x² − 2x³` of `x` clamped to [0, 1].
+#[inline(always)]
+pub(super) fn smoothstep(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
 }
 
 /// Eight pixels of a smoothed G-buffer row, channel by channel.
@@ -183,4 +243,6 @@ pub(super) struct Surface8 {
     pub normal: [Lanes; 3],
     /// Secretion, mm.
     pub secretion: Lanes,
+    /// Unit normal of the secretion's surface (either side; NaN: none, the tissue's is taken).
+    pub secretion_normal: [Lanes; 3],
 }

@@ -62,7 +62,8 @@ fn weight_by_distance(difference: f32, inverse: f32) -> f32 {
     (2.0 - 2.0 * difference.abs() * inverse).clamp(0.0, 1.0)
 }
 
-/// `gbuffer` smoothed over a window of `2 · radius + 1` pixels each way (0: unchanged). Pixels
+/// `gbuffer` smoothed over a window of `2 · radius + 1` pixels each way (0: unchanged; the
+/// secretion's surface normals are never smoothed: the shading reads them as traced). Pixels
 /// without a hit stay without one (NaN depth, position and normal, no secretion) and give no
 /// weight to those with one.
 pub fn smooth(gbuffer: &GBuffer, radius: usize) -> GBuffer {
@@ -77,6 +78,7 @@ pub fn smooth(gbuffer: &GBuffer, radius: usize) -> GBuffer {
         hit_mm: vec![[0.0; 3]; n],
         normal: vec![[0.0; 3]; n],
         secretion_mm: vec![0.0; n],
+        secretion_normal: gbuffer.secretion_normal.clone(),
         stats: gbuffer.stats,
     };
     let bands = SmoothBands::new(gbuffer, radius);

@@ -35,11 +35,14 @@ fn pass(volume: Volume, secretion: SecretionMode, base: &RenderSettings) -> RayP
 }
 
 /// Shading that leaves only the secretion's fog: red tissue, green secretion, no texture,
-/// wetness, fall-off or smoothing.
+/// wetness, fall-off or smoothing, and light from everywhere (the tissue and the secretion's
+/// own surface, at other angles, lit alike).
 fn fog_only() -> Shading {
     Shading {
         tissue_color: [1.0, 0.0, 0.0],
         secretion_color: [0.0, 1.0, 0.0],
+        ambient: 1.0,
+        diffuse: 0.0,
         attenuation_mm: None,
         smoothing_px: 0,
         fog_mm: 4.0,
@@ -436,6 +439,78 @@ fn a_bare_blurred_wall_has_no_secretion_film_and_a_layer_on_it_keeps_its_thickne
                 .map(|s| (s - expected).abs())
                 .fold(0.0, f32::max);
             assert!(worst < 0.5, "{mode:?}, layer {layer}: off by {worst:.2}");
+        }
+    }
+}
+
+/// Near-white: every channel at least this (a highlight saturating the mucosa's colour).
+const NEAR_WHITE: f32 = 0.85;
+
+/// Pixels of `frame` that are near-white, and pixels with a hit, among those `counted` picks.
+fn highlights(frame: &crate::render::Frame, counted: impl Fn(usize) -> bool) -> (usize, usize) {
+    let hit = |i: usize| frame.color[i].transmittance == 0.0 && counted(i);
+    let white = |i: usize| hit(i) && frame.color[i].rgb.iter().all(|&c| c >= NEAR_WHITE);
+    let n = frame.color.len();
+    (
+        (0..n).filter(|&i| white(i)).count(),
+        (0..n).filter(|&i| hit(i)).count(),
+    )
+}
+
+/// The realistic look of the CT preset at `wetness` (the default where `None`).
+fn realistic(wetness: Option<f32>) -> Shading {
+    let mut shading = Look::of_kind(LookKind::Realistic, &PresetLook::CT)
+        .unwrap()
+        .shading;
+    shading.wetness = wetness.unwrap_or(shading.wetness);
+    shading
+}
+
+#[test]
+fn the_default_look_glistens_and_a_dry_one_does_not() {
+    // The sinus phantom (bone-walled air cells, no secretion) from inside its right cell, and
+    // the layered phantom (air over a secretion layer over tissue) from above.
+    let (sinus, _) = crate::phantom::sinus(&options(48));
+    let sinus_camera = looking_down_k(&sinus, DVec3::new(14.4, 19.0, 21.6), 90.0, 64);
+    let (layers, _) = layered(&options(40));
+    let layers_camera = looking_down_k(&layers, DVec3::new(19.5, 19.5, 2.0), 90.0, 64);
+    let scenes = [
+        (sinus, sinus_camera, SecretionMode::Off),
+        (layers, layers_camera, SecretionMode::On),
+    ];
+    for (volume, camera, secretion) in scenes {
+        let mut settings = Look::of_kind(LookKind::Realistic, &PresetLook::CT)
+            .unwrap()
+            .ray;
+        settings.secretion = secretion;
+        if secretion != SecretionMode::Off {
+            (settings.tissue_hu, settings.secretion_hu) = (
+                Layered::tissue_threshold_hu(),
+                Layered::secretion_threshold_hu(),
+            );
+        }
+        let renderer = Arc::new(Renderer::new(volume));
+        let gbuffer = RayPass::new(&renderer, &RenderSettings::default(), &settings)
+            .unwrap()
+            .trace(&camera, Quality::Full);
+        let wet = shade(&gbuffer, &camera, &realistic(None)).unwrap();
+        let (white, tissue) = highlights(&wet, |_| true);
+        assert!(tissue > 1000, "{secretion:?}: {tissue} tissue pixels");
+        assert!(
+            white * 100 >= tissue,
+            "{secretion:?}: {white} highlight pixels of {tissue}"
+        );
+        let dry = shade(&gbuffer, &camera, &realistic(Some(0.0))).unwrap();
+        assert_eq!(highlights(&dry, |_| true).0, 0, "{secretion:?}: dry");
+        if secretion != SecretionMode::Off {
+            // The mucus film glistens: highlights where the layer is thick, none when dry.
+            let layer = |i: usize| gbuffer.secretion_mm[i] > 3.0;
+            let (white, pixels) = highlights(&wet, layer);
+            assert!(
+                pixels > 1000 && white * 100 >= pixels,
+                "{white} of {pixels}"
+            );
+            assert_eq!(highlights(&dry, layer).0, 0);
         }
     }
 }
