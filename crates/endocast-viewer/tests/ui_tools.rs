@@ -107,8 +107,8 @@ fn the_large_slice_pages_zooms_sets_its_window_jumps_and_shows_the_path() {
     caption_until(&mut window, |t| t.starts_with("coronal ·"));
 }
 
-#[test]
-fn the_keys_help_fits_the_panel_and_leaves_the_view_its_width() {
+/// The window on a small straight tube, its session open and drawn once.
+fn open_tube() -> Window {
     let source = ScanSource::Phantom {
         name: "straight-tube".into(),
         size: 48,
@@ -116,6 +116,12 @@ fn the_keys_help_fits_the_panel_and_leaves_the_view_its_width() {
     let mut window = Window::open(options(source));
     window.run_until(|app| app.session().is_some());
     window.frame(Vec::new());
+    window
+}
+
+#[test]
+fn the_keys_help_fits_the_panel_and_leaves_the_view_its_width() {
+    let mut window = open_tube();
     let view = window.app.session().unwrap().view_size();
     window.click_text("Keys");
     window.wheel(Pos2::new(100.0, 300.0), -2000.0, Modifiers::NONE);
@@ -139,13 +145,7 @@ fn the_keys_help_fits_the_panel_and_leaves_the_view_its_width() {
 
 #[test]
 fn a_colour_point_is_added_on_the_strip_under_the_histogram_and_offered_for_editing() {
-    let source = ScanSource::Phantom {
-        name: "straight-tube".into(),
-        size: 48,
-    };
-    let mut window = Window::open(options(source));
-    window.run_until(|app| app.session().is_some());
-    window.frame(Vec::new());
+    let mut window = open_tube();
     let colours = |w: &Window| w.app.session().unwrap().controls.tf.color_points().len();
     let before = colours(&window);
     // The strip lies just above the isovalue slider.
