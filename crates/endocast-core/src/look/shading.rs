@@ -47,7 +47,8 @@ pub struct Shading {
     /// Strength of the wet highlights at full wetness, 0–1 (times the specular map, 0.5–1.5).
     /// Default 1.
     pub specular: f32,
-    /// Sharpness of the mucosa's wet highlights (Phong exponent), 1–1000. Default 10.
+    /// Sharpness of the mucosa's wet highlights (Phong exponent), 1–1000. Default 24: glints, not
+    /// a broad sheen, where a wall faces the tip closely.
     pub shininess: f32,
     /// Wetness, 0 (dry) – 1. Default 0.
     pub wetness: f32,
@@ -74,7 +75,7 @@ impl Default for Shading {
             ambient: 0.12,
             diffuse: 0.88,
             specular: 1.0,
-            shininess: 10.0,
+            shininess: 24.0,
             wetness: 0.0,
             texture: None,
             texture_mm: 12.0,
