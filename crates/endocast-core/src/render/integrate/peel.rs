@@ -14,7 +14,8 @@
 //! no crossing and are transparent under the transfer function of before the peel; behind it,
 //! bricks transparent under the one of after.
 
-use super::{until_opaque, Integrator, Probe};
+use super::composite::until_opaque;
+use super::{Integrator, Probe};
 use crate::render::crossing::crosses;
 use crate::render::march::{Flow, RayMarch, Sample, Walk};
 use crate::render::ray_task::{Bracket, PixelOut};
