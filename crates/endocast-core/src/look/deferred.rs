@@ -2,6 +2,7 @@
 //! ([`Shading`]) fused band by band, eight pixels at a time, each smoothed row shaded while it
 //! is in the cache.
 
+use super::clipped::overlay;
 use super::gbuffer::GBuffer;
 use super::lanes::{load, map, map3, Lanes, LANES};
 use super::shading::{Shading, Surface8};
@@ -13,7 +14,7 @@ use rayon::prelude::*;
 
 /// Shades `gbuffer` (traced by `camera`) as `shading` says, into a frame: colour, opaque where
 /// the rays hit and transparent (background) elsewhere, the smoothed depth, the camera's
-/// vignetting. Reads no volume: a new `shading` on the same G-buffer marches no ray. Fails
+/// vignetting, and the colour overlay where the tissue is clipped. Reads no volume: a new `shading` on the same G-buffer marches no ray. Fails
 /// when a setting is out of range or the G-buffer's size is not the camera's.
 pub fn shade(gbuffer: &GBuffer, camera: &Camera, shading: &Shading) -> Result<Frame, LookError> {
     shading.validate()?;
@@ -58,6 +59,7 @@ pub fn shade(gbuffer: &GBuffer, camera: &Camera, shading: &Shading) -> Result<Fr
                 );
             },
         );
+    overlay(&mut frame, &gbuffer.clipped);
     Ok(frame)
 }
 

@@ -1,6 +1,7 @@
 //! The ray pass: one march per pixel into a [`GBuffer`] (tissue depth, hit position, normal,
 //! secretion, hit mask), the only stage of a look that samples the volume.
 
+use super::clipped::clipped_pixels;
 use super::secretion::Continuation;
 use super::settings::{RayPassSettings, SecretionMode};
 use super::LookError;
@@ -40,13 +41,18 @@ pub struct GBuffer {
     /// is), up the value gradient; NaN where the ray met no secretion. Empty without secretion
     /// and below full quality (the shading then takes the tissue's normal).
     pub secretion_normal: Vec<[f32; 3]>,
+    /// Whether pixel `i`'s ray starts inside the tissue (the eye or the near plane placed in
+    /// the wall): the deferred stage lays a colour overlay there. Empty when none does.
+    pub clipped: Vec<bool>,
     /// The ray pass's counters (its time included).
     pub stats: RenderStats,
 }
 
 impl GBuffer {
-    /// The bytes a pixel takes: depth, hit position, normal, secretion and its surface's normal.
-    pub const BYTES_PER_PIXEL: usize = 2 * size_of::<f32>() + 3 * size_of::<[f32; 3]>();
+    /// The bytes a pixel takes: depth, hit position, normal, secretion, its surface's normal
+    /// and whether the tissue is clipped.
+    pub const BYTES_PER_PIXEL: usize =
+        2 * size_of::<f32>() + 3 * size_of::<[f32; 3]>() + size_of::<bool>();
 
     /// Number of pixels.
     pub fn len(&self) -> usize {
@@ -175,6 +181,7 @@ impl RayPass {
             let secretion = std::mem::take(&mut upsampled.value);
             into_gbuffer(upsampled, secretion)
         };
+        gbuffer.clipped = clipped_pixels(self.prepared.renderer(), camera, &self.settings);
         gbuffer.stats.time = start.elapsed();
         gbuffer
     }
@@ -234,6 +241,7 @@ fn into_gbuffer(frame: Frame, secretion_mm: Vec<f32>) -> GBuffer {
         normal: frame.normal,
         secretion_mm,
         secretion_normal: Vec::new(),
+        clipped: Vec::new(),
         stats: frame.stats,
     }
 }

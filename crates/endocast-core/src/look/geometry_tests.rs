@@ -19,7 +19,7 @@ const SIZE: usize = 48;
 
 /// A 32 × 32 × 40 volume (1 mm voxels) of air with a wall of tissue beyond `k` = [`WALL_K`],
 /// and with `secretion` a layer of secretion 6 voxels thick against it.
-fn wall(secretion: bool) -> Volume {
+pub(super) fn wall(secretion: bool) -> Volume {
     let options = PhantomOptions {
         size: 40,
         ..Default::default()

@@ -58,6 +58,7 @@
 //! assert_ne!(wet.color, dry.color);
 //! ```
 
+mod clipped;
 mod deferred;
 mod gbuffer;
 mod geometry;
@@ -71,6 +72,8 @@ pub mod smooth;
 mod still;
 mod texture;
 
+#[cfg(test)]
+mod clipped_tests;
 #[cfg(test)]
 mod deferred_tests;
 #[cfg(test)]

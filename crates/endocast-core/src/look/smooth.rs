@@ -63,7 +63,7 @@ fn weight_by_distance(difference: f32, inverse: f32) -> f32 {
 }
 
 /// `gbuffer` smoothed over a window of `2 · radius + 1` pixels each way (0: unchanged; the
-/// secretion's surface normals are never smoothed: the shading reads them as traced). Pixels
+/// secretion's surface normals and the clipped pixels are never smoothed: the shading reads them as traced). Pixels
 /// without a hit stay without one (NaN depth, position and normal, no secretion) and give no
 /// weight to those with one.
 pub fn smooth(gbuffer: &GBuffer, radius: usize) -> GBuffer {
@@ -79,6 +79,7 @@ pub fn smooth(gbuffer: &GBuffer, radius: usize) -> GBuffer {
         normal: vec![[0.0; 3]; n],
         secretion_mm: vec![0.0; n],
         secretion_normal: gbuffer.secretion_normal.clone(),
+        clipped: gbuffer.clipped.clone(),
         stats: gbuffer.stats,
     };
     let bands = SmoothBands::new(gbuffer, radius);
