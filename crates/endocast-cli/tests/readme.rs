@@ -223,8 +223,8 @@ fn say(line: &str) {
     let _ = writeln!(std::io::stderr(), "{line}");
 }
 
-/// The scratch folder: `work/` to run in, `shared` beside it (a link to the shared scans'
-/// folder when they are here), and `bin/endocast`.
+/// The scratch folder: `work/` to run in (with a link to the repository's `bench/`), `shared`
+/// beside it (a link to the shared scans' folder when they are here), and `bin/endocast`.
 struct Scratch {
     _dir: tempfile::TempDir,
     work: PathBuf,
@@ -245,6 +245,8 @@ impl Scratch {
             PathBuf::from,
         );
         std::os::unix::fs::symlink(&binary, bin.join("endocast")).unwrap();
+        // README's helper scripts (e.g. bench/tube_obj.py) run as from the repository's root.
+        std::os::unix::fs::symlink(root().join("bench"), work.join("bench")).unwrap();
         let shared = endocast_testdata::shared_data("");
         if let Some(data) = &shared {
             let folder = data.canonicalize().unwrap().parent().unwrap().to_path_buf();
