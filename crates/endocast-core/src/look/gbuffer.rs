@@ -147,22 +147,37 @@ impl RayPass {
             Quality::Full => *camera,
             reduced => reduced_camera(camera, reduced.reduced_size(full)),
         };
-        let with_secretion = self.settings.secretion != SecretionMode::Off;
-        let layers = self.settings.traced_layers();
-        // The look shades the G-buffer itself: the renderer only finds the surfaces.
-        let options = RenderOptions {
-            grid_shift: shift,
-            ..RenderOptions::new().layers(layers).unlit()
-        };
         let mut frame = Frame::default();
         // Nothing cancels it.
-        let _ = self.prepared.render_with(&small, &options, &mut frame);
-        let (secretion, surface) = if with_secretion {
-            self.continue_to_tissue(&small, &mut frame)
+        let _ = self
+            .prepared
+            .render_with(&small, &self.first_options(shift), &mut frame);
+        let mut gbuffer = self.finish(&small, frame, full);
+        gbuffer.stats.time = start.elapsed();
+        gbuffer
+    }
+
+    /// The renderer's options of the first threshold's search, every sample grid shifted by
+    /// `shift` steps: the look shades the G-buffer itself, the renderer only finds the
+    /// surfaces.
+    pub(super) fn first_options(&self, shift: f32) -> RenderOptions<'static> {
+        let layers = self.settings.traced_layers();
+        RenderOptions {
+            grid_shift: shift,
+            ..RenderOptions::new().layers(layers).unlit()
+        }
+    }
+
+    /// The G-buffer of `frame`, the first threshold's search from `camera` (with
+    /// [`Self::first_options`]): each ray carried on to the tissue, and upsampled to `full`
+    /// where `camera` is smaller.
+    pub(super) fn finish(&self, camera: &Camera, mut frame: Frame, full: [usize; 2]) -> GBuffer {
+        let (secretion, surface) = if self.settings.secretion != SecretionMode::Off {
+            self.continue_to_tissue(camera, &mut frame)
         } else {
             (vec![0.0; frame.len()], Vec::new())
         };
-        let mut gbuffer = if quality == Quality::Full {
+        if camera.size() == full {
             GBuffer {
                 secretion_normal: surface,
                 ..into_gbuffer(frame, secretion)
@@ -174,9 +189,7 @@ impl RayPass {
             upsample(&frame, full, &mut upsampled);
             let secretion = std::mem::take(&mut upsampled.value);
             into_gbuffer(upsampled, secretion)
-        };
-        gbuffer.stats.time = start.elapsed();
-        gbuffer
+        }
     }
 
     /// Carries every ray of `frame` (traced by `camera` to its secretion hit) on to the tissue:
