@@ -60,7 +60,8 @@ impl LensArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct StereoArgs {
     /// Render a stereo pair (two off-axis eyes): anaglyph (red/blue, VIVENDI's), red-cyan,
-    /// dubois (colour anaglyph), side-by-side, top-bottom, or pair (OUT-left and OUT-right).
+    /// dubois (colour anaglyph), side-by-side, top-bottom, or pair (OUT-left and OUT-right);
+    /// in any --look, meshes and markers drawn in each eye.
     #[arg(long, value_name = "OUTPUT", value_parser = parse_stereo)]
     pub stereo: Option<StereoOutput>,
     /// Distance between the eyes, mm (default: the focus distance / 30).

@@ -74,3 +74,14 @@ pub fn hit_share(depth: &std::path::Path) -> f64 {
     let hits = values.iter().filter(|d| d.is_finite()).count();
     hits as f64 / values.len() as f64
 }
+
+/// The width and height of a PNG and its pixels as RGB rows.
+pub fn read_png_rgb(path: &std::path::Path) -> ([usize; 2], Vec<u8>) {
+    let file = std::io::BufReader::new(std::fs::File::open(path).unwrap());
+    let mut reader = png::Decoder::new(file).read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb, "{}", path.display());
+    pixels.truncate(info.buffer_size());
+    ([info.width as usize, info.height as usize], pixels)
+}

@@ -1,7 +1,7 @@
 //! `--look`, `--secretion`, `--wetness`, `--texture`, `--attenuation` end to end (issue 20), on
 //! the layered phantom (air | secretion | tissue).
 
-use crate::common::{endocast, fails_with, read_npy};
+use crate::common::{endocast, fails_with, read_npy, read_png_rgb};
 use std::path::{Path, PathBuf};
 
 /// The layered phantom at 40 voxels in `dir`.
@@ -158,11 +158,125 @@ fn geometry_is_drawn_in_the_realistic_look_in_front_and_behind_the_tissue() {
     let behind = render(&volume, &png, &[&look[..], &marker].concat());
     assert_ne!(behind, without);
     assert_eq!(read_npy(&depth).1[16 * 32 + 16], tissue);
-    // A stereo pair is not drawn in a look yet.
-    let stereo = ["--look", "realistic", "--stereo", "anaglyph"];
-    let mut args = vec!["render", volume.to_str().unwrap(), "-o", "/tmp/never.png"];
-    args.extend_from_slice(&stereo);
-    fails_with(&args, "no stereo pair yet");
+}
+
+/// The left and right halves of a side-by-side image (RGB rows `width` wide).
+fn halves(rgb: &[u8], width: usize) -> [Vec<u8>; 2] {
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    for row in rgb.chunks(3 * width) {
+        let (l, r) = row.split_at(3 * width / 2);
+        left.extend_from_slice(l);
+        right.extend_from_slice(r);
+    }
+    [left, right]
+}
+
+/// The mean column of the pixels where `a` and `b` (RGB rows `width` wide) differ, and how
+/// many there are.
+fn mean_column_of_difference(a: &[u8], b: &[u8], width: usize) -> (f64, usize) {
+    let columns: Vec<usize> = a
+        .chunks(3)
+        .zip(b.chunks(3))
+        .enumerate()
+        .filter(|(_, (p, q))| p != q)
+        .map(|(i, _)| i % width)
+        .collect();
+    let n = columns.len();
+    (columns.iter().sum::<usize>() as f64 / n.max(1) as f64, n)
+}
+
+#[test]
+fn a_realistic_stereo_pair_draws_the_mesh_in_each_eye_with_its_parallax() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = layered(dir.path());
+    let png = dir.path().join("pair.png");
+    let mesh = dir.path().join("tip.obj");
+    // Its centre 6.5 mm ahead of the eye, nearer than the focus on the secretion (10 mm).
+    std::fs::write(&mesh, octahedron_obj(-11.0)).unwrap();
+    let stereo = [
+        "--look",
+        "realistic",
+        "--stereo",
+        "side-by-side",
+        "--eye-separation",
+        "2",
+        "--focus",
+        "10",
+        "--fov",
+        "60",
+    ];
+    render(&volume, &png, &stereo);
+    let ([width, height], without) = read_png_rgb(&png);
+    let mesh_arg = ["--mesh", mesh.to_str().unwrap()];
+    render(&volume, &png, &[&stereo[..], &mesh_arg].concat());
+    let (size, with) = read_png_rgb(&png);
+    assert_eq!([width, height], [64, 32]);
+    assert_eq!(size, [64, 32]);
+    let [left, right] = halves(&with, width);
+    let [left_plain, right_plain] = halves(&without, width);
+    assert_ne!(left, right);
+    // The mesh in each eye: where the image differs from the same eye's without it. A point
+    // z mm ahead shifts K·(1/z − 1/focus) pixels between the eyes, K = e / tan(fov/2) · h/2
+    // (55.4 pixel·mm): 3.0 pixels at the centre's 6.5 mm, to the right in the left eye.
+    let (left_x, left_n) = mean_column_of_difference(&left, &left_plain, 32);
+    let (right_x, right_n) = mean_column_of_difference(&right, &right_plain, 32);
+    assert!(left_n > 20 && right_n > 20, "{left_n} and {right_n} pixels");
+    let parallax = left_x - right_x;
+    assert!((2.2..3.8).contains(&parallax), "parallax {parallax} pixels");
+}
+
+#[test]
+fn a_flight_in_the_realistic_look_films_stereo_pairs() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = layered(dir.path());
+    let route = dir.path().join("route.json");
+    std::fs::write(
+        &route,
+        r#"{"format": "endocast-path", "version": 1, "coordinate_system": "LPS", "units": "mm", "points": [[0, 0, -17], [0, 0, -13]]}"#,
+    )
+    .unwrap();
+    let fly = |look: &str| {
+        let frames = dir.path().join(look);
+        let out = endocast(&[
+            "fly",
+            volume.to_str().unwrap(),
+            "--path",
+            route.to_str().unwrap(),
+            "-o",
+            frames.to_str().unwrap(),
+            "--preset",
+            "sinus",
+            "--look",
+            look,
+            "--stereo",
+            "side-by-side",
+            "--size",
+            "24x24",
+            "--frame-step",
+            "4",
+            "--threads",
+            "2",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut pngs: Vec<_> = std::fs::read_dir(&frames)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        pngs.sort();
+        pngs.iter().map(|p| read_png_rgb(p)).collect::<Vec<_>>()
+    };
+    let (realistic, plain) = (fly("realistic"), fly("plain"));
+    assert!(realistic.len() >= 2);
+    for ((size, rgb), (_, plain)) in realistic.iter().zip(&plain) {
+        assert_eq!(*size, [48, 24]);
+        let [left, right] = halves(rgb, 48);
+        assert_ne!(left, right);
+        assert_ne!(rgb, plain);
+    }
 }
 
 #[test]

@@ -184,6 +184,8 @@ pub enum RenderKind {
     Look(Layers),
     /// A stereo pair of the plain look, written as one image or two.
     Stereo,
+    /// A stereo pair of a two-stage look whose ray pass renders frames with these layers.
+    LookStereo(Layers),
 }
 
 /// The bytes the PNG or JPEG encoder holds a pixel of the image it writes: its filtered copy
@@ -195,11 +197,12 @@ pub const ENCODER_BYTES_PER_PIXEL: u64 = 2 * Image::BYTES_PER_PIXEL as u64;
 pub const MARGIN_BYTES_PER_PIXEL: u64 = 4;
 
 impl RenderKind {
-    /// The kind of a view drawn with a two-stage `look`, or else a stereo pair (`stereo`), or
-    /// else the plain look without optional layers.
+    /// The kind of a view drawn with a two-stage `look` (a pair with `stereo`), or else a
+    /// stereo pair (`stereo`), or else the plain look without optional layers.
     pub fn of(look: Option<&Look>, stereo: bool) -> Self {
         match (look, stereo) {
-            (Some(look), _) => Self::Look(look.ray.traced_layers()),
+            (Some(look), false) => Self::Look(look.ray.traced_layers()),
+            (Some(look), true) => Self::LookStereo(look.ray.traced_layers()),
             (None, true) => Self::Stereo,
             (None, false) => Self::Plain(Layers::NONE),
         }
@@ -217,6 +220,8 @@ impl RenderKind {
     /// - stereo: the left eye's frame beside the right one being rendered and the start-up
     ///   the right eye reuses, or both frames, their 8-bit images and the combined image (side
     ///   by side: two) with the encoder's copies;
+    /// - a look's stereo pair: a look's peak beside the other eye's still mean and frame,
+    ///   its first-pass frame and the start-up, or the stereo pair's writing;
     ///
     /// and for every kind at least the frame, its 8-bit image and the encoder's copies. After
     /// a render with optional layers, the tiles' memory (two small blocks a tile) is counted as
@@ -227,6 +232,8 @@ impl RenderKind {
         let rendering = |layers| per_pixel(Frame::rendering_bytes_per_pixel(layers));
         let image = per_pixel(Image::BYTES_PER_PIXEL);
         let written = image + ENCODER_BYTES_PER_PIXEL;
+        let stereo_written = 2 * frame + 2 * image + 2 * written;
+        let start_up = per_pixel(StereoFrames::SCRATCH_BYTES_PER_PIXEL);
         let peak = match self {
             Self::Plain(layers) => {
                 let with_layers = per_pixel(Frame::bytes_per_pixel(layers));
@@ -240,9 +247,13 @@ impl RenderKind {
                 frame + rendering(traced).max(after)
             }
             Self::Stereo => {
-                let start_up = per_pixel(StereoFrames::SCRATCH_BYTES_PER_PIXEL);
                 let rendering = frame + rendering(Layers::NONE) + start_up;
-                rendering.max(2 * frame + 2 * image + 2 * written)
+                rendering.max(stereo_written)
+            }
+            Self::LookStereo(traced) => {
+                let one_eye = Self::Look(traced).bytes_per_pixel();
+                let first_pass = per_pixel(Frame::bytes_per_pixel(traced));
+                (one_eye + 2 * frame + first_pass + start_up).max(stereo_written)
             }
         };
         peak.max(frame + written) + MARGIN_BYTES_PER_PIXEL
@@ -394,6 +405,11 @@ mod tests {
         let rendering = bytes(Frame::rendering_bytes_per_pixel(Layers::NONE));
         assert!(stereo >= frame + rendering + start_up);
         assert!(stereo >= 2 * frame + 4 * image + 2 * ENCODER_BYTES_PER_PIXEL);
+        for layers in traced {
+            let look = RenderKind::Look(layers).bytes_per_pixel();
+            let pair = RenderKind::LookStereo(layers).bytes_per_pixel();
+            assert!(pair >= look + 2 * frame + start_up && pair >= stereo);
+        }
     }
 
     #[test]
@@ -414,6 +430,7 @@ mod tests {
             RenderKind::Look(Layers::NONE),
             without_secretion,
             RenderKind::Stereo,
+            RenderKind::LookStereo(Layers::NONE),
         ] {
             assert!(short.check_frames(p, [4000, 4000], kind, 1).is_err());
         }

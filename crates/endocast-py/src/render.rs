@@ -6,7 +6,7 @@ use crate::look::{camera, LookOptions, Placed};
 use crate::scene::{warn, SceneFiles};
 use crate::volume::Volume;
 use endocast_core::camera::StereoRig;
-use endocast_core::look::{still_view, MAX_STILL_FRAMES};
+use endocast_core::look::{stereo_view, still_view, Look, MAX_STILL_FRAMES};
 use endocast_core::render::{Camera, Frame, Prepared};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
@@ -55,7 +55,8 @@ struct View {
 ///   (width, height; default 512 × 512), `lens` (pinhole, equidistant, equisolid,
 ///   orthographic), `distortion` (k1, k2), `vignetting`;
 /// - stereo: `stereo` (anaglyph, red-cyan, dubois, side-by-side, top-bottom, pair),
-///   `eye_separation`, `focus` (mm);
+///   `eye_separation`, `focus` (mm), in any look (the geometry drawn in each eye, `still`
+///   averaging each eye);
 /// - depth peeling (`mode="peel"`): `peel` (1, 2, 3 … or "last"), `peel_threshold`,
 ///   `peel_falling`, `peel_keep` (0–1), `unpeeled` (discard, context), `tf_after`;
 /// - the endoscope's look: `look` (plain, clinical, realistic; default the preset's),
@@ -88,11 +89,6 @@ pub fn render<'py>(
             "still must be between 1 and {MAX_STILL_FRAMES} frames, not {still}"
         )));
     }
-    if look.look.is_some() && stereo.is_some() {
-        return Err(error(
-            "the clinical and realistic looks draw no stereo pair yet; use look=\"plain\"",
-        ));
-    }
     let kind = RenderKind::of(look.look.as_ref(), stereo.is_some());
     Limits::default()
         .check_frames(Path::new("size"), camera.size(), kind, 1)
@@ -110,7 +106,9 @@ pub fn render<'py>(
                 Ok((single(&frame, look.settings.background), partial))
             }
             Some(stereo) => {
-                let view = look.in_pool(|| render_stereo(&prepared, &camera, stereo))?;
+                let view = look.in_pool(|| {
+                    render_stereo(&prepared, look.look.as_ref(), (&camera, stereo), still)
+                })?;
                 Ok((view, partial))
             }
         }
@@ -180,12 +178,18 @@ fn single(frame: &Frame, background: [f32; 3]) -> View {
     }
 }
 
-/// Both eyes of `camera`, combined as `stereo.output` says (a pair stays two images).
-fn render_stereo(prepared: &Prepared, camera: &Camera, stereo: &Stereo) -> PyResult<View> {
+/// Both eyes of `camera` in `look` (`None`: plain), each the average of `still` frames,
+/// combined as `stereo.output` says (a pair stays two images).
+fn render_stereo(
+    prepared: &Prepared,
+    look: Option<&Look>,
+    (camera, stereo): (&Camera, &Stereo),
+    still: usize,
+) -> PyResult<View> {
     let nearest = || prepared.nearest_surface_mm(camera);
     let rig =
         StereoRig::for_view(stereo.eye_separation_mm, stereo.focus_mm, nearest).map_err(to_py)?;
-    let [left, right] = prepared.render_stereo(camera, &rig).map_err(to_py)?;
+    let [left, right] = stereo_view(prepared, look, (camera, &rig), still).map_err(to_py)?;
     let background = prepared.settings().background;
     if stereo.output == StereoOutput::Pair {
         let (l, r) = (single(&left, background), single(&right, background));

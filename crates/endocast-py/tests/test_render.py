@@ -62,6 +62,32 @@ def test_a_stereo_pair_is_two_images(volume):
     assert not np.array_equal(rgba[0], rgba[1])
 
 
+def octahedron_obj(centre, r):
+    """A closed octahedron of half-diagonal `r` mm around `centre`, as OBJ text."""
+    corners = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+    lines = [f"v {centre[0] + r * x} {centre[1] + r * y} {centre[2] + r * z}"
+             for x, y, z in corners]
+    for a, b in [(1, 3), (3, 2), (2, 4), (4, 1)]:
+        lines += [f"f {a} {b} 5", f"f {b} {a} 6"]
+    return "\n".join(lines) + "\n"
+
+
+def test_a_realistic_stereo_pair_with_a_mesh_equals_the_cli(volume, colon, cli, tmp_path):
+    eye, look_at, _ = endocast.default_view(volume, preset="colonoscopy")
+    eye, look_at = np.array(eye), np.array(look_at)
+    ahead = (look_at - eye) / np.linalg.norm(look_at - eye)
+    mesh = tmp_path / "marker.obj"
+    mesh.write_text(octahedron_obj(eye + 6 * ahead, 1.5))
+    png = tmp_path / "cli.png"
+    cli("render", colon, "--size", "48x40", "-o", png, "--preset", "colonoscopy", "--look",
+        "realistic", "--stereo", "side-by-side", "--mesh", mesh)
+    rgba, depth = endocast.render(volume, size=(48, 40), preset="colonoscopy", look="realistic",
+                                  stereo="side-by-side", meshes=[str(mesh)])
+    assert rgba.shape == (40, 96, 4) and depth.shape == (40, 48)
+    np.testing.assert_array_equal(rgba[..., :3], read_png_rgb(png))
+    assert not np.array_equal(rgba[:, :48], rgba[:, 48:])
+
+
 def test_path_equals_the_cli(volume, colon, cli, tmp_path):
     out = tmp_path / "path.json"
     eye, _, _ = endocast.default_view(volume, preset="colonoscopy")

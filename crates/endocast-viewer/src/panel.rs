@@ -255,12 +255,7 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
                 ui.selectable_value(&mut c.look, kind, kind.name());
             }
         });
-    let stereo = if c.look == LookKind::Plain {
-        "stereo (red/cyan anaglyph)"
-    } else {
-        "stereo (red/cyan; not with this look)"
-    };
-    ui.checkbox(&mut c.stereo, stereo);
+    ui.checkbox(&mut c.stereo, "stereo (red/cyan anaglyph)");
     if c.mode == Mode::Peel {
         peel_ui(ui, &mut c.peel, c.iso_hu, (lo, hi));
     }

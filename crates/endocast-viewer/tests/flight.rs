@@ -135,19 +135,7 @@ fn stereo_shows_an_anaglyph_of_two_shifted_eyes() {
         .wait_for(g, Duration::from_secs(30), |f| f.stage == Stage::Full)
         .unwrap();
     assert_eq!([stereo.image.width(), stereo.image.height()], [64, 64]);
-    // Red from the left eye, green and blue from the right: each channel differs from the
-    // centre eye's somewhere.
-    let channel_differs = |c: usize| {
-        mono.image
-            .rgb()
-            .chunks(3)
-            .zip(stereo.image.rgb().chunks(3))
-            .any(|(m, s)| m[c].abs_diff(s[c]) > 8)
-    };
-    assert!(
-        channel_differs(0) && channel_differs(1),
-        "not two shifted eyes"
-    );
+    assert!(two_shifted_eyes(&mono, &stereo), "not two shifted eyes");
     // The focus stays with the pose: once the pair is at full quality no new view follows.
     session.sync(false);
     let g = session.worker().generation();
@@ -164,6 +152,35 @@ fn stereo_shows_an_anaglyph_of_two_shifted_eyes() {
         );
     }
     assert_eq!(session.worker().generation(), g);
+}
+
+/// Whether `stereo` is an anaglyph of eyes on either side of `mono`'s: red from the left eye,
+/// green and blue from the right, each channel differing from the centre eye's somewhere.
+fn two_shifted_eyes(
+    mono: &endocast_viewer::worker::Delivered,
+    stereo: &endocast_viewer::worker::Delivered,
+) -> bool {
+    let channel_differs = |c: usize| {
+        mono.image
+            .rgb()
+            .chunks(3)
+            .zip(stereo.image.rgb().chunks(3))
+            .any(|(m, s)| m[c].abs_diff(s[c]) > 8)
+    };
+    channel_differs(0) && channel_differs(1)
+}
+
+#[test]
+fn the_realistic_look_in_stereo_shows_an_anaglyph_of_two_shifted_eyes() {
+    use endocast_core::look::LookKind;
+    let (mut session, _) = tube_session();
+    session.turn(0.0, 0.6);
+    session.controls.look = LookKind::Realistic;
+    let mono = settled(&mut session);
+    session.controls.stereo = true;
+    let stereo = settled(&mut session);
+    assert_eq!([stereo.image.width(), stereo.image.height()], [64, 64]);
+    assert!(two_shifted_eyes(&mono, &stereo), "not two shifted eyes");
 }
 
 #[test]

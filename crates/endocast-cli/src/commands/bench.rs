@@ -158,9 +158,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let pass =
                 RayPass::new(&renderer, &cell.settings, &look.ray).context("invalid look")?;
             let stages = (&pass, &look.shading, scene.as_deref());
-            let timed = in_pool(args.look.threads, || {
-                measure_look(stages, args.quality, &cameras)
-            })??;
+            let timed = in_pool(args.look.threads, || measure_look(stages, args, &cameras))??;
             report(args, optics.field, &cell.name, &timed.whole, None)?;
             let name = format!("{}: its deferred stage alone", cell.name);
             report(args, optics.field, &name, &timed.deferred, None)?;
@@ -168,6 +166,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 let name = format!("{}: its deferred stage with the geometry", cell.name);
                 report(args, optics.field, &name, geometry, None)?;
             }
+            let label = ("stereo pair", "pair ÷ one eye", "pair_over_one_eye");
+            report_against(args, optics.field, &cell.name, timed.pair, label)?;
+            let label = (
+                "stereo pair, eyes traced apart",
+                "apart ÷ one eye",
+                "apart_over_one_eye",
+            );
+            report_against(args, optics.field, &cell.name, timed.apart, label)?;
             continue;
         }
         let mut prepared = renderer
@@ -208,23 +214,36 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             ),
         ];
         for (paired, suffix, label, key) in against {
-            let Some((measured, mut ratios)) = paired else {
-                continue;
-            };
-            ratios.sort_by(f64::total_cmp);
-            let name = format!("{}, {suffix}", cell.name);
-            report(args, optics.field, &name, &measured, Some((key, &ratios)))?;
-            say(
-                table,
-                &format!(
-                    "|   {label}, median of the frames (min–max) | {:.3} ({:.2}–{:.2}) | | | | |",
-                    ratios[ratios.len() / 2],
-                    ratios[0],
-                    ratios[ratios.len() - 1]
-                ),
-            );
+            report_against(args, optics.field, &cell.name, paired, (suffix, label, key))?;
         }
     }
+    Ok(())
+}
+
+/// Reports `paired`, the timings of `cell`'s frames rendered another way (`suffix`), and the
+/// median and range of their per-frame ratios (`label`, JSON `key`); nothing without them.
+fn report_against(
+    args: &BenchArgs,
+    fov_deg: f64,
+    cell: &str,
+    paired: Option<(Measured, Vec<f64>)>,
+    (suffix, label, key): (&str, &str, &str),
+) -> Result<()> {
+    let Some((measured, mut ratios)) = paired else {
+        return Ok(());
+    };
+    ratios.sort_by(f64::total_cmp);
+    let name = format!("{cell}, {suffix}");
+    report(args, fov_deg, &name, &measured, Some((key, &ratios)))?;
+    say(
+        !args.json,
+        &format!(
+            "|   {label}, median of the frames (min–max) | {:.3} ({:.2}–{:.2}) | | | | |",
+            ratios[ratios.len() / 2],
+            ratios[0],
+            ratios[ratios.len() - 1]
+        ),
+    );
     Ok(())
 }
 
@@ -343,27 +362,38 @@ fn render_reusing(
     ms
 }
 
-/// The timings of a look along the path: whole frames, their deferred stage alone, and with
-/// geometry that deferred stage with the geometry composited.
+/// The timings of a look along the path: whole frames, their deferred stage alone, with
+/// geometry that deferred stage with the geometry composited, and with `--stereo` the stereo
+/// pairs (with the per-frame ratio of a pair's time to one eye's).
 struct LookTimed {
     whole: Measured,
     deferred: Measured,
     geometry: Option<Measured>,
+    pair: Option<(Measured, Vec<f64>)>,
+    /// The same pairs with each eye traced and shaded alone (no search shared).
+    apart: Option<(Measured, Vec<f64>)>,
 }
 
-/// Renders every camera with a look's ray `pass` at `quality` and shades it as `shading` says
-/// (below full quality both stages at the reduced size, the shaded frame upsampled); with a
-/// `scene` (full quality only) also shades each G-buffer again with the scene composited.
+/// Renders every camera with a look's ray `pass` at `--quality` and shades it as `shading`
+/// says (below full quality both stages at the reduced size, the shaded frame upsampled);
+/// with a `scene` (full quality only) also shades each G-buffer again with the scene
+/// composited; with `--stereo` (full quality only) also renders each camera as the look's
+/// stereo pair right after it, without the scene as the whole frame is
+/// ([`look::stereo_frame`], its eyes' searches shared).
 fn measure_look(
     (pass, shading, scene): (&RayPass, &Shading, Option<&Scene>),
-    quality: Quality,
+    args: &BenchArgs,
     cameras: &[Camera],
 ) -> Result<LookTimed> {
-    if scene.is_some() && quality != Quality::Full {
-        bail!("bench times a look's geometry at --quality full only");
+    let quality = args.quality;
+    if (scene.is_some() || args.stereo.stereo.is_some()) && quality != Quality::Full {
+        bail!("bench times a look's geometry and stereo pairs at --quality full only");
     }
     let (mut whole, mut deferred) = (Measured::default(), Measured::default());
     let mut geometry = scene.map(|_| Measured::default());
+    let stereo = args.stereo.stereo.is_some();
+    let mut pair = stereo.then(|| (Paired::default(), StereoFrames::default()));
+    let mut apart = stereo.then(Paired::default);
     for camera in cameras {
         let start = Instant::now();
         let small = reduced_camera(camera, quality.reduced_size(camera.size()));
@@ -379,12 +409,54 @@ fn measure_look(
             look::shade_with_scene(&gbuffer, camera, shading, scene).context("invalid look")?;
             measured.ms.push(start.elapsed().as_secs_f64() * 1e3);
         }
+        if let (Some((shared, frames)), Some(apart)) = (&mut pair, &mut apart) {
+            let one_ms = whole.ms.last().copied().unwrap_or(f64::NAN);
+            let nearest = || pass.prepared().nearest_surface_mm(camera);
+            let rig = StereoRig::for_view(args.stereo.eye_separation, args.stereo.focus, nearest)
+                .context("invalid --stereo options")?;
+            let start = Instant::now();
+            let eyes = look::stereo_frame(pass, (camera, &rig), shading, None, 0, frames)
+                .context("invalid stereo camera or look")?;
+            let samples = eyes[0].stats.samples + eyes[1].stats.samples;
+            shared.add(start.elapsed(), samples, one_ms);
+            let start = Instant::now();
+            let mut samples = 0;
+            for eye in rig.eyes(camera).context("invalid stereo camera")? {
+                let gbuffer = pass.trace(&eye, Quality::Full);
+                look::shade(&gbuffer, &eye, shading).context("invalid look")?;
+                samples += gbuffer.stats.samples;
+            }
+            apart.add(start.elapsed(), samples, one_ms);
+        }
     }
     Ok(LookTimed {
         whole,
         deferred,
         geometry,
+        pair: pair.map(|(shared, _)| shared.into_parts()),
+        apart: apart.map(Paired::into_parts),
     })
+}
+
+/// Timings of frames rendered another way and their per-frame ratios to one eye's.
+#[derive(Default)]
+struct Paired {
+    measured: Measured,
+    ratios: Vec<f64>,
+}
+
+impl Paired {
+    /// Adds a frame that took `time` and `samples`, against one eye's `one_ms`.
+    fn add(&mut self, time: std::time::Duration, samples: u64, one_ms: f64) {
+        let ms = time.as_secs_f64() * 1e3;
+        self.measured.ms.push(ms);
+        self.measured.samples += samples;
+        self.ratios.push(ms / one_ms);
+    }
+
+    fn into_parts(self) -> (Measured, Vec<f64>) {
+        (self.measured, self.ratios)
+    }
 }
 
 /// A `--quality` level by name.

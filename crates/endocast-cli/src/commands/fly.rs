@@ -168,9 +168,6 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
     let scene = args.scene.scene()?;
-    if look.is_some() && stereo.is_some() {
-        bail!("--look clinical and realistic draw no stereo pair yet; use --look plain");
-    }
     flight.set_scene(scene);
     flight.set_look(look);
     flight.set_annotations(marks);

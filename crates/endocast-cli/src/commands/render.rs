@@ -62,7 +62,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE.npy")]
     depth_out: Option<PathBuf>,
     /// Average this many jittered frames (sub-pixel offsets, shifted sample grids): a
-    /// converged still without sampling bands or stair-stepped edges.
+    /// converged still without sampling bands or stair-stepped edges (with --stereo, each eye).
     #[arg(long, value_name = "FRAMES", default_value_t = 1)]
     still: usize,
     /// Print the frame's statistics and the camera pose it used as JSON.
@@ -116,9 +116,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .prepare(settings)
         .context("invalid render settings")?;
     let scene = args.scene.scene()?;
-    if look.look.is_some() && args.stereo.stereo.is_some() {
-        bail!("--look clinical and realistic draw no stereo pair yet; use --look plain");
-    }
     prepared.set_scene(scene);
     if let Some([x, y]) = args.debug_pixel {
         print_trace(&prepared, &camera, x, y)?;
@@ -126,8 +123,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let stereo = args.stereo.rig(|| prepared.nearest_surface_mm(&camera))?;
     let frame = match stereo {
         Some((rig, output)) => {
-            let frames = in_pool(args.look.threads, || prepared.render_stereo(&camera, &rig))?
-                .context("invalid stereo rig")?;
+            let frames = in_pool(args.look.threads, || {
+                look::stereo_view(&prepared, look.look.as_ref(), (&camera, &rig), args.still)
+            })?
+            .context("invalid stereo rig or look")?;
             write_stereo(&args.output, &frames, output, settings.background)?;
             eprintln!(
                 "stereo: eye separation {:.2} mm, focus {:.1} mm",

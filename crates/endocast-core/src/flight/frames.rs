@@ -6,7 +6,7 @@ use super::Shot;
 use crate::annotate::{self, Annotations, DrawOptions, SurfaceView};
 use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
-use crate::look::{shade_with_scene, Look, RayPass};
+use crate::look::{shade_with_scene, stereo_frame, Look, RayPass};
 use crate::render::{
     Camera, Frame, Prepared, Quality, RenderSettings, RenderStats, Renderer, StereoFrames,
 };
@@ -108,8 +108,8 @@ impl Flight {
     }
 
     /// Shows the endoscope frames in `look` (clinical or realistic; `None`: the renderer's own
-    /// image) from now on, the scene composited into them by depth. A look draws no stereo
-    /// pair: those frames stay plain.
+    /// image) from now on, the scene composited into them by depth (in each eye of a stereo
+    /// pair).
     pub fn set_look(&mut self, look: Option<Look>) {
         self.look = look;
         self.look_pass = None;
@@ -255,7 +255,17 @@ impl Flight {
                 let rig = StereoRig::for_view(stereo.eye_separation_mm, stereo.focus_mm, || {
                     prepared.nearest_surface_mm(&camera)
                 })?;
-                prepared.render_stereo_into(&camera, &rig, &mut self.frames)?;
+                match &self.look {
+                    Some(look) => {
+                        let slot = &mut self.look_pass;
+                        let pass = look_pass(slot, &self.renderer, settings, look)?;
+                        let (scene, pair) = (self.scene.as_deref(), &mut self.frames);
+                        let eyes =
+                            stereo_frame(pass, (&camera, &rig), &look.shading, scene, 0, pair);
+                        pair.eyes = eyes?;
+                    }
+                    None => prepared.render_stereo_into(&camera, &rig, &mut self.frames)?,
+                }
                 let [left, right] = &self.frames.eyes;
                 let background = settings.background;
                 let cameras = rig.eyes(&camera)?;

@@ -153,22 +153,38 @@ impl RayPass {
             Quality::Full => *camera,
             reduced => reduced_camera(camera, reduced.reduced_size(full)),
         };
-        let with_secretion = self.settings.secretion != SecretionMode::Off;
-        let layers = self.settings.traced_layers();
-        // The look shades the G-buffer itself: the renderer only finds the surfaces.
-        let options = RenderOptions {
-            grid_shift: shift,
-            ..RenderOptions::new().layers(layers).unlit()
-        };
         let mut frame = Frame::default();
         // Nothing cancels it.
-        let _ = self.prepared.render_with(&small, &options, &mut frame);
-        let (secretion, surface) = if with_secretion {
-            self.continue_to_tissue(&small, &mut frame)
+        let _ = self
+            .prepared
+            .render_with(&small, &self.first_options(shift), &mut frame);
+        let mut gbuffer = self.finish(&small, frame, camera);
+        gbuffer.stats.time = start.elapsed();
+        gbuffer
+    }
+
+    /// The renderer's options of the first threshold's search, every sample grid shifted by
+    /// `shift` steps: the look shades the G-buffer itself, the renderer only finds the
+    /// surfaces.
+    pub(super) fn first_options(&self, shift: f32) -> RenderOptions<'static> {
+        let layers = self.settings.traced_layers();
+        RenderOptions {
+            grid_shift: shift,
+            ..RenderOptions::new().layers(layers).unlit()
+        }
+    }
+
+    /// The G-buffer of `frame`, the first threshold's search from `camera` (with
+    /// [`Self::first_options`]): each ray carried on to the tissue, upsampled to the size of
+    /// `full` (the camera at full size) where `camera` is smaller, and the pixels of `full`
+    /// whose rays start inside the tissue marked.
+    pub(super) fn finish(&self, camera: &Camera, mut frame: Frame, full: &Camera) -> GBuffer {
+        let (secretion, surface) = if self.settings.secretion != SecretionMode::Off {
+            self.continue_to_tissue(camera, &mut frame)
         } else {
             (vec![0.0; frame.len()], Vec::new())
         };
-        let mut gbuffer = if quality == Quality::Full {
+        let mut gbuffer = if camera.size() == full.size() {
             GBuffer {
                 secretion_normal: surface,
                 ..into_gbuffer(frame, secretion)
@@ -177,12 +193,11 @@ impl RayPass {
             // The value layer (NaN in iso mode) carries the secretion through the upsampling.
             frame.value = secretion;
             let mut upsampled = Frame::default();
-            upsample(&frame, full, &mut upsampled);
+            upsample(&frame, full.size(), &mut upsampled);
             let secretion = std::mem::take(&mut upsampled.value);
             into_gbuffer(upsampled, secretion)
         };
-        gbuffer.clipped = clipped_pixels(self.prepared.renderer(), camera, &self.settings);
-        gbuffer.stats.time = start.elapsed();
+        gbuffer.clipped = clipped_pixels(self.prepared.renderer(), full, &self.settings);
         gbuffer
     }
 

@@ -6,14 +6,14 @@ use super::*;
 use crate::camera::Ray;
 use crate::phantom::profile::{paint, ramp, AIR_HU, TISSUE_HU};
 use crate::phantom::{rasterize, PhantomOptions, SECRETION_HU};
-use crate::render::{Camera, Quality, RenderSettings, Renderer};
+use crate::render::{Camera, Frame, Quality, RenderSettings, Renderer};
 use crate::scene::{Marker, Material, Scene, TriangleMesh};
 use crate::Volume;
 use glam::DVec3;
 use std::sync::Arc;
 
 /// The wall's surface (the mid-value of its ramp), `k` index: tissue beyond.
-const WALL_K: f64 = 20.0;
+pub(super) const WALL_K: f64 = 20.0;
 /// Pixels across the test image.
 const SIZE: usize = 48;
 
@@ -33,11 +33,22 @@ pub(super) fn wall(secretion: bool) -> Volume {
     })
 }
 
-/// The G-buffer of `volume` seen from voxel (15.5, 15.5, 2) along +k, the rays stopping at
-/// the air/tissue mid-value (the wall's surface) and finding secretion as `secretion` says.
+/// The G-buffer of `volume` seen from [`camera`], the rays stopping at the air/tissue
+/// mid-value (the wall's surface) and finding secretion as `secretion` says.
 fn traced(volume: Volume, secretion: SecretionMode) -> (GBuffer, Camera, Volume) {
+    let camera = camera(&volume);
+    let pass = ray_pass(&volume, secretion);
+    (pass.trace(&camera, Quality::Full), camera, volume)
+}
+
+/// A camera at voxel (15.5, 15.5, 2) of `volume` looking along +k at the wall.
+pub(super) fn camera(volume: &Volume) -> Camera {
     let eye = volume.geometry().world_of(DVec3::new(15.5, 15.5, 2.0));
-    let camera = Camera::look_at(eye, eye + DVec3::Z, DVec3::Y, 40.0, [SIZE, SIZE]).unwrap();
+    Camera::look_at(eye, eye + DVec3::Z, DVec3::Y, 40.0, [SIZE, SIZE]).unwrap()
+}
+
+/// The ray pass over `volume` stopping at the wall's surface, with `secretion`.
+pub(super) fn ray_pass(volume: &Volume, secretion: SecretionMode) -> RayPass {
     // The mid-values of the wall's edge and of the layer's top.
     let settings = RayPassSettings {
         tissue_hu: match secretion {
@@ -49,13 +60,12 @@ fn traced(volume: Volume, secretion: SecretionMode) -> (GBuffer, Camera, Volume)
         ..RayPassSettings::default()
     };
     let renderer = Arc::new(Renderer::new(volume.clone()));
-    let pass = RayPass::new(&renderer, &RenderSettings::default(), &settings).unwrap();
-    (pass.trace(&camera, Quality::Full), camera, volume)
+    RayPass::new(&renderer, &RenderSettings::default(), &settings).unwrap()
 }
 
 /// Red tissue, green secretion (a thin fog: 5 mm veil 63 %), no texture, fall-off or smoothing
 /// (depths stay exact).
-fn red_and_green() -> Shading {
+pub(super) fn red_and_green() -> Shading {
     Shading {
         fog_mm: 5.0,
         tissue_color: [1.0, 0.0, 0.0],
@@ -67,7 +77,7 @@ fn red_and_green() -> Shading {
 }
 
 /// An opaque blue sphere of `radius` mm centred at voxel `(15.5, 15.5, k)` of `volume`.
-fn blue_sphere(volume: &Volume, k: f64, radius: f64) -> (Scene, DVec3, f64) {
+pub(super) fn blue_sphere(volume: &Volume, k: f64, radius: f64) -> (Scene, DVec3, f64) {
     let centre = volume.geometry().world_of(DVec3::new(15.5, 15.5, k));
     let mut scene = Scene::new();
     let blue = Material::new([0.0, 0.0, 1.0], 1.0).unwrap();
@@ -94,6 +104,21 @@ fn a_sphere_through_the_wall_is_solid_in_front_and_stippled_behind() {
     let shading = red_and_green();
     let plain = shade(&gbuffer, &camera, &shading).unwrap();
     let with = shade_with_scene(&gbuffer, &camera, &shading, Some(&scene)).unwrap();
+    let counts = sphere_through_wall(&camera, [&plain, &with], &volume, (centre, radius));
+    assert!(counts.iter().all(|&n| n > 40), "{counts:?}");
+}
+
+/// Checks `with`, the look's frame `plain` of [`wall`]`(false)` in `volume` seen by `camera`
+/// with a sphere (`centre`, `radius`) composited, pixel by pixel against the depths along
+/// `camera`'s rays: solid where the sphere lies in front of the wall, on the stipple where it
+/// lies behind, the look's own pixel elsewhere. Returns how many pixels show it in front,
+/// behind, hide it behind, and miss it.
+pub(super) fn sphere_through_wall(
+    camera: &Camera,
+    [plain, with]: [&Frame; 2],
+    volume: &Volume,
+    (centre, radius): (DVec3, f64),
+) -> [usize; 4] {
     let wall_z = volume.geometry().world_of(DVec3::new(0.0, 0.0, WALL_K)).z;
     let mut counts = [0; 4]; // in front, behind shown, behind hidden, elsewhere
     for y in 0..SIZE {
@@ -135,7 +160,7 @@ fn a_sphere_through_the_wall_is_solid_in_front_and_stippled_behind() {
             }
         }
     }
-    assert!(counts.iter().all(|&n| n > 40), "{counts:?}");
+    counts
 }
 
 #[test]

@@ -19,6 +19,9 @@
 //!    layer's thickness. Changing any of it never marches a ray again:
 //!    [`shade`] takes a `&GBuffer` and no renderer.
 //!
+//! [`stereo_view`] draws a look's stereo pair (each eye the look's mono image from that eye,
+//! the eyes' searches shared as the renderer's stereo pair shares them).
+//!
 //! [`shade_with_scene`] composites scene geometry (meshes, overlays, markers, the grid, the
 //! instruments) into the shaded frame by depth, as the paper's composition does its polygonal
 //! data: solid in front of the tissue, through a stipple behind it, veiled only by the
@@ -69,6 +72,7 @@ mod secretion;
 mod settings;
 mod shading;
 pub mod smooth;
+mod stereo;
 mod still;
 mod texture;
 
@@ -79,6 +83,8 @@ mod deferred_tests;
 #[cfg(test)]
 mod geometry_tests;
 #[cfg(test)]
+mod stereo_tests;
+#[cfg(test)]
 mod tests;
 
 pub use deferred::shade;
@@ -88,6 +94,7 @@ pub use kind::{Look, LookKind, PresetLook};
 pub use reduced::{shade_reduced, shade_reduced_with_scene};
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;
+pub use stereo::{stereo_frame, stereo_still, stereo_view};
 pub use still::{still, still_frame, still_view, MAX_STILL_FRAMES};
 pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, MAX_TEXELS};
 
@@ -118,6 +125,9 @@ pub enum LookError {
     /// The renderer's settings cannot be rendered.
     #[error(transparent)]
     Settings(#[from] crate::render::SettingsError),
+    /// The camera or the stereo rig has no eyes.
+    #[error(transparent)]
+    Camera(#[from] crate::camera::CameraError),
 }
 
 /// `Ok` when `value` is finite and `ok`, else [`LookError::OutOfRange`].

@@ -131,17 +131,33 @@ impl Prepared {
         rig: &StereoRig,
         pair: &mut StereoFrames,
     ) -> Result<(), CameraError> {
+        self.render_stereo_with(camera, rig, &RenderOptions::new(), pair)
+    }
+
+    /// [`Self::render_stereo_into`] with each eye rendered as `options` ask (their layers,
+    /// grid shift, unlit; a cancel flag in them is not watched): a look's ray pass shares the
+    /// right eye's search starts this way.
+    pub(crate) fn render_stereo_with(
+        &self,
+        camera: &Camera,
+        rig: &StereoRig,
+        options: &RenderOptions<'_>,
+        pair: &mut StereoFrames,
+    ) -> Result<(), CameraError> {
         let [left, right] = rig.eyes(camera)?;
         let [left_frame, right_frame] = &mut pair.eyes;
-        self.render_into(&left, left_frame);
+        let options = RenderOptions {
+            cancel: None,
+            ..*options
+        };
+        // Without a cancel flag nothing can cancel them.
+        let _ = self.render_with(&left, &options, left_frame);
         if self.shares_emptiness(&left, &right) {
             let starts = &mut pair.starts;
             self.search_starts((&left, left_frame), &right, rig, starts);
-            let options = RenderOptions::new().search_starts(starts);
-            // Without a cancel flag nothing can cancel it.
-            let _ = self.render_with(&right, &options, right_frame);
+            let _ = self.render_with(&right, &options.search_starts(starts), right_frame);
         } else {
-            self.render_into(&right, right_frame);
+            let _ = self.render_with(&right, &options, right_frame);
         }
         Ok(())
     }

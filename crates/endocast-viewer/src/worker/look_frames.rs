@@ -1,13 +1,19 @@
 //! The endoscope's clinical or realistic look in the workstation: the look's ray pass (kept
 //! while its settings stay) traced at half resolution while the camera moves, then the full
-//! frame, both with the view's geometry composited, then jittered frames averaged into a still, each
-//! level delivered as it finishes; a new view stops it between levels and between still frames.
+//! frame, both with the view's geometry composited, then jittered frames averaged into a still,
+//! each level delivered as it finishes (with stereo on, both eyes as a red/cyan anaglyph); a
+//! new view stops it between levels and between still frames.
 
 use super::{Deliver, View, STILL_FRAMES};
-use endocast_core::look::{shade_reduced_with_scene, still_frame, Look, RayPass, RayPassSettings};
+use endocast_core::look::{
+    shade_reduced_with_scene, stereo_frame, still_frame, Look, RayPass, RayPassSettings,
+};
 use endocast_core::render::progressive::Stage;
 use endocast_core::render::quality::reduced_camera;
-use endocast_core::render::{Frame, Quality, RenderSettings, Renderer, Still};
+use endocast_core::render::{
+    Camera, Frame, Quality, RenderSettings, Renderer, StereoFrames, Still,
+};
+use endocast_core::views::stereo::{combine, StereoOutput};
 use endocast_core::views::Image;
 use std::sync::Arc;
 use std::time::Instant;
@@ -38,8 +44,9 @@ impl LookPass {
     }
 }
 
-/// Renders `view` in `look` level by level, handing each to `deliver`; stops (without error)
-/// as soon as `superseded` says a newer view waits, between levels and still frames.
+/// Renders `view` in `look` level by level, handing each to `deliver` (with stereo on, both
+/// eyes combined into a red/cyan anaglyph); stops (without error) as soon as `superseded`
+/// says a newer view waits, between levels and still frames.
 pub(crate) fn render_look(
     passes: &mut LookPass,
     renderer: &Arc<Renderer>,
@@ -49,38 +56,85 @@ pub(crate) fn render_look(
     deliver: &Deliver<'_>,
 ) -> Result<(), String> {
     let pass = passes.get(renderer, &view.settings, look)?;
-    let (camera, shading) = (&view.camera, &look.shading);
-    let scene = view.scene.0.as_deref();
     let background = view.settings.background;
-    let show = |stage: Stage, frame: &Frame, start: Instant| {
-        if let Ok(image) = Image::from_frame(frame, background) {
-            deliver(stage, image, &frame.depth_mm, start.elapsed());
+    let show = |stage: Stage, frames: &[&Frame], start: Instant| {
+        let images: Result<Vec<_>, _> = frames
+            .iter()
+            .map(|f| Image::from_frame(f, background))
+            .collect();
+        let image = images.and_then(|i| match &i[..] {
+            [left, right] => combine(left, right, StereoOutput::RedCyan),
+            _ => Ok(i[0].clone()),
+        });
+        if let Ok(image) = image {
+            deliver(stage, image, &frames[0].depth_mm, start.elapsed());
         }
     };
     let start = Instant::now();
-    // Both stages at half size (the deferred stage too), the shaded frame upsampled.
-    let small = reduced_camera(camera, Quality::Half.reduced_size(camera.size()));
-    let preview = pass.trace(&small, Quality::Full);
-    let frame =
-        shade_reduced_with_scene(&preview, camera, shading, scene).map_err(|e| e.to_string())?;
-    show(Stage::Preview(Quality::Half), &frame, start);
+    let eyes = match view.stereo {
+        Some(rig) => rig.eyes(&view.camera).map_err(|e| e.to_string())?.to_vec(),
+        None => vec![view.camera],
+    };
+    let previews = eyes
+        .iter()
+        .map(|eye| preview(pass, eye, look, view))
+        .collect::<Result<Vec<_>, _>>()?;
+    show(
+        Stage::Preview(Quality::Half),
+        &previews.iter().collect::<Vec<_>>(),
+        start,
+    );
     if view.moving {
         return Ok(());
     }
-    let mut still = Still::new();
+    let mut stills = vec![Still::new(); eyes.len()];
+    let mut pair = StereoFrames::default();
     for k in 0..STILL_FRAMES {
         if superseded() {
             return Ok(());
         }
         let start = Instant::now();
-        let frame = still_frame(pass, camera, shading, scene, k).map_err(|e| e.to_string())?;
-        still.add(&frame);
+        let frames = still_frames(pass, view, look, k, &mut pair)?;
+        for (still, frame) in stills.iter_mut().zip(&frames) {
+            still.add(frame);
+        }
         let stage = if k == 0 {
             Stage::Full
         } else {
             Stage::Still(k + 1)
         };
-        show(stage, still.frame(), start);
+        show(
+            stage,
+            &stills.iter().map(Still::frame).collect::<Vec<_>>(),
+            start,
+        );
     }
     Ok(())
+}
+
+/// The half-size preview of `eye` in `look`: both stages at half size (the deferred stage
+/// too), the shaded frame upsampled, with `view`'s geometry.
+fn preview(pass: &RayPass, eye: &Camera, look: &Look, view: &View) -> Result<Frame, String> {
+    let small = reduced_camera(eye, Quality::Half.reduced_size(eye.size()));
+    let traced = pass.trace(&small, Quality::Full);
+    let scene = view.scene.0.as_deref();
+    shade_reduced_with_scene(&traced, eye, &look.shading, scene).map_err(|e| e.to_string())
+}
+
+/// Still frame `k` of `view` in `look`: one eye, or both of a stereo view (their searches
+/// shared through `pair`'s buffers).
+fn still_frames(
+    pass: &RayPass,
+    view: &View,
+    look: &Look,
+    k: usize,
+    pair: &mut StereoFrames,
+) -> Result<Vec<Frame>, String> {
+    let (camera, shading) = (&view.camera, &look.shading);
+    let scene = view.scene.0.as_deref();
+    let frames = match &view.stereo {
+        Some(rig) => stereo_frame(pass, (camera, rig), shading, scene, k, pair).map(Vec::from),
+        None => still_frame(pass, camera, shading, scene, k).map(|f| vec![f]),
+    };
+    frames.map_err(|e| e.to_string())
 }

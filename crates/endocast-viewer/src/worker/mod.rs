@@ -50,8 +50,8 @@ pub struct View {
     pub moving: bool,
     /// Geometry drawn with the scan.
     pub scene: SceneRef,
-    /// The endoscope's clinical or realistic look instead of the renderer's own image (one
-    /// image: with stereo on, the look is drawn for the centre eye).
+    /// The endoscope's clinical or realistic look instead of the renderer's own image (with
+    /// stereo on, in both eyes).
     pub look: Option<Look>,
 }
 
