@@ -4,7 +4,7 @@
 
 use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
 use super::settings::{RayPassSettings, SecretionMode};
-use crate::render::{with_avx2, Lighting, Renderer, Sampler, Shader};
+use crate::render::{with_avx2, Renderer, Sampler};
 use glam::{DAffine3, DVec3, Mat3};
 
 /// Bisection steps refining the tissue hit (then linear interpolation in the last bracket):
@@ -23,7 +23,7 @@ const LAYER_MIN: f32 = 1.5;
 
 /// The tissue behind the secretion hits of up to eight rays, one per lane (unspecified where
 /// the lane found none).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct TissueHits {
     /// Whether the lane's ray found the tissue.
     pub found: [bool; LANES],
@@ -53,7 +53,7 @@ pub(crate) struct Continuation<'a> {
     sampler: Sampler<'a>,
     voxel_from_world: DAffine3,
     extent: DVec3,
-    /// Turns voxel-space gradients into world space (as [`Shader::normal`] does).
+    /// Turns voxel-space gradients into world space (as `Shader::normal` does).
     world_from_gradient: Mat3,
     /// The thresholds in stored units.
     tissue: f32,
@@ -79,11 +79,13 @@ impl<'a> Continuation<'a> {
             sampler: renderer.sampler(),
             voxel_from_world: geometry.voxel_from_world(),
             extent: DVec3::from(dims.map(|n| (n - 1) as f64)),
-            world_from_gradient: Shader::new(
-                geometry.world_from_voxel().matrix3,
-                Lighting::default(),
-            )
-            .world_from_gradient(),
+            // The inverse transpose of the linear part, as `Shader::new` makes it.
+            world_from_gradient: geometry
+                .world_from_voxel()
+                .matrix3
+                .inverse()
+                .transpose()
+                .as_mat3(),
             tissue,
             secretion,
             rising: tissue > secretion,
@@ -96,18 +98,28 @@ impl<'a> Continuation<'a> {
     /// set-up, the march, the bisection and the measures branch-free over fixed lanes, compiled
     /// for AVX2 where the CPU has it (each sample batch one AVX2 gather). Ray `k` starts at
     /// world `origin` along unit `dir` and met the secretion `t_secretion_mm` along it. A lane
-    /// is `None` where its ray is missing, has no secretion hit (NaN), or leaves the volume
-    /// before the tissue. Each lane takes the samples a one-ray march would: the same
-    /// positions, values and bisection, so the result does not depend on its neighbours.
+    /// finds nothing where its ray is missing, has no secretion hit (NaN), or leaves the volume
+    /// before the tissue; where no lane finds the tissue, nothing is refined or measured. Each
+    /// lane takes the samples a one-ray march would: the same positions, values and bisection,
+    /// so the result does not depend on its neighbours. The normals are [`Shader::normal`]'s
+    /// operation for operation, lane by lane (the same bits).
+    ///
+    /// [`Shader::normal`]: crate::render::Shader::normal
     pub fn tissue_after8(&self, rays: &[Option<(DVec3, DVec3, f32)>]) -> TissueHits {
         debug_assert!(rays.len() <= 8);
         let world = WorldRays::new(rays);
+        if !world.on.contains(&true) {
+            return TissueHits::default();
+        }
         with_avx2(
             #[inline(always)]
             || {
                 let mut lanes = self.start(&world);
                 lanes.v = self.values(&lanes, &lanes.t);
                 self.march(&mut lanes);
+                if !lanes.found.contains(&true) {
+                    return TissueHits::default();
+                }
                 let t_hit = self.refine(&lanes);
                 self.measure(&lanes, &world, t_hit)
             },
@@ -125,8 +137,8 @@ impl<'a> Continuation<'a> {
             columns[0][a] * v[0][k] + columns[1][a] * v[1][k] + columns[2][a] * v[2][k]
         };
         let shift = self.voxel_from_world.translation;
-        let o: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.origin, a, k) + shift[a]));
-        let d: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.dir, a, k)));
+        let o = map64x3(|a, k| turn(&world.origin, a, k) + shift[a]);
+        let d = map64x3(|a, k| turn(&world.dir, a, k));
         let (mut t0, mut t1, mut on) = ([0.0f64; LANES], [f64::INFINITY; LANES], world.on);
         for a in 0..3 {
             for k in 0..LANES {
@@ -173,13 +185,11 @@ impl<'a> Continuation<'a> {
             let slope = gx[k] * dx + gy[k] * dy + gz[k] * dz;
             (measured - self.own_edge(edge, slope)).max(0.0)
         });
-        let hit: [F64s; 3] = std::array::from_fn(|a| {
-            map64(|k| world.origin[a][k] + world.dir[a][k] * f64::from(t_hit[k]))
-        });
+        let hit = map64x3(|a, k| world.origin[a][k] + world.dir[a][k] * f64::from(t_hit[k]));
         TissueHits {
             found: lanes.found,
             depth_mm: t_hit,
-            hit_mm: std::array::from_fn(|k| [hit[0][k] as f32, hit[1][k] as f32, hit[2][k] as f32]),
+            hit_mm: per_lane(|k| [hit[0][k] as f32, hit[1][k] as f32, hit[2][k] as f32]),
             normal: self.normals(&gradient),
             secretion_mm,
             secretion_normal: self.normals(&surface),
@@ -187,7 +197,7 @@ impl<'a> Continuation<'a> {
     }
 
     /// World-space unit normals of voxel-space `gradient` lanes (zero where a gradient is
-    /// zero): [`Shader::normal`] lane by lane, operation for operation.
+    /// zero): `Shader::normal` lane by lane, operation for operation.
     #[inline(always)]
     fn normals(&self, gradient: &[Lanes; 3]) -> [Lanes; 3] {
         let m = self.world_from_gradient;
@@ -324,6 +334,29 @@ fn pick<T>(on: bool, a: T, b: T) -> T {
     }
 }
 
+/// `f(axis, lane)` for three axes of lanes, in `f64` (a loop inlined where it is called, unlike
+/// `std::array::from_fn`'s closures, so that it compiles for AVX2 there).
+#[inline(always)]
+fn map64x3(f: impl Fn(usize, usize) -> f64) -> [F64s; 3] {
+    let mut out = [[0.0; LANES]; 3];
+    for (axis, o) in out.iter_mut().enumerate() {
+        for (k, o) in o.iter_mut().enumerate() {
+            *o = f(axis, k);
+        }
+    }
+    out
+}
+
+/// `f(lane)` for each lane, as [`map64x3`] does.
+#[inline(always)]
+fn per_lane<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] {
+    let mut out = [T::default(); LANES];
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = f(k);
+    }
+    out
+}
+
 /// Eight rays' continuations in lockstep, each quantity one value per lane.
 #[derive(Default)]
 struct Lanes8 {
@@ -351,16 +384,6 @@ struct Lanes8 {
 
 /// Eight `f64` values, one per lane.
 type F64s = [f64; LANES];
-
-/// `f` lane by lane, in `f64`.
-#[inline(always)]
-fn map64(f: impl Fn(usize) -> f64) -> F64s {
-    let mut out = [0.0; LANES];
-    for (k, o) in out.iter_mut().enumerate() {
-        *o = f(k);
-    }
-    out
-}
 
 /// Eight lanes' world rays (zero in idle lanes) and secretion hits.
 struct WorldRays {
@@ -409,7 +432,9 @@ mod tests {
     use super::*;
     use crate::phantom::{layered, PhantomOptions};
     use crate::render::traverse::VoxelRay;
+    use crate::render::{Lighting, Shader};
     use crate::test_rng::Rng;
+    use glam::Vec3;
 
     #[test]
     fn the_lanes_start_as_the_voxel_rays_do() {
@@ -464,6 +489,40 @@ mod tests {
             inside > 50 && outside > 20,
             "{inside} inside, {outside} outside"
         );
+    }
+
+    #[test]
+    fn the_lane_normals_are_the_shaders_bit_for_bit() {
+        let volume = layered(&PhantomOptions {
+            size: 16,
+            ..Default::default()
+        })
+        .0;
+        let renderer = Renderer::new(volume);
+        let mut on = Continuation::new(&renderer, &RayPassSettings::default());
+        // A sheared, anisotropic grid, as `Continuation::new` turns it.
+        let linear = glam::DMat3::from_cols_array(&[0.7, 0.1, 0.0, 0.05, 1.3, 0.2, 0.0, -0.3, 2.1]);
+        on.world_from_gradient = linear.inverse().transpose().as_mat3();
+        let shader = Shader::new(linear, Lighting::default());
+        let mut s = Rng::new(11);
+        for round in 0..20 {
+            let mut lanes = [[0.0f32; LANES]; 3];
+            for k in 0..LANES {
+                let g = match (round + k) % 5 {
+                    0 => Vec3::ZERO,
+                    1 => s.vec().as_vec3() * 1e-30,
+                    _ => s.vec().as_vec3() * 300.0 - 150.0,
+                };
+                (lanes[0][k], lanes[1][k], lanes[2][k]) = (g.x, g.y, g.z);
+            }
+            let normals = on.normals(&lanes);
+            for k in 0..LANES {
+                let g = Vec3::new(lanes[0][k], lanes[1][k], lanes[2][k]);
+                let want = shader.normal(g).to_array().map(f32::to_bits);
+                let got = TissueHits::vector(&normals, k).map(f32::to_bits);
+                assert_eq!(got, want, "gradient {g}");
+            }
+        }
     }
 
     #[test]

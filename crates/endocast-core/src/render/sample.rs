@@ -229,12 +229,6 @@ impl Shader {
         }
     }
 
-    /// The matrix turning voxel-space gradients into world space ([`Self::normal`] before
-    /// normalising): `world_from_gradient * gradient`.
-    pub(crate) fn world_from_gradient(&self) -> Mat3 {
-        self.world_from_gradient
-    }
-
     /// World-space unit normal for a voxel-space gradient (zero where the gradient is zero).
     #[inline]
     pub fn normal(&self, gradient_vox: Vec3) -> Vec3 {
