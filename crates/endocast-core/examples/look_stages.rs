@@ -5,8 +5,12 @@
 //! upsampling of the shaded frame). Median wall-clock ms per frame of 512×512.
 //!
 //! ```text
-//! cargo run --release -p endocast-core --example look_stages -- [full|half] [FRAMES] [THREADS]
+//! cargo run --release -p endocast-core --example look_stages -- [full|half] [FRAMES] [THREADS] [all|iso|look]
 //! ```
+//!
+//! `iso` or `look` runs only plain iso or only the look's frame (its ray pass with secretion and
+//! its deferred stage), for instruction counts: e.g. `valgrind --tool=callgrind
+//! --toggle-collect=look_stages::stages` with one thread counts that stage alone.
 
 use endocast_core::look::{self, Look, LookKind, PresetLook, RayPass, SecretionMode};
 use endocast_core::phantom::{self, PhantomOptions};
@@ -29,6 +33,12 @@ fn main() -> Result<(), Error> {
     };
     let frames: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
     let threads: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let only = match args.next().as_deref() {
+        None | Some("all") => Only::All,
+        Some("iso") => Only::Iso,
+        Some("look") => Only::Look,
+        Some(other) => return Err(format!("{other:?}: expected all, iso or look").into()),
+    };
     let (volume, colon) = phantom::colon(&PhantomOptions {
         size: 512,
         ..Default::default()
@@ -51,15 +61,26 @@ fn main() -> Result<(), Error> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
-    pool.install(|| stages(&renderer, &look, &cameras, quality))
+    pool.install(|| stages(&renderer, &look, &cameras, quality, only))
 }
 
-/// Times every stage on every camera and prints the medians.
+/// Which stages run.
+#[derive(Clone, Copy, PartialEq)]
+enum Only {
+    All,
+    /// Plain iso alone.
+    Iso,
+    /// The look's frame alone: the ray pass with secretion and the deferred stage.
+    Look,
+}
+
+/// Times every stage (or those `only` names) on every camera and prints the medians.
 fn stages(
     renderer: &Arc<Renderer>,
     look: &Look,
     cameras: &[Camera],
     quality: Quality,
+    only: Only,
 ) -> Result<(), Error> {
     let base = RenderSettings::default();
     let pass = RayPass::new(renderer, &base, &look.ray)?;
@@ -72,7 +93,15 @@ fn stages(
     let options = RenderOptions::new().quality(quality);
     let mut frame = Frame::default();
     let mut ms: [Vec<f64>; 6] = Default::default();
+    let runs = |stage: usize| match only {
+        Only::All => true,
+        Only::Iso => stage == 0,
+        Only::Look => stage == 2 || stage == 5,
+    };
     let mut time = |stage: usize, run: &mut dyn FnMut()| {
+        if !runs(stage) {
+            return;
+        }
         let start = Instant::now();
         run();
         ms[stage].push(start.elapsed().as_secs_f64() * 1e3);
@@ -91,7 +120,7 @@ fn stages(
         let mut gbuffer = None;
         time(2, &mut || gbuffer = Some(pass.trace(&small, Quality::Full)));
         time(3, &mut || drop(dry.trace(&small, Quality::Full)));
-        let gbuffer = gbuffer.ok_or("no G-buffer")?;
+        let Some(gbuffer) = gbuffer else { continue };
         time(4, &mut || drop(look::smooth::smooth(&gbuffer, 2)));
         let mut shaded = Ok(Frame::default());
         time(5, &mut || {
@@ -107,10 +136,29 @@ fn stages(
         "smoothing alone",
         "deferred stage (smoothing, shading)",
     ];
+    // The look's frame: its ray pass with secretion and its deferred stage, frame by frame.
+    let frames: Vec<f64> = ms[2].iter().zip(&ms[5]).map(|(a, b)| a + b).collect();
+    let whole = median(frames);
     println!("{} frames, {quality:?} quality, median ms:", cameras.len());
-    for (name, mut v) in names.iter().zip(ms) {
-        v.sort_by(f64::total_cmp);
-        println!("  {name:<40} {:>7.1}", v[v.len() / 2]);
+    for (name, v) in names.iter().zip(&ms) {
+        if let Some(m) = median(v.clone()) {
+            println!("  {name:<40} {m:>7.1}");
+        }
+    }
+    if let Some(whole) = whole {
+        println!(
+            "  {:<40} {whole:>7.1}",
+            "look frame (ray pass on + deferred)"
+        );
+    }
+    if let (Some(whole), Some(iso)) = (whole, median(ms[0].clone())) {
+        println!("  {:<40} {:>7.2}", "look frame ÷ plain iso", whole / iso);
     }
     Ok(())
+}
+
+/// The median of `v` (`None` when empty).
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied()
 }

@@ -2,7 +2,7 @@
 //! secretion, hit mask), the only stage of a look that samples the volume.
 
 use super::clipped::clipped_pixels;
-use super::secretion::Continuation;
+use super::secretion::{Continuation, TissueHits};
 use super::settings::{RayPassSettings, SecretionMode};
 use super::LookError;
 use crate::camera::Camera;
@@ -71,6 +71,7 @@ impl GBuffer {
 
     /// Pixel `i`'s eight channels as the smoothing filters them: depth, hit position (x, y,
     /// z), normal (x, y, z), secretion.
+    #[cfg(test)]
     pub(crate) fn texel(&self, i: usize) -> [f32; 8] {
         let ([px, py, pz], [nx, ny, nz]) = (self.hit_mm[i], self.normal[i]);
         [
@@ -209,8 +210,9 @@ impl RayPass {
         let renderer = self.prepared.renderer();
         let on = Continuation::new(renderer, &self.settings);
         let (w, n) = (frame.width, frame.len());
-        (frame.hit_mm, frame.normal) = (vec![[f32::NAN; 3]; n], vec![[f32::NAN; 3]; n]);
-        let mut surface = vec![[f32::NAN; 3]; n];
+        // Zeroed (the allocator's fresh pages), then every pixel written in parallel.
+        (frame.hit_mm, frame.normal) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        let mut surface = vec![[0.0; 3]; n];
         let mut secretion = vec![0.0; n];
         frame
             .depth_mm
@@ -229,15 +231,21 @@ impl RayPass {
                         let ray = camera.pixel_ray(x, y)?;
                         Some((ray.origin, ray.dir, depth[x]))
                     });
-                    for (x, found) in lanes.zip(on.tissue_after8(&rays)) {
-                        depth[x] = f32::NAN;
-                        if let Some(found) = found {
-                            depth[x] = found.depth_mm;
-                            hit[x] = found.hit_mm;
-                            normal[x] = found.normal;
-                            secretion[x] = found.secretion_mm;
-                            surface[x] = found.secretion_normal;
-                        }
+                    let found = on.tissue_after8(&rays);
+                    let vector = TissueHits::vector;
+                    for (k, x) in lanes.enumerate() {
+                        (depth[x], hit[x], normal[x], secretion[x], surface[x]) = if found.found[k]
+                        {
+                            (
+                                found.depth_mm[k],
+                                found.hit_mm[k],
+                                vector(&found.normal, k),
+                                found.secretion_mm[k],
+                                vector(&found.secretion_normal, k),
+                            )
+                        } else {
+                            (f32::NAN, [f32::NAN; 3], [f32::NAN; 3], 0.0, [f32::NAN; 3])
+                        };
                     }
                 }
             });

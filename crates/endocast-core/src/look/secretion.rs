@@ -2,10 +2,10 @@
 //! march at a small step to the tissue threshold, refined by bisection, with the secretion
 //! measured on the way.
 
-use super::lanes::{map, map3, Lanes, LANES};
+use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
 use super::settings::{RayPassSettings, SecretionMode};
-use crate::render::{with_avx2, Lighting, Renderer, Sampler, Shader};
-use glam::{DAffine3, DVec3, Vec3};
+use crate::render::{with_avx2, Renderer, Sampler};
+use glam::{DAffine3, DVec3, Mat3};
 
 /// Bisection steps refining the tissue hit (then linear interpolation in the last bracket):
 /// 1/16 of a small step (1/64 voxel at the default quarter voxel; the renderer's own surfaces
@@ -21,20 +21,31 @@ const EDGE_MAX: f32 = 1.2;
 /// layered phantom's thinnest layer, 3 voxels between two 2-voxel ramps, takes 1.56).
 const LAYER_MIN: f32 = 1.5;
 
-/// The tissue behind a secretion hit.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct TissueHit {
+/// The tissue behind the secretion hits of up to eight rays, one per lane (unspecified where
+/// the lane found none).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct TissueHits {
+    /// Whether the lane's ray found the tissue.
+    pub found: [bool; LANES],
     /// Distance from the ray's start to the tissue, mm.
-    pub depth_mm: f32,
+    pub depth_mm: Lanes,
     /// World position of the hit, mm.
-    pub hit_mm: [f32; 3],
-    /// Unit world normal, up the value gradient.
-    pub normal: [f32; 3],
+    pub hit_mm: [[f32; 3]; LANES],
+    /// Unit world normal, up the value gradient, by axis.
+    pub normal: [Lanes; 3],
     /// Secretion in front of the tissue, mm.
-    pub secretion_mm: f32,
+    pub secretion_mm: Lanes,
     /// Unit world normal of the secretion's surface at the ray's secretion hit, up the value
-    /// gradient.
-    pub secretion_normal: [f32; 3],
+    /// gradient, by axis.
+    pub secretion_normal: [Lanes; 3],
+}
+
+impl TissueHits {
+    /// Lane `k`'s normal, or its secretion surface's (`normals`: [`Self::normal`] or
+    /// [`Self::secretion_normal`]).
+    pub fn vector(normals: &[Lanes; 3], k: usize) -> [f32; 3] {
+        [normals[0][k], normals[1][k], normals[2][k]]
+    }
 }
 
 /// Everything a continuation needs, shared by the rays of a frame.
@@ -42,7 +53,8 @@ pub(crate) struct Continuation<'a> {
     sampler: Sampler<'a>,
     voxel_from_world: DAffine3,
     extent: DVec3,
-    shader: Shader,
+    /// Turns voxel-space gradients into world space (as `Shader::normal` does).
+    world_from_gradient: Mat3,
     /// The thresholds in stored units.
     tissue: f32,
     secretion: f32,
@@ -67,7 +79,13 @@ impl<'a> Continuation<'a> {
             sampler: renderer.sampler(),
             voxel_from_world: geometry.voxel_from_world(),
             extent: DVec3::from(dims.map(|n| (n - 1) as f64)),
-            shader: Shader::new(geometry.world_from_voxel().matrix3, Lighting::default()),
+            // The inverse transpose of the linear part, as `Shader::new` makes it.
+            world_from_gradient: geometry
+                .world_from_voxel()
+                .matrix3
+                .inverse()
+                .transpose()
+                .as_mat3(),
             tissue,
             secretion,
             rising: tissue > secretion,
@@ -80,31 +98,32 @@ impl<'a> Continuation<'a> {
     /// set-up, the march, the bisection and the measures branch-free over fixed lanes, compiled
     /// for AVX2 where the CPU has it (each sample batch one AVX2 gather). Ray `k` starts at
     /// world `origin` along unit `dir` and met the secretion `t_secretion_mm` along it. A lane
-    /// is `None` where its ray is missing, has no secretion hit (NaN), or leaves the volume
-    /// before the tissue. Each lane takes the samples a one-ray march would: the same
-    /// positions, values and bisection, so the result does not depend on its neighbours.
-    pub fn tissue_after8(&self, rays: &[Option<(DVec3, DVec3, f32)>]) -> [Option<TissueHit>; 8] {
+    /// finds nothing where its ray is missing, has no secretion hit (NaN), or leaves the volume
+    /// before the tissue; where no lane finds the tissue, nothing is refined or measured. Each
+    /// lane takes the samples a one-ray march would: the same positions, values and bisection,
+    /// so the result does not depend on its neighbours. The normals are [`Shader::normal`]'s
+    /// operation for operation, lane by lane (the same bits).
+    ///
+    /// [`Shader::normal`]: crate::render::Shader::normal
+    pub fn tissue_after8(&self, rays: &[Option<(DVec3, DVec3, f32)>]) -> TissueHits {
         debug_assert!(rays.len() <= 8);
         let world = WorldRays::new(rays);
-        let (hits, found) = with_avx2(
+        if !world.on.contains(&true) {
+            return TissueHits::default();
+        }
+        with_avx2(
             #[inline(always)]
             || {
                 let mut lanes = self.start(&world);
                 lanes.v = self.values(&lanes, &lanes.t);
                 self.march(&mut lanes);
+                if !lanes.found.contains(&true) {
+                    return TissueHits::default();
+                }
                 let t_hit = self.refine(&lanes);
-                (lanes.found, self.measure(&lanes, &world, t_hit))
+                self.measure(&lanes, &world, t_hit)
             },
-        );
-        std::array::from_fn(|k| {
-            hits[k].then(|| TissueHit {
-                depth_mm: found.t_hit[k],
-                hit_mm: found.hit[k],
-                normal: self.shader.normal(found.gradient[k]).to_array(),
-                secretion_mm: found.secretion_mm[k],
-                secretion_normal: self.shader.normal(found.surface[k]).to_array(),
-            })
-        })
+        )
     }
 
     /// The lanes' voxel rays and the ends of their marches, operation for operation as
@@ -118,8 +137,8 @@ impl<'a> Continuation<'a> {
             columns[0][a] * v[0][k] + columns[1][a] * v[1][k] + columns[2][a] * v[2][k]
         };
         let shift = self.voxel_from_world.translation;
-        let o: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.origin, a, k) + shift[a]));
-        let d: [F64s; 3] = std::array::from_fn(|a| map64(|k| turn(&world.dir, a, k)));
+        let o = map64x3(|a, k| turn(&world.origin, a, k) + shift[a]);
+        let d = map64x3(|a, k| turn(&world.dir, a, k));
         let (mut t0, mut t1, mut on) = ([0.0f64; LANES], [f64::INFINITY; LANES], world.on);
         for a in 0..3 {
             for k in 0..LANES {
@@ -145,14 +164,15 @@ impl<'a> Continuation<'a> {
         lanes
     }
 
-    /// What the lanes found at `t_hit`: the world hit, the gradient and the secretion, and the
-    /// gradient at the secretion hit (the secretion surface's normal).
+    /// What the lanes found at `t_hit`: the world hit, the normal and the secretion, and the
+    /// normal at the secretion hit (the secretion surface's).
     #[inline(always)]
-    fn measure(&self, lanes: &Lanes8, world: &WorldRays, t_hit: Lanes) -> Found {
+    fn measure(&self, lanes: &Lanes8, world: &WorldRays, t_hit: Lanes) -> TissueHits {
         let points = map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * t_hit[k]);
-        let [gx, gy, gz] = self.sampler.gradients8_lanes(&points);
+        let gradient = self.sampler.gradients8_lanes(&points);
+        let [gx, gy, gz] = gradient;
         let at_secretion = map3(|a, k| lanes.o[a][k] + lanes.d[a][k] * world.t_secretion[k]);
-        let [sx, sy, sz] = self.sampler.gradients8_lanes(&at_secretion);
+        let surface = self.sampler.gradients8_lanes(&at_secretion);
         let secretion_mm = map(|k| {
             let measured = if self.accumulate {
                 let last = self.inside_secretion((lanes.t[k], lanes.v[k]), (t_hit[k], self.tissue));
@@ -165,16 +185,27 @@ impl<'a> Continuation<'a> {
             let slope = gx[k] * dx + gy[k] * dy + gz[k] * dz;
             (measured - self.own_edge(edge, slope)).max(0.0)
         });
-        let hit: [F64s; 3] = std::array::from_fn(|a| {
-            map64(|k| world.origin[a][k] + world.dir[a][k] * f64::from(t_hit[k]))
-        });
-        Found {
-            t_hit,
-            hit: std::array::from_fn(|k| [hit[0][k] as f32, hit[1][k] as f32, hit[2][k] as f32]),
-            gradient: std::array::from_fn(|k| Vec3::new(gx[k], gy[k], gz[k])),
-            surface: std::array::from_fn(|k| Vec3::new(sx[k], sy[k], sz[k])),
+        let hit = map64x3(|a, k| world.origin[a][k] + world.dir[a][k] * f64::from(t_hit[k]));
+        TissueHits {
+            found: lanes.found,
+            depth_mm: t_hit,
+            hit_mm: per_lane(|k| [hit[0][k] as f32, hit[1][k] as f32, hit[2][k] as f32]),
+            normal: self.normals(&gradient),
             secretion_mm,
+            secretion_normal: self.normals(&surface),
         }
+    }
+
+    /// World-space unit normals of voxel-space `gradient` lanes (zero where a gradient is
+    /// zero): `Shader::normal` lane by lane, operation for operation.
+    #[inline(always)]
+    fn normals(&self, gradient: &[Lanes; 3]) -> [Lanes; 3] {
+        let m = self.world_from_gradient;
+        let [gx, gy, gz] = gradient;
+        // `Mat3 * Vec3`: x column times x, plus y's, plus z's.
+        normalize_or_zero(map3(|a, k| {
+            m.x_axis[a] * gx[k] + m.y_axis[a] * gy[k] + m.z_axis[a] * gz[k]
+        }))
     }
 
     /// The values at distances `t` along the lanes' rays (idle lanes read the origin).
@@ -199,7 +230,8 @@ impl<'a> Continuation<'a> {
                 let found = on & self.past(next.1, self.tissue);
                 let go = on & !found;
                 lanes.found[k] |= found;
-                lanes.after[k] = pick(found, next, lanes.after[k]);
+                lanes.after_t[k] = pick(found, next.0, lanes.after_t[k]);
+                lanes.after_v[k] = pick(found, next.1, lanes.after_v[k]);
                 if self.accumulate {
                     let inside = lanes.inside[k] + self.inside_secretion(here, next);
                     lanes.inside[k] = pick(go, inside, lanes.inside[k]);
@@ -208,7 +240,8 @@ impl<'a> Continuation<'a> {
                     !self.past(here.1, self.secretion) && self.past(next.1, self.secretion);
                 let entered = crossing(here, next, self.secretion);
                 lanes.entered[k] = pick(go && enters, entered, lanes.entered[k]);
-                (lanes.t[k], lanes.v[k]) = pick(go, next, here);
+                lanes.t[k] = pick(go, next.0, here.0);
+                lanes.v[k] = pick(go, next.1, here.1);
                 lanes.marching[k] = go;
             }
         }
@@ -218,17 +251,27 @@ impl<'a> Continuation<'a> {
     /// interpolation in the last bracket (other lanes: unspecified).
     #[inline(always)]
     fn refine(&self, lanes: &Lanes8) -> Lanes {
-        let (mut before, mut after) = (lanes.before(), lanes.after);
+        // Each end of the brackets as distance and value lanes.
+        let (mut before_t, mut before_v) = (lanes.t, lanes.v);
+        let (mut after_t, mut after_v) = (lanes.after_t, lanes.after_v);
         for _ in 0..REFINE_STEPS {
-            let t = map(|k| 0.5 * (before[k].0 + after[k].0));
+            let t = map(|k| 0.5 * (before_t[k] + after_t[k]));
             let v = self.values(lanes, &t);
             for k in 0..LANES {
                 let past = self.past(v[k], self.tissue);
-                after[k] = pick(past, (t[k], v[k]), after[k]);
-                before[k] = pick(past, before[k], (t[k], v[k]));
+                (after_t[k], after_v[k]) =
+                    (pick(past, t[k], after_t[k]), pick(past, v[k], after_v[k]));
+                (before_t[k], before_v[k]) =
+                    (pick(past, before_t[k], t[k]), pick(past, before_v[k], v[k]));
             }
         }
-        map(|k| crossing(before[k], after[k], self.tissue))
+        map(|k| {
+            crossing(
+                (before_t[k], before_v[k]),
+                (after_t[k], after_v[k]),
+                self.tissue,
+            )
+        })
     }
 
     /// How much of the last stretch into the tissue, `edge_mm` long (from where the ray last
@@ -291,6 +334,29 @@ fn pick<T>(on: bool, a: T, b: T) -> T {
     }
 }
 
+/// `f(axis, lane)` for three axes of lanes, in `f64` (a loop inlined where it is called, unlike
+/// `std::array::from_fn`'s closures, so that it compiles for AVX2 there).
+#[inline(always)]
+fn map64x3(f: impl Fn(usize, usize) -> f64) -> [F64s; 3] {
+    let mut out = [[0.0; LANES]; 3];
+    for (axis, o) in out.iter_mut().enumerate() {
+        for (k, o) in o.iter_mut().enumerate() {
+            *o = f(axis, k);
+        }
+    }
+    out
+}
+
+/// `f(lane)` for each lane, as [`map64x3`] does.
+#[inline(always)]
+fn per_lane<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] {
+    let mut out = [T::default(); LANES];
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = f(k);
+    }
+    out
+}
+
 /// Eight rays' continuations in lockstep, each quantity one value per lane.
 #[derive(Default)]
 struct Lanes8 {
@@ -306,8 +372,9 @@ struct Lanes8 {
     /// Still marching; found the tissue.
     marching: [bool; LANES],
     found: [bool; LANES],
-    /// The end of the found crossing's bracket.
-    after: [(f32, f32); LANES],
+    /// The end of the found crossing's bracket: distance and value.
+    after_t: Lanes,
+    after_v: Lanes,
     /// Length inside the secretion so far ([`SecretionMode::Accumulate`]).
     inside: Lanes,
     /// Where the ray last crossed into the secretion: its first secretion hit, or later
@@ -315,26 +382,8 @@ struct Lanes8 {
     entered: Lanes,
 }
 
-impl Lanes8 {
-    /// The start of each lane's found bracket.
-    #[inline(always)]
-    fn before(&self) -> [(f32, f32); LANES] {
-        std::array::from_fn(|k| (self.t[k], self.v[k]))
-    }
-}
-
 /// Eight `f64` values, one per lane.
 type F64s = [f64; LANES];
-
-/// `f` lane by lane, in `f64`.
-#[inline(always)]
-fn map64(f: impl Fn(usize) -> f64) -> F64s {
-    let mut out = [0.0; LANES];
-    for (k, o) in out.iter_mut().enumerate() {
-        *o = f(k);
-    }
-    out
-}
 
 /// Eight lanes' world rays (zero in idle lanes) and secretion hits.
 struct WorldRays {
@@ -367,16 +416,6 @@ impl WorldRays {
     }
 }
 
-/// What each lane found (unspecified where it found nothing).
-struct Found {
-    t_hit: Lanes,
-    hit: [[f32; 3]; LANES],
-    gradient: [Vec3; LANES],
-    /// The value gradient at the secretion hit.
-    surface: [Vec3; LANES],
-    secretion_mm: Lanes,
-}
-
 /// The largest `f32` not greater than `x`, so that `f64::from(t) > x` for an `f32` `t` is
 /// `t > f32_not_past(x)` (for finite `x`; `f32::MAX` where `x` lies beyond the `f32` range).
 fn f32_not_past(x: f64) -> f32 {
@@ -393,7 +432,9 @@ mod tests {
     use super::*;
     use crate::phantom::{layered, PhantomOptions};
     use crate::render::traverse::VoxelRay;
+    use crate::render::{Lighting, Shader};
     use crate::test_rng::Rng;
+    use glam::Vec3;
 
     #[test]
     fn the_lanes_start_as_the_voxel_rays_do() {
@@ -448,6 +489,40 @@ mod tests {
             inside > 50 && outside > 20,
             "{inside} inside, {outside} outside"
         );
+    }
+
+    #[test]
+    fn the_lane_normals_are_the_shaders_bit_for_bit() {
+        let volume = layered(&PhantomOptions {
+            size: 16,
+            ..Default::default()
+        })
+        .0;
+        let renderer = Renderer::new(volume);
+        let mut on = Continuation::new(&renderer, &RayPassSettings::default());
+        // A sheared, anisotropic grid, as `Continuation::new` turns it.
+        let linear = glam::DMat3::from_cols_array(&[0.7, 0.1, 0.0, 0.05, 1.3, 0.2, 0.0, -0.3, 2.1]);
+        on.world_from_gradient = linear.inverse().transpose().as_mat3();
+        let shader = Shader::new(linear, Lighting::default());
+        let mut s = Rng::new(11);
+        for round in 0..20 {
+            let mut lanes = [[0.0f32; LANES]; 3];
+            for k in 0..LANES {
+                let g = match (round + k) % 5 {
+                    0 => Vec3::ZERO,
+                    1 => s.vec().as_vec3() * 1e-30,
+                    _ => s.vec().as_vec3() * 300.0 - 150.0,
+                };
+                (lanes[0][k], lanes[1][k], lanes[2][k]) = (g.x, g.y, g.z);
+            }
+            let normals = on.normals(&lanes);
+            for k in 0..LANES {
+                let g = Vec3::new(lanes[0][k], lanes[1][k], lanes[2][k]);
+                let want = shader.normal(g).to_array().map(f32::to_bits);
+                let got = TissueHits::vector(&normals, k).map(f32::to_bits);
+                assert_eq!(got, want, "gradient {g}");
+            }
+        }
     }
 
     #[test]

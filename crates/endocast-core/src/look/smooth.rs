@@ -222,16 +222,25 @@ impl<'a> SmoothBands<'a> {
     fn gather(&self, y: usize, input: &mut Planes) {
         let g = self.gbuffer;
         let (w, r) = (g.width, self.radius());
+        let row = w * y..w * (y + 1);
+        let depth = &g.depth_mm[row.clone()];
         for (channel, plane) in input.iter_mut().enumerate() {
-            plane.fill(if channel == DEPTH { NO_HIT } else { 0.0 });
-        }
-        for x in 0..w {
-            let i = x + w * y;
-            if !g.hit(i) {
-                continue;
-            }
-            for (plane, v) in input.iter_mut().zip(g.texel(i)) {
-                plane[r + x] = v;
+            let miss = if channel == DEPTH { NO_HIT } else { 0.0 };
+            plane[..r].fill(miss);
+            plane[r + w..].fill(miss);
+            let (out, rows) = (&mut plane[r..r + w], row.clone());
+            match channel {
+                DEPTH => copy_hits(out, depth.iter().copied(), depth, miss),
+                SECRETION => copy_hits(out, g.secretion_mm[rows].iter().copied(), depth, miss),
+                c if c < NORMAL => {
+                    copy_hits(out, g.hit_mm[rows].iter().map(|p| p[c - HIT]), depth, miss)
+                }
+                c => copy_hits(
+                    out,
+                    g.normal[rows].iter().map(|n| n[c - NORMAL]),
+                    depth,
+                    miss,
+                ),
             }
         }
     }
@@ -264,6 +273,15 @@ impl<'a> SmoothBands<'a> {
                 plane[x0..x0 + LANES].copy_from_slice(m);
             }
         }
+    }
+}
+
+/// `values` into `out` where `depth` has a hit, `miss` elsewhere: a select per pixel, in a loop
+/// that vectorises.
+#[inline(always)]
+fn copy_hits(out: &mut [f32], values: impl Iterator<Item = f32>, depth: &[f32], miss: f32) {
+    for ((out, v), d) in out.iter_mut().zip(values).zip(depth) {
+        *out = if d.is_nan() { miss } else { v };
     }
 }
 
