@@ -13,8 +13,9 @@
 //!    depth-aware image-space smoothing of depth, normals and secretion ([`smooth`]), Phong with
 //!    the light at the endoscope's tip and its fall-off with distance, wetness (a low-power
 //!    view-dependent darkening and highlights, strongest on the detail texture's darker texels:
-//!    a specular map; raised by the secretion's density and nearness), a tri-planar detail
-//!    texture ([`Texture`]) and the secretion as fog under a glossy film: its upper boundary,
+//!    a specular map, or one given; raised by the secretion's density and nearness), a
+//!    tri-planar, mip-mapped detail texture ([`Texture`], colour or grey; each pixel reads the
+//!    level of its footprint on the tissue) and the secretion as fog under a glossy film: its upper boundary,
 //!    found by the ray pass with its own normal, lit and highlighted, fading in with the
 //!    layer's thickness. Changing any of it never marches a ray again:
 //!    [`shade`] takes a `&GBuffer` and no renderer.
@@ -59,6 +60,7 @@
 //! ```
 
 mod deferred;
+mod footprint;
 mod gbuffer;
 mod geometry;
 mod kind;
@@ -77,6 +79,8 @@ mod deferred_tests;
 mod geometry_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod texture_tests;
 
 pub use deferred::shade;
 pub use gbuffer::{GBuffer, RayPass};
@@ -86,7 +90,7 @@ pub use reduced::{shade_reduced, shade_reduced_with_scene};
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;
 pub use still::{still, still_frame, still_view, MAX_STILL_FRAMES};
-pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, MAX_TEXELS};
+pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, LUMA, MAX_TEXELS};
 
 use thiserror::Error;
 
