@@ -188,22 +188,22 @@ impl Texture {
         let mean = self.mean;
         let mut sum = map3(|_, _| 0.0);
         // The (x, y) projection is also the fallback where no axis has weight (a NaN normal).
-        let fallback = scale.iter().any(|s| !(*s > 0.0));
+        let fallback = scale.iter().any(|&s| s <= 0.0);
         for (axis, (a, b)) in [(1, 2), (0, 2), (0, 1)].into_iter().enumerate() {
             let used = weights[axis].iter().any(|&w| w > 0.0) || (axis == 2 && fallback);
             if !used {
                 continue;
             }
             let rgb = self.trilinear8(&p[a], &p[b], &levels);
-            for c in 0..3 {
-                for k in 0..LANES {
-                    sum[c][k] += weights[axis][k] * (rgb[c][k] - mean[c]);
-                }
-            }
+            sum = map3(|c, k| sum[c][k] + weights[axis][k] * (rgb[c][k] - mean[c]));
             if axis == 2 && fallback {
-                for k in (0..LANES).filter(|&k| !(scale[k] > 0.0)) {
-                    (0..3).for_each(|c| sum[c][k] = rgb[c][k] - mean[c]);
-                }
+                sum = map3(|c, k| {
+                    if scale[k] > 0.0 {
+                        sum[c][k]
+                    } else {
+                        rgb[c][k] - mean[c]
+                    }
+                });
             }
         }
         map3(|c, k| {
