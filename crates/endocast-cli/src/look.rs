@@ -166,9 +166,15 @@ pub struct RealismArgs {
     /// own surface; secretion raises it (default: the preset's, 0.8 for CT).
     #[arg(long, value_name = "0..1", allow_negative_numbers = true)]
     wetness: Option<f32>,
-    /// Detail texture: mucosa, grid, none, or a PNG file (its luminance).
+    /// Detail texture: mucosa (default: a low-contrast mottled mucosa with fine vessels), grid
+    /// (lines, the strongest shape cue), none, or a PNG file (its colour kept, mip-mapped).
     #[arg(long, value_name = "NAME|FILE.png")]
     texture: Option<String>,
+    /// Specular map: a PNG file read as grey (its luminance), tiled as the texture; where it is
+    /// bright the tissue is wetter and glossier, where black it has no highlights (default:
+    /// derived from the texture, strongest on its darker texels).
+    #[arg(long, value_name = "FILE.png")]
+    specular_map: Option<std::path::PathBuf>,
     /// Edge of one texture tile on the tissue, mm.
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     texture_scale: Option<f32>,
@@ -196,6 +202,15 @@ impl RealismArgs {
                 })
                 .transpose()?,
             texture_scale: self.texture_scale,
+            specular_map: self
+                .specular_map
+                .as_deref()
+                .map(|path| {
+                    endocast_io::texture::read_specular_map(path)
+                        .map(std::sync::Arc::new)
+                        .context("cannot use the specular map")
+                })
+                .transpose()?,
             attenuation: self.attenuation,
         };
         options.resolve(base, tissue_iso).map_err(flag_error)

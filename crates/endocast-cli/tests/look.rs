@@ -350,3 +350,92 @@ fn bench_times_the_realistic_look_against_plain_iso() {
     assert!(table.contains("| realistic look |"), "{table}");
     assert!(table.contains("deferred stage alone"), "{table}");
 }
+
+/// Writes `pixels` (RGB, `width` wide) as a PNG at `path`.
+fn write_rgb_png(path: &Path, width: u32, pixels: &[u8]) {
+    let height = pixels.len() as u32 / (3 * width);
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut encoder = png::Encoder::new(file, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().unwrap();
+    writer.write_image_data(pixels).unwrap();
+}
+
+/// How far red over green varies over the image's lit, unsaturated pixels (`max / min − 1`).
+fn hue_spread(png_bytes: &[u8]) -> f64 {
+    let mut reader = png::Decoder::new(std::io::Cursor::new(png_bytes))
+        .read_info()
+        .unwrap();
+    let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buffer).unwrap();
+    let channels = info.color_type.samples();
+    let hues: Vec<f64> = buffer[..info.buffer_size()]
+        .chunks_exact(channels)
+        .filter(|px| px[..3].iter().all(|&c| (20..250).contains(&c)))
+        .map(|px| f64::from(px[0]) / f64::from(px[1]))
+        .collect();
+    assert!(hues.len() > 100, "{} pixels", hues.len());
+    let (lo, hi) = hues
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), &v| (l.min(v), h.max(v)));
+    hi / lo - 1.0
+}
+
+#[test]
+fn a_colour_texture_changes_the_hue_a_specular_map_is_read_and_bad_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = layered(dir.path());
+    let png = dir.path().join("look.png");
+    // A 2 × 2 checker of reddish and greenish texels, and its grey twin.
+    let colour = dir.path().join("colour.png");
+    write_rgb_png(&colour, 2, &[200, 60, 60, 60, 200, 60, 60, 200, 60, 200, 60, 60]);
+    let grey = dir.path().join("grey.png");
+    write_rgb_png(&grey, 2, &[100, 100, 100, 160, 160, 160, 160, 160, 160, 100, 100, 100]);
+    let look = |texture: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "--look",
+            "realistic",
+            "--wetness",
+            "0",
+            "--texture-scale",
+            "4",
+            "--texture",
+            texture.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        render(&volume, &png, &args)
+    };
+    let (coloured, greyed) = (look(&colour, &[]), look(&grey, &[]));
+    let (c, g) = (hue_spread(&coloured), hue_spread(&greyed));
+    assert!(c > 0.3 && g < 0.1, "hue varies by {c} (colour) and {g} (grey)");
+    // A specular map changes the wet look.
+    let wet = |extra: &[&str]| {
+        let mut args = vec!["--look", "realistic", "--wetness", "1"];
+        args.extend_from_slice(extra);
+        render(&volume, &png, &args)
+    };
+    assert_ne!(wet(&[]), wet(&["--specular-map", grey.to_str().unwrap()]));
+    // Bad files: named, with the problem.
+    let broken = dir.path().join("broken.png");
+    std::fs::write(&broken, b"no png here").unwrap();
+    let base = [
+        "render",
+        volume.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--look",
+        "realistic",
+    ];
+    let missing = dir.path().join("missing.png");
+    for (flag, file, problem) in [
+        ("--texture", &missing, "missing.png"),
+        ("--texture", &broken, "not a readable PNG"),
+        ("--specular-map", &broken, "broken.png"),
+        ("--specular-map", &missing, "specular map"),
+    ] {
+        let mut args = base.to_vec();
+        args.extend_from_slice(&[flag, file.to_str().unwrap()]);
+        fails_with(&args, problem);
+    }
+}

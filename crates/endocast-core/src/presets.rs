@@ -208,7 +208,7 @@ pub const ALL: &[Preset] = &[
         reference: Reference::Hounsfield,
         look: PresetLook {
             secretion_mode: SecretionMode::Off,
-            texture_mm: 15.0,
+            texture_mm: 36.0,
             attenuation_mm: 60.0,
             tissue_color: [0.95, 0.6, 0.5],
             ..PresetLook::CT
@@ -353,7 +353,7 @@ pub const ALL: &[Preset] = &[
             secretion: 60.0,
             secretion_mode: SecretionMode::Off,
             wetness: 0.5,
-            texture_mm: 20.0,
+            texture_mm: 48.0,
             attenuation_mm: 30.0,
             tissue_color: [0.92, 0.84, 0.76],
             secretion_color: [0.85, 0.85, 0.9],

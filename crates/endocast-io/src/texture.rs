@@ -1,15 +1,32 @@
-//! Detail textures for the realistic look from PNG files: any PNG (greyscale, colour, palette,
-//! with or without alpha, 8 or 16 bits) read as its luminance, 0–1.
+//! Detail textures and specular maps for the realistic look from PNG files: any PNG (greyscale,
+//! colour, palette, with or without alpha, 8 or 16 bits). A texture keeps the file's colour (a
+//! grey file gives a grey texture); a specular map is the file's luminance.
 
 use crate::error::{ReadError, Result};
-use endocast_core::look::{Texture, BUILT_IN_TEXTURES, MAX_TEXELS};
+use endocast_core::look::{Texture, BUILT_IN_TEXTURES, LUMA, MAX_TEXELS};
 use std::io::BufReader;
 use std::path::Path;
 
-/// Reads the PNG at `path` as a [`Texture`] of its luminance (Rec. 709 weights; alpha
-/// ignored). Errors name the file: missing, not a PNG, or an image of 0 or more than 8192
-/// pixels along an edge.
+/// Reads the PNG at `path` as a [`Texture`] of its colours (alpha ignored). Errors name the
+/// file: missing, not a PNG, or an image of 0 or more than 8192 pixels along an edge.
 pub fn read_texture(path: &Path) -> Result<Texture> {
+    let (width, height, rgb) = read_rgb(path)?;
+    Texture::from_rgb(width, height, rgb).map_err(|e| ReadError::format(path, e.to_string()))
+}
+
+/// Reads the PNG at `path` as a specular map: a grey [`Texture`] of its luminance (Rec. 709
+/// weights; alpha ignored). Errors as [`read_texture`]'s.
+pub fn read_specular_map(path: &Path) -> Result<Texture> {
+    let (width, height, rgb) = read_rgb(path)?;
+    let luma = rgb
+        .iter()
+        .map(|c| (LUMA[0] * c[0] + LUMA[1] * c[1] + LUMA[2] * c[2]).clamp(0.0, 1.0))
+        .collect();
+    Texture::from_luma(width, height, luma).map_err(|e| ReadError::format(path, e.to_string()))
+}
+
+/// The PNG at `path`: width, height and its pixels' red, green and blue, 0–1 (grey repeated).
+fn read_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>)> {
     let file = std::fs::File::open(path).map_err(|e| ReadError::io(path, e))?;
     let mut decoder = png::Decoder::new(BufReader::new(file));
     decoder.set_transformations(png::Transformations::normalize_to_color8());
@@ -23,18 +40,17 @@ pub fn read_texture(path: &Path) -> Result<Texture> {
     let info = reader.next_frame(&mut buffer).map_err(bad)?;
     let channels = info.color_type.samples();
     let (width, height) = (info.width as usize, info.height as usize);
-    let luma = buffer[..info.buffer_size()]
+    let unit = |v: u8| f32::from(v) / 255.0;
+    let rgb = buffer[..info.buffer_size()]
         .chunks_exact(info.line_size)
         .flat_map(|row| row[..width * channels].chunks_exact(channels))
         .map(|px| match px {
-            [g] | [g, _] => f32::from(*g) / 255.0,
-            [r, g, b, ..] => {
-                (0.2126 * f32::from(*r) + 0.7152 * f32::from(*g) + 0.0722 * f32::from(*b)) / 255.0
-            }
-            [] => 0.0,
+            [g] | [g, _] => [unit(*g); 3],
+            [r, g, b, ..] => [unit(*r), unit(*g), unit(*b)],
+            [] => [0.0; 3],
         })
         .collect();
-    Texture::from_luma(width, height, luma).map_err(|e| ReadError::format(path, e.to_string()))
+    Ok((width, height, rgb))
 }
 
 /// A detail texture by built-in name (`none`: no texture) or from a PNG file, as `--texture`
@@ -80,15 +96,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reads_colour_pngs_as_luminance_and_names_bad_files() {
+    fn reads_colour_pngs_in_colour_specular_maps_as_luminance_and_names_bad_files() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.png");
         // Two pixels: white and pure green.
         crate::write_image_rgb8(&path, 2, 1, &[255, 255, 255, 0, 255, 0]).unwrap();
         let texture = read_texture(&path).unwrap();
         assert_eq!(texture.size(), [2, 1]);
-        assert!((texture.sample(0.25, 0.5) - 1.0).abs() < 1e-6);
-        assert!((texture.sample(0.75, 0.5) - 0.7152).abs() < 1e-4);
+        assert!(texture.is_colour());
+        assert_eq!(texture.sample(0.25, 0.5, 0), [1.0; 3]);
+        assert_eq!(texture.sample(0.75, 0.5, 0), [0.0, 1.0, 0.0]);
+        let map = read_specular_map(&path).unwrap();
+        assert!(!map.is_colour());
+        assert!((map.sample(0.75, 0.5, 0)[0] - 0.7152).abs() < 1.0 / 255.0);
+        // A grey file: a grey texture.
+        crate::write_image_rgb8(&path, 2, 1, &[90, 90, 90, 200, 200, 200]).unwrap();
+        assert!(!read_texture(&path).unwrap().is_colour());
         let missing = dir.path().join("missing.png");
         let error = read_texture(&missing).unwrap_err().to_string();
         assert!(error.contains("missing.png"), "{error}");

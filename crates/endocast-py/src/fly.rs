@@ -28,8 +28,8 @@ use std::path::PathBuf;
 /// and `render`'s look, peel, lens and lumen options: `preset`, `mode`, `iso`, `iso2`,
 /// `iso_opacity`, `tf`, `step`, `jitter`, `skip_empty`, `shade_dvr`, `background`, `peel`,
 /// `peel_threshold`, `peel_falling`, `peel_keep`, `unpeeled`, `tf_after`, `look`,
-/// `secretion`, `secretion_iso`, `wetness`, `texture`, `texture_scale`, `attenuation`, `fov`,
-/// `near`, `lens`, `distortion`, `vignetting`, `lumen_threshold`, `bright_lumen`, `threads`,
+/// `secretion`, `secretion_iso`, `wetness`, `texture`, `texture_scale`, `specular_map`,
+/// `attenuation`, `fov`, `near`, `lens`, `distortion`, `vignetting`, `lumen_threshold`, `bright_lumen`, `threads`,
 /// `meshes`, `overlays` (see `help(endocast.render)`). The volume may be a nibabel or SimpleITK image.
 #[pyfunction]
 #[pyo3(signature = (volume, route, out = None, **options))]

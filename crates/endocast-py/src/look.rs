@@ -33,7 +33,7 @@ impl LookOptions {
     /// options (`mode`, `iso2`, `iso_opacity`, `tf`, `step`, `jitter`, `skip_empty`,
     /// `shade_dvr`, `background`), the peel's (`peel`, `peel_threshold`, `peel_falling`,
     /// `peel_keep`, `unpeeled`, `tf_after`) and the look's (`look`, `secretion`,
-    /// `secretion_iso`, `wetness`, `texture`, `texture_scale`, `attenuation`).
+    /// `secretion_iso`, `wetness`, `texture`, `texture_scale`, `specular_map`, `attenuation`).
     pub fn take(kw: &Kwargs<'_>) -> PyResult<Self> {
         let tf = |key| -> PyResult<Option<TransferFunction>> {
             kw.take::<String>(key)?
@@ -73,6 +73,14 @@ impl LookOptions {
                 })
                 .transpose()?,
             texture_scale: kw.take("texture_scale")?,
+            specular_map: kw
+                .take::<std::path::PathBuf>("specular_map")?
+                .map(|path| {
+                    endocast_io::texture::read_specular_map(&path)
+                        .map(Arc::new)
+                        .map_err(to_py)
+                })
+                .transpose()?,
             attenuation: kw.take("attenuation")?,
         };
         Ok(Self {

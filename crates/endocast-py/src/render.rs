@@ -61,7 +61,8 @@ struct View {
 ///   `peel_falling`, `peel_keep` (0–1), `unpeeled` (discard, context), `tf_after`;
 /// - the endoscope's look: `look` (plain, clinical, realistic; default the preset's),
 ///   `secretion` (off, on, accumulate), `secretion_iso`, `wetness` (0–1), `texture`
-///   (mucosa, grid, none or a PNG file), `texture_scale` (mm), `attenuation` (mm, 0: none),
+///   (mucosa, grid, none or a PNG file, its colour kept), `texture_scale` (mm),
+///   `specular_map` (a PNG file, grey: bright is glossier), `attenuation` (mm, 0: none),
 ///   `still` (average this many jittered frames, 1–256);
 /// - lumen: `lumen_threshold`, `bright_lumen`;
 /// - geometry: `meshes` (STL, OBJ or PLY files, world mm), `overlays` (DICOM segmentations,

@@ -3,6 +3,7 @@
 //! is in the cache.
 
 use super::clipped::overlay;
+use super::footprint::Footprints;
 use super::gbuffer::GBuffer;
 use super::lanes::{load, map, map3, Lanes, LANES};
 use super::shading::{Shading, Surface8};
@@ -37,6 +38,7 @@ pub fn shade(gbuffer: &GBuffer, camera: &Camera, shading: &Shading) -> Result<Fr
     let rows = Rows {
         shading,
         camera,
+        footprints: Footprints::of(camera),
         secretion_normal: &gbuffer.secretion_normal,
     };
     frame
@@ -67,6 +69,8 @@ pub fn shade(gbuffer: &GBuffer, camera: &Camera, shading: &Shading) -> Result<Fr
 struct Rows<'a> {
     shading: &'a Shading,
     camera: &'a Camera,
+    /// The camera's pixel footprints (for the texture's mip levels).
+    footprints: Footprints,
     /// The G-buffer's secretion surface normals, unsmoothed (empty: none).
     secretion_normal: &'a [[f32; 3]],
 }
@@ -81,8 +85,10 @@ impl Rows<'_> {
         let vignetting = self.camera.lens().vignetting > 0.0;
         for x0 in (0..w).step_by(LANES) {
             let lanes = |c: usize| load(&planes[c], x0);
+            let depth = lanes(DEPTH);
             let surface = Surface8 {
-                depth: lanes(DEPTH),
+                footprint: self.footprints.row8(x0, y, &depth),
+                depth,
                 hit: [lanes(HIT), lanes(HIT + 1), lanes(HIT + 2)],
                 normal: [lanes(NORMAL), lanes(NORMAL + 1), lanes(NORMAL + 2)],
                 secretion: lanes(SECRETION),

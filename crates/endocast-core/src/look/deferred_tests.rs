@@ -2,9 +2,11 @@
 //! look first shaded): the same bits, on a G-buffer with misses, silhouettes, secretion and an
 //! odd size (lane sets and bands cut off at the edges).
 
+use super::footprint::Footprints;
+use super::lanes::LANES;
 use super::shading::{
-    smoothstep, FILM_GLOSS, FILM_MM, FILM_SHININESS, SPECULAR_MAP_BASE, SPECULAR_MAP_GAIN,
-    WET_DARKENING,
+    smoothstep, FILM_GLOSS, FILM_MM, FILM_SHININESS, MIN_FOOTPRINT_COS, SPECULAR_MAP_BASE,
+    SPECULAR_MAP_GAIN, SPECULAR_MAP_MAX, WET_DARKENING,
 };
 use super::smooth::DEPTH_EDGE;
 use super::*;
@@ -124,9 +126,20 @@ fn highlight(s: &Shading, gloss: f32, cos: f32, shininess: f32) -> f32 {
     }
 }
 
+/// The luminance of a colour.
+fn luma(rgb: [f32; 3]) -> f32 {
+    LUMA[0] * rgb[0] + LUMA[1] * rgb[1] + LUMA[2] * rgb[2]
+}
+
 /// The shading of one smoothed texel, one pixel at a time (`surface`: the secretion surface's
-/// normal, NaN for none).
-fn shade_pixel(s: &Shading, t: [f32; 8], surface: Vec3, tip: Vec3) -> Premultiplied {
+/// normal, NaN for none; `footprint`: the pixel's width at its depth, mm).
+fn shade_pixel(
+    s: &Shading,
+    t: [f32; 8],
+    surface: Vec3,
+    tip: Vec3,
+    footprint: f32,
+) -> Premultiplied {
     if t[0].is_nan() {
         return Premultiplied::default();
     }
@@ -144,11 +157,9 @@ fn shade_pixel(s: &Shading, t: [f32; 8], surface: Vec3, tip: Vec3) -> Premultipl
     let cos = cosine(n);
     let film_cos = cosine(surface);
     let film_cos = if film_cos.is_nan() { cos } else { film_cos };
-    let texel = s
-        .texture
-        .as_ref()
-        .map_or(0.5, |tex| tex.triplanar(p / s.texture_mm, n));
-    let detail = 1.0 + s.texture_strength * (2.0 * texel - 1.0);
+    let tiles = footprint / (cos.max(MIN_FOOTPRINT_COS) * s.texture_mm);
+    let lookup = |tex: &Arc<Texture>| tex.triplanar(p / s.texture_mm, n, tiles);
+    let texel = s.texture.as_ref().map_or([0.5; 3], lookup);
     let fog = s.fog(t[7]);
     let film = if t[7] > 0.0 {
         smoothstep(t[7] / FILM_MM)
@@ -165,11 +176,16 @@ fn shade_pixel(s: &Shading, t: [f32; 8], surface: Vec3, tip: Vec3) -> Premultipl
     let raised = (1.0 - s.wetness) * fog * near * s.wetness.min(0.5) * 2.0;
     let wet = (s.wetness + raised).clamp(0.0, 1.0);
     let darkening = |c: f32| 1.0 - wet * WET_DARKENING * (1.0 - c * c);
-    let tissue =
-        Vec3::from(s.tissue_color) * (detail * (s.ambient + s.diffuse * cos) * darkening(cos));
+    let detail = texel.map(|c| 1.0 + s.texture_strength * (2.0 * c - 1.0));
+    let lit = s.ambient + s.diffuse * cos;
+    let tissue = Vec3::from(detail.map(|d| d * lit * darkening(cos)));
+    let tissue = Vec3::from(s.tissue_color) * tissue;
     let lit = s.ambient + s.diffuse * film_cos;
     let mucus = Vec3::from(s.secretion_color) * lit;
-    let map = SPECULAR_MAP_BASE + SPECULAR_MAP_GAIN * (1.0 - texel);
+    let map = match &s.specular_map {
+        Some(m) => SPECULAR_MAP_MAX * luma(lookup(m)),
+        None => SPECULAR_MAP_BASE + SPECULAR_MAP_GAIN * (1.0 - luma(texel)),
+    };
     let glints = [
         highlight(s, wet * map * (1.0 - fog), cos, s.shininess),
         highlight(s, wet * FILM_GLOSS * film, film_cos, FILM_SHININESS),
@@ -196,7 +212,21 @@ fn the_vectorised_deferred_stage_matches_its_scalar_form() {
         attenuation_mm: None,
         ..Shading::default()
     };
-    for (shading, radius) in [(&realistic, 2), (&realistic, 0), (&plain, 3)] {
+    // A colour texture and a specular map, a few mm a tile (several mip levels in use).
+    let rgb = (0..48)
+        .map(|i| [hash(i, 7), hash(i, 8), hash(i, 9)])
+        .collect();
+    let mapped = Shading {
+        wetness: 0.9,
+        texture: Texture::from_rgb(8, 6, rgb).ok().map(Arc::new),
+        specular_map: Texture::from_luma(4, 4, (0..16).map(|i| hash(i, 10)).collect())
+            .ok()
+            .map(Arc::new),
+        texture_mm: 3.0,
+        ..Shading::default()
+    };
+    let cases = [(&realistic, 2), (&realistic, 0), (&plain, 3), (&mapped, 1)];
+    for (shading, radius) in cases {
         let shading = Shading {
             smoothing_px: radius,
             ..shading.clone()
@@ -204,9 +234,12 @@ fn the_vectorised_deferred_stage_matches_its_scalar_form() {
         let frame = shade(&g, &camera, &shading).unwrap();
         let texels = smooth_by_pixel(&g, radius);
         let smoothed = smooth::smooth(&g, radius);
+        let footprints = Footprints::of(&camera);
         for (i, t) in texels.iter().enumerate() {
             let surface = Vec3::from(g.secretion_normal[i]);
-            let expected = shade_pixel(&shading, *t, surface, tip);
+            let (x, y) = (i % camera.size()[0], i / camera.size()[0]);
+            let footprint = footprints.row8(x, y, &[t[0]; LANES])[0];
+            let expected = shade_pixel(&shading, *t, surface, tip, footprint);
             assert_eq!(frame.color[i], expected, "radius {radius}, pixel {i}");
             let same = |a: f32, b: f32| a == b || (a.is_nan() && b.is_nan());
             assert!(same(frame.depth_mm[i], t[0]), "pixel {i}");
@@ -220,8 +253,8 @@ fn the_vectorised_deferred_stage_matches_its_scalar_form() {
 #[test]
 fn vectorised_texture_lookups_match_the_scalar_ones() {
     let texture = Texture::built_in("mucosa").unwrap();
-    let odd = Texture::from_luma(5, 3, (0..15).map(|i| i as f32 / 14.0).collect()).unwrap();
-    for t in [&texture, &odd] {
+    let odd = Texture::from_rgb(5, 3, (0..15).map(|i| [i as f32 / 14.0, 0.2, 0.9]).collect());
+    for t in [&texture, &odd.unwrap()] {
         let [w, h] = t.size();
         for i in 0..2000 {
             let (u, v) = (40.0 * hash(i, 5) - 20.0, 40.0 * hash(i, 6) - 20.0);
@@ -234,13 +267,14 @@ fn vectorised_texture_lookups_match_the_scalar_ones() {
             let at = |i: f32, j: f32| {
                 let i = (i as i64).rem_euclid(w as i64) as f32;
                 let j = (j as i64).rem_euclid(h as i64) as f32;
-                t.sample((i + 0.5) / w as f32, (j + 0.5) / h as f32)
+                Vec3::from(t.sample((i + 0.5) / w as f32, (j + 0.5) / h as f32, 0))
             };
             let (fx, fy) = (x - x0, y - y0);
             let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1.0, y0) * fx;
             let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
             let expected = top * (1.0 - fy) + bottom * fy;
-            assert!((t.sample(u, v) - expected).abs() < 1e-4, "({u}, {v})");
+            let got = Vec3::from(t.sample(u, v, 0));
+            assert!((got - expected).abs().max_element() < 1e-4, "({u}, {v})");
         }
     }
 }

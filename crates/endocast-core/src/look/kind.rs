@@ -80,7 +80,7 @@ impl PresetLook {
         secretion_mode: SecretionMode::On,
         wetness: 0.8,
         texture: "mucosa",
-        texture_mm: 12.0,
+        texture_mm: 30.0,
         attenuation_mm: 40.0,
         tissue_color: [0.93, 0.62, 0.55],
         secretion_color: [0.92, 0.88, 0.62],

@@ -13,8 +13,9 @@
 //!    depth-aware image-space smoothing of depth, normals and secretion ([`smooth`]), Phong with
 //!    the light at the endoscope's tip and its fall-off with distance, wetness (a low-power
 //!    view-dependent darkening and highlights, strongest on the detail texture's darker texels:
-//!    a specular map; raised by the secretion's density and nearness), a tri-planar detail
-//!    texture ([`Texture`]) and the secretion as fog under a glossy film: its upper boundary,
+//!    a specular map, or one given; raised by the secretion's density and nearness), a
+//!    tri-planar, mip-mapped detail texture ([`Texture`], colour or grey; each pixel reads the
+//!    level of its footprint on the tissue) and the secretion as fog under a glossy film: its upper boundary,
 //!    found by the ray pass with its own normal, lit and highlighted, fading in with the
 //!    layer's thickness. Changing any of it never marches a ray again:
 //!    [`shade`] takes a `&GBuffer` and no renderer.
@@ -63,6 +64,7 @@
 
 mod clipped;
 mod deferred;
+mod footprint;
 mod gbuffer;
 mod geometry;
 mod kind;
@@ -86,6 +88,8 @@ mod geometry_tests;
 mod stereo_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod texture_tests;
 
 pub use deferred::shade;
 pub use gbuffer::{GBuffer, RayPass};
@@ -96,7 +100,7 @@ pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;
 pub use stereo::{stereo_frame, stereo_still, stereo_view};
 pub use still::{still, still_frame, still_view, MAX_STILL_FRAMES};
-pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, MAX_TEXELS};
+pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, LUMA, MAX_TEXELS};
 
 use thiserror::Error;
 

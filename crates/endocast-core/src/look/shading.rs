@@ -9,7 +9,7 @@
 //! and highlighted by the secretion surface's own normal, fading in where the layer thins.
 
 use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
-use super::texture::Texture;
+use super::texture::{Texture, LUMA};
 use super::{check, LookError};
 use glam::Vec3;
 use std::sync::Arc;
@@ -23,6 +23,12 @@ pub(super) const WET_DARKENING: f32 = 0.55;
 pub(super) const SPECULAR_MAP_BASE: f32 = 0.5;
 /// See [`SPECULAR_MAP_BASE`].
 pub(super) const SPECULAR_MAP_GAIN: f32 = 1.0;
+/// A given specular map's strength at its brightest (white) texels; black gives none.
+pub(super) const SPECULAR_MAP_MAX: f32 = 1.5;
+
+/// The smallest cosine between the view and the normal that widens a pixel's footprint on the
+/// surface (at most 16 times: the texture's mip level at most 4 coarser than facing).
+pub(super) const MIN_FOOTPRINT_COS: f32 = 1.0 / 16.0;
 
 /// Secretion thickness at which the mucus film's gloss is full, mm; thinner, it fades in
 /// smoothly (soft edges where the layer thins).
@@ -44,7 +50,7 @@ pub struct Shading {
     pub ambient: f32,
     /// Diffuse weight of the tip's light, 0–1. Default 0.88.
     pub diffuse: f32,
-    /// Strength of the wet highlights at full wetness, 0–1 (times the specular map, 0.5–1.5).
+    /// Strength of the wet highlights at full wetness, 0–1 (times the specular map, 0–1.5).
     /// Default 1.
     pub specular: f32,
     /// Sharpness of the mucosa's wet highlights (Phong exponent), 1–1000. Default 24: glints, not
@@ -52,9 +58,15 @@ pub struct Shading {
     pub shininess: f32,
     /// Wetness, 0 (dry) – 1. Default 0.
     pub wetness: f32,
-    /// The detail texture; `None` (the default) for none.
+    /// The detail texture (its colour, or grey, modulates the tissue's); `None` (the default)
+    /// for none.
     pub texture: Option<Arc<Texture>>,
-    /// Edge of one texture tile on the tissue, mm, 0.1–1000. Default 12.
+    /// The specular map: where it is bright the tissue is wetter and glossier, where black it
+    /// has no highlights (its luminance, 0–1, times [`SPECULAR_MAP_MAX`]); tiled and projected
+    /// as the texture is. `None` (the default): derived from the detail texture, strongest on
+    /// its darker texels (Krüger et al. §4.4).
+    pub specular_map: Option<Arc<Texture>>,
+    /// Edge of one texture tile on the tissue, mm, 0.1–1000. Default 30.
     pub texture_mm: f32,
     /// How much the texture changes the colour, 0–1 (±this share). Default 0.6.
     pub texture_strength: f32,
@@ -78,7 +90,8 @@ impl Default for Shading {
             shininess: 24.0,
             wetness: 0.0,
             texture: None,
-            texture_mm: 12.0,
+            specular_map: None,
+            texture_mm: 30.0,
             texture_strength: 0.6,
             attenuation_mm: Some(40.0),
             fog_mm: 1.5,
@@ -140,9 +153,12 @@ impl Shading {
     /// The colours of eight hits (before the vignetting and the clamp to 1), `tip` the light at
     /// the endoscope's tip; lanes without a hit (NaN) give NaN or anything else.
     ///
-    /// The tissue: lit (ambient plus diffuse), its texture's detail, darkened by the wetness's
-    /// low-power view term (`1 − wet · WET_DARKENING · (1 − cos²)`), then its highlights added
-    /// (the specular map: stronger on the texture's darker texels). Over it the secretion: a fog
+    /// The tissue: lit (ambient plus diffuse), its texture's detail (per channel: a colour
+    /// texture changes the hue), darkened by the wetness's low-power view term
+    /// (`1 − wet · WET_DARKENING · (1 − cos²)`), then its highlights added (times the specular
+    /// map: the one given, else stronger on the texture's darker texels). The texture and the
+    /// map are read at the mip level of the pixel's footprint on the tissue (`s.footprint`,
+    /// widened by `1 / cos` of the view to the normal). Over it the secretion: a fog
     /// toward the mucus colour, lit (not darkened) by the secretion surface's own normal, with the glossy
     /// film's highlights on that surface fading in with the layer's thickness (no hard edge
     /// where it thins). Secretion raises the wetness with its density (its fog) and the
@@ -162,10 +178,7 @@ impl Shading {
                 film_cos[k]
             }
         });
-        let texel = match &self.texture {
-            Some(t) => t.triplanar8(&map3(|a, k| s.hit[a][k] / self.texture_mm), &s.normal),
-            None => [0.5; LANES],
-        };
+        let (texel, specular_map) = self.detail8(s, &cos);
         let secreted = s.secretion.iter().any(|&mm| mm > 0.0);
         let (fog, film) = if secreted {
             let film = map(|k| smoothstep(s.secretion[k] / FILM_MM));
@@ -181,11 +194,12 @@ impl Shading {
         let lit = map(|k| self.ambient + self.diffuse * cos[k]);
         let film_lit = map(|k| self.ambient + self.diffuse * film_cos[k]);
         let darkening = map(|k| 1.0 - wet[k] * WET_DARKENING * (1.0 - cos[k] * cos[k]));
-        let tissue = map(|k| (1.0 + self.texture_strength * (2.0 * texel[k] - 1.0)) * lit[k]);
-        let tissue = map(|k| tissue[k] * darkening[k]);
+        let tissue = map3(|c, k| {
+            let detail = 1.0 + self.texture_strength * (2.0 * texel[c][k] - 1.0);
+            detail * lit[k] * darkening[k]
+        });
         // The mucus is a translucent liquid, not the wet mucosa: lit, not darkened.
         let mucus = film_lit;
-        let specular_map = map(|k| SPECULAR_MAP_BASE + SPECULAR_MAP_GAIN * (1.0 - texel[k]));
         let tissue_gloss = map(|k| wet[k] * specular_map[k] * (1.0 - fog[k]));
         let film_gloss = map(|k| wet[k] * FILM_GLOSS * film[k]);
         let highlight = self.highlights8(&tissue_gloss, &cos, self.shininess);
@@ -197,9 +211,32 @@ impl Shading {
         let falloff = map(|k| self.falloff(s.depth[k]));
         map3(|c, k| {
             let (t, m) = (self.tissue_color[c], self.secretion_color[c]);
-            let mixed = t * tissue[k] * (1.0 - fog[k]) + m * mucus[k] * fog[k];
+            let mixed = t * tissue[c][k] * (1.0 - fog[k]) + m * mucus[k] * fog[k];
             (mixed + highlight[k] + glints[k]) * falloff[k]
         })
+    }
+
+    /// The detail texture's colours of eight hits (mid-grey without one) and the specular
+    /// map's strengths there, `cos` the cosines of the view to the normals.
+    #[inline(always)]
+    fn detail8(&self, s: &Surface8, cos: &Lanes) -> ([Lanes; 3], Lanes) {
+        let tiles = map3(|a, k| s.hit[a][k] / self.texture_mm);
+        let footprint = map(|k| s.footprint[k] / (cos[k].max(MIN_FOOTPRINT_COS) * self.texture_mm));
+        let texel = match &self.texture {
+            Some(t) => t.triplanar8(&tiles, &s.normal, &footprint),
+            None => [[0.5; LANES]; 3],
+        };
+        let specular_map = match &self.specular_map {
+            Some(m) => {
+                let v = luma(&m.triplanar8(&tiles, &s.normal, &footprint));
+                map(|k| SPECULAR_MAP_MAX * v[k])
+            }
+            None => {
+                let v = luma(&texel);
+                map(|k| SPECULAR_MAP_BASE + SPECULAR_MAP_GAIN * (1.0 - v[k]))
+            }
+        };
+        (texel, specular_map)
     }
 
     /// Highlights of eight hits: sharp (Phong exponent `shininess`) where the light reflects
@@ -217,6 +254,12 @@ impl Shading {
         }
         highlight
     }
+}
+
+/// The luminance of eight colours.
+#[inline(always)]
+fn luma(rgb: &[Lanes; 3]) -> Lanes {
+    map(|k| LUMA[0] * rgb[0][k] + LUMA[1] * rgb[1][k] + LUMA[2] * rgb[2][k])
 }
 
 /// `|n · v|` per lane, at most 1 (NaN where the normal is NaN).
@@ -246,4 +289,6 @@ pub(super) struct Surface8 {
     pub secretion: Lanes,
     /// Unit normal of the secretion's surface (either side; NaN: none, the tissue's is taken).
     pub secretion_normal: [Lanes; 3],
+    /// The pixel's width on a surface facing the eye at the hit's depth, mm.
+    pub footprint: Lanes,
 }

@@ -160,6 +160,9 @@ pub struct LookOptions {
     pub texture: Option<Option<Arc<Texture>>>,
     /// The edge of one texture tile, mm.
     pub texture_scale: Option<f32>,
+    /// The specular map (bright: wetter, glossier); `None` keeps the one derived from the
+    /// detail texture.
+    pub specular_map: Option<Arc<Texture>>,
     /// The distance at which the tip's light halves, mm (0: no fall-off).
     pub attenuation: Option<f32>,
 }
@@ -173,6 +176,7 @@ impl LookOptions {
             ("wetness", self.wetness.is_some()),
             ("texture", self.texture.is_some()),
             ("texture_scale", self.texture_scale.is_some()),
+            ("specular_map", self.specular_map.is_some()),
             ("attenuation", self.attenuation.is_some()),
         ];
         keys.iter().filter(|(_, on)| *on).map(|(k, _)| *k).collect()
@@ -211,6 +215,9 @@ impl LookOptions {
         }
         if let Some(texture) = &self.texture {
             look.shading.texture.clone_from(texture);
+        }
+        if let Some(map) = &self.specular_map {
+            look.shading.specular_map = Some(map.clone());
         }
         if let Some(mm) = self.texture_scale {
             if !(mm.is_finite() && mm > 0.0) {
