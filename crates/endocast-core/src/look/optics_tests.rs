@@ -150,7 +150,10 @@ fn a_folding_distortion_ends_in_a_soft_round_field_stop() {
             assert_eq!(shown, None, "beyond the fold at {x}: the background shows");
         } else if r < edge - 2.5 {
             let v = shown.unwrap();
-            assert!((v - inside).abs() < 0.03 * inside, "inside the field at {x}: {v}");
+            assert!(
+                (v - inside).abs() < 0.03 * inside,
+                "inside the field at {x}: {v}"
+            );
         } else if r > edge - 1.5 {
             let v = shown.unwrap();
             assert!(v < 0.9 * inside, "the stop's soft edge at {x}: {v}");
