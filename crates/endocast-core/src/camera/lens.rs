@@ -200,7 +200,7 @@ mod tests {
         assert!(lens.undistort_scale(edge * 1.001).is_none());
         assert_eq!(lens.field_stop(edge * 0.5, 0.01), 1.0);
         assert_eq!(lens.field_stop(edge, 0.01), 0.0);
-        let soft = lens.field_stop(edge - 0.02, 0.01);
+        let soft = lens.field_stop(edge - 0.01, 0.01);
         assert!(soft > 0.0 && soft < 1.0);
         // Both roots: 1 − 1.5 s + 0.5 s² (k1 = −0.5, k2 = 0.1) folds at s = 1.
         let both = Lens {
