@@ -181,6 +181,12 @@ pub struct RealismArgs {
     /// Distance at which the tip's light falls to half, mm (0: no fall-off).
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     attenuation: Option<f32>,
+    /// Lighting: phong (the default); ibl, image-based (Krüger et al. §4.4): the diffuse light
+    /// from a built-in lit sphere (the tip's light with a soft terminator and rim); or
+    /// ibl:FILE.png, your lit sphere (a square image of a lit ball, its luminance; centre:
+    /// facing the tip). The wet highlights stay the specular model's.
+    #[arg(long, value_name = "phong|ibl|ibl:FILE.png")]
+    lighting: Option<String>,
 }
 
 impl RealismArgs {
@@ -212,6 +218,13 @@ impl RealismArgs {
                 })
                 .transpose()?,
             attenuation: self.attenuation,
+            lighting: self
+                .lighting
+                .as_deref()
+                .map(|spec| {
+                    endocast_io::lit_sphere::named_or_file(spec).context("cannot use the lighting")
+                })
+                .transpose()?,
         };
         options.resolve(base, tissue_iso).map_err(flag_error)
     }

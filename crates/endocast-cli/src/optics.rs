@@ -1,10 +1,13 @@
 //! The camera options `render`, `fly` and `bench` share — the lens's projection, distortion
 //! and vignetting — and the stereo options of `render` and `fly`.
 
+use crate::look::flag_error;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::camera::{Lens, Optics, Projection, StereoRig};
+use endocast_core::camera::{Optics, Projection, StereoRig};
+use endocast_core::look::Look;
 use endocast_core::presets::{self, Preset};
+use endocast_core::study::LensOptions;
 use endocast_core::views::stereo::StereoOutput;
 use std::path::{Path, PathBuf};
 
@@ -17,20 +20,27 @@ pub struct LensArgs {
     #[arg(long, value_name = "PROJECTION", value_parser = parse_projection)]
     pub lens: Option<Projection>,
     /// Radial lens distortion (Brown–Conrady) on image coordinates normalised to the half
-    /// height: K1 < 0 is the barrel distortion of a real endoscope (e.g. -0.25,0.05).
+    /// height: K1 < 0 is the barrel distortion of a real endoscope. Default: the look's lens —
+    /// with --look realistic a rigid sinus endoscope's (-0.166,0.0246 on a pinhole; none on a
+    /// fisheye, which is its own wide-angle compression), else none; 0,0 for an ideal lens.
+    /// Where a strong barrel distortion folds, the picture ends in a round field stop.
     #[arg(long, value_name = "K1,K2", value_parser = parse_pair, allow_hyphen_values = true)]
     pub distortion: Option<[f64; 2]>,
-    /// Darkening toward the image edge, 0–1 (1: black corners).
-    #[arg(long, value_name = "0..1", default_value_t = 0.0)]
-    pub vignetting: f64,
+    /// Darkening toward the image edge, 0–1 (1: black corners). Default: the look's lens —
+    /// with --look realistic a rigid endoscope's 0.6 (0.3 on a fisheye, whose edge is its
+    /// circle's), else 0.
+    #[arg(long, value_name = "0..1", allow_negative_numbers = true)]
+    pub vignetting: Option<f64>,
 }
 
 impl LensArgs {
-    /// The optics for `fov` (the `--fov` given, if any) under `preset`, with `near_mm`. An
-    /// orthographic view without `--fov` is `default_height_mm` tall.
+    /// The optics for `fov` (the `--fov` given, if any) under `preset` and `look` (its default
+    /// lens; `None`: the plain look), with `near_mm`. An orthographic view without `--fov` is
+    /// `default_height_mm` tall.
     pub fn optics(
         &self,
         preset: Option<&Preset>,
+        look: Option<&Look>,
         fov: Option<f64>,
         near_mm: f64,
         default_height_mm: f64,
@@ -47,10 +57,12 @@ impl LensArgs {
         Ok(Optics {
             projection,
             field,
-            lens: Lens {
-                distortion: self.distortion.unwrap_or([0.0; 2]),
+            lens: LensOptions {
+                distortion: self.distortion,
                 vignetting: self.vignetting,
-            },
+            }
+            .resolve(look, projection)
+            .map_err(flag_error)?,
             near_mm,
         })
     }
@@ -148,20 +160,31 @@ mod tests {
             lens,
             ..LensArgs::default()
         };
-        let pinhole = args(None).optics(None, None, 0.0, 50.0).unwrap();
+        let pinhole = args(None).optics(None, None, None, 0.0, 50.0).unwrap();
         assert_eq!(
             (pinhole.projection, pinhole.field),
             (Projection::Pinhole, 90.0)
         );
         let fisheye = args(Some(Projection::Equidistant));
-        assert_eq!(fisheye.optics(None, None, 0.0, 50.0).unwrap().field, 170.0);
         assert_eq!(
-            fisheye.optics(None, Some(200.0), 0.0, 50.0).unwrap().field,
+            fisheye.optics(None, None, None, 0.0, 50.0).unwrap().field,
+            170.0
+        );
+        assert_eq!(
+            fisheye
+                .optics(None, None, Some(200.0), 0.0, 50.0)
+                .unwrap()
+                .field,
             200.0
         );
         let ortho = args(Some(Projection::Orthographic));
-        assert_eq!(ortho.optics(None, None, 0.0, 50.0).unwrap().field, 50.0);
-        assert!(args(None).optics(None, Some(200.0), 0.0, 50.0).is_err());
+        assert_eq!(
+            ortho.optics(None, None, None, 0.0, 50.0).unwrap().field,
+            50.0
+        );
+        assert!(args(None)
+            .optics(None, None, Some(200.0), 0.0, 50.0)
+            .is_err());
         assert!(parse_pair("-0.2,0.05").is_ok());
         assert!(parse_pair("nan,0").is_err() && parse_pair("1").is_err());
         assert!(parse_projection("fisheye").is_err());

@@ -437,5 +437,60 @@ fn a_colour_texture_changes_the_hue_a_specular_map_is_read_and_bad_files_are_ref
         let mut args = base.to_vec();
         args.extend_from_slice(&[flag, file.to_str().unwrap()]);
         fails_with(&args, problem);
+
+#[test]
+fn the_realistic_look_sees_through_an_endoscope_unless_told_and_lights_by_a_lit_sphere() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = layered(dir.path());
+    let png = dir.path().join("view.png");
+    let view = |extra: &[&str]| render(&volume, &png, extra);
+    let realistic = view(&["--look", "realistic"]);
+    let endoscope = ["--distortion", "-0.166,0.0246", "--vignetting", "0.6"];
+    assert_eq!(
+        view(&[&["--look", "realistic"][..], &endoscope].concat()),
+        realistic
+    );
+    let ideal = ["--distortion", "0,0", "--vignetting", "0"];
+    assert_ne!(
+        view(&[&["--look", "realistic"][..], &ideal].concat()),
+        realistic
+    );
+    // The plain look's lens is the ideal one.
+    assert_eq!(view(&[]), view(&ideal));
+    let ibl = view(&["--look", "realistic", "--lighting", "ibl"]);
+    assert_ne!(ibl, realistic);
+    assert_eq!(
+        view(&["--look", "realistic", "--lighting", "phong"]),
+        realistic
+    );
+    let sphere = dir.path().join("sphere.png");
+    std::fs::write(&sphere, &ibl).unwrap();
+    let user = format!("ibl:{}", sphere.display());
+    assert_ne!(view(&["--look", "realistic", "--lighting", &user]), ibl);
+    let v = volume.to_str().unwrap();
+    let base = ["render", v, "-o", "/tmp/never.png", "--size", "16x16"];
+    for (extra, needle) in [
+        (
+            &["--look", "realistic", "--lighting", "matcap"][..],
+            "phong, ibl or ibl:FILE.png",
+        ),
+        (
+            &["--look", "realistic", "--lighting", "ibl:gone.png"],
+            "gone.png",
+        ),
+        (
+            &["--lighting", "ibl"],
+            "--lighting only applies to the clinical or realistic look",
+        ),
+        (
+            &["--look", "realistic", "--distortion", "nan,0"],
+            "not a finite number",
+        ),
+        (
+            &["--look", "realistic", "--distortion", "-3,0"],
+            "--distortion must be two finite",
+        ),
+    ] {
+        fails_with(&[&base[..], extra].concat(), needle);
     }
 }

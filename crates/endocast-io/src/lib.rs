@@ -28,6 +28,7 @@ mod escape;
 mod guard;
 pub mod image_out;
 pub mod limits;
+pub mod lit_sphere;
 mod loaded;
 pub mod markups;
 pub mod mesh;

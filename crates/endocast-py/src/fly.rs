@@ -29,7 +29,8 @@ use std::path::PathBuf;
 /// `iso_opacity`, `tf`, `step`, `jitter`, `skip_empty`, `shade_dvr`, `background`, `peel`,
 /// `peel_threshold`, `peel_falling`, `peel_keep`, `unpeeled`, `tf_after`, `look`,
 /// `secretion`, `secretion_iso`, `wetness`, `texture`, `texture_scale`, `specular_map`,
-/// `attenuation`, `fov`, `near`, `lens`, `distortion`, `vignetting`, `lumen_threshold`, `bright_lumen`, `threads`,
+/// `attenuation`, `lighting`, `fov`, `near`, `lens`, `distortion`, `vignetting`,
+/// `lumen_threshold`, `bright_lumen`, `threads`,
 /// `meshes`, `overlays` (see `help(endocast.render)`). The volume may be a nibabel or SimpleITK image.
 #[pyfunction]
 #[pyo3(signature = (volume, route, out = None, **options))]
@@ -55,7 +56,13 @@ pub fn fly<'py>(
         .ok_or_else(|| error("the route has no frames"))?
         .pose;
     let look = options.resolve(py, volume.volume(), Some(first), fov)?;
-    let optics = optics(&kw, look.study.preset(), volume.volume(), fov)?;
+    let optics = optics(
+        &kw,
+        look.study.preset(),
+        look.look.as_ref(),
+        volume.volume(),
+        fov,
+    )?;
     let files = SceneFiles::take(&kw)?;
     kw.finish()?;
     let (scene, partial) = py.detach(|| files.read())?;

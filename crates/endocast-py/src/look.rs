@@ -4,12 +4,12 @@
 
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
-use endocast_core::camera::{default_up, Lens, Optics, Projection};
+use endocast_core::camera::{default_up, Optics, Projection};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Camera, PeelLayer, RenderSettings, TransferFunction};
 use endocast_core::study::{
-    self, named, OptionError, PeelOptions, Study, StudyRequest, ViewOptions,
+    self, named, LensOptions, OptionError, PeelOptions, Study, StudyRequest, ViewOptions,
 };
 use endocast_core::Volume;
 use glam::DVec3;
@@ -33,7 +33,8 @@ impl LookOptions {
     /// options (`mode`, `iso2`, `iso_opacity`, `tf`, `step`, `jitter`, `skip_empty`,
     /// `shade_dvr`, `background`), the peel's (`peel`, `peel_threshold`, `peel_falling`,
     /// `peel_keep`, `unpeeled`, `tf_after`) and the look's (`look`, `secretion`,
-    /// `secretion_iso`, `wetness`, `texture`, `texture_scale`, `specular_map`, `attenuation`).
+    /// `secretion_iso`, `wetness`, `texture`, `texture_scale`, `specular_map`, `attenuation`,
+    /// `lighting`).
     pub fn take(kw: &Kwargs<'_>) -> PyResult<Self> {
         let tf = |key| -> PyResult<Option<TransferFunction>> {
             kw.take::<String>(key)?
@@ -82,6 +83,10 @@ impl LookOptions {
                 })
                 .transpose()?,
             attenuation: kw.take("attenuation")?,
+            lighting: kw
+                .take::<String>("lighting")?
+                .map(|spec| endocast_io::lit_sphere::named_or_file(&spec).map_err(to_py))
+                .transpose()?,
         };
         Ok(Self {
             preset: kw
@@ -210,11 +215,13 @@ pub fn find_preset(name: &str) -> PyResult<&'static Preset> {
 }
 
 /// The optics the options `lens`, `distortion`, `vignetting` and `near` and the field `fov`
-/// (the caller took it) describe under `preset`, with the library's defaults
-/// ([`presets::lens_defaults`]).
+/// (the caller took it) describe under `preset` and `look` (its lens: the realistic look's
+/// endoscope; `None`: the plain look), with the library's defaults
+/// ([`presets::lens_defaults`], [`LensOptions::resolve`]).
 pub fn optics(
     kw: &Kwargs<'_>,
     preset: Option<&Preset>,
+    look: Option<&endocast_core::look::Look>,
     volume: &Volume,
     fov: Option<f64>,
 ) -> PyResult<Optics> {
@@ -233,10 +240,12 @@ pub fn optics(
     Ok(Optics {
         projection,
         field,
-        lens: Lens {
-            distortion: kw.take("distortion")?.unwrap_or([0.0; 2]),
-            vignetting: kw.take("vignetting")?.unwrap_or(0.0),
-        },
+        lens: LensOptions {
+            distortion: kw.take("distortion")?,
+            vignetting: kw.take("vignetting")?,
+        }
+        .resolve(look, projection)
+        .map_err(option_error)?,
         near_mm: kw.take("near")?.unwrap_or(0.0),
     })
 }
@@ -281,7 +290,13 @@ impl Placed {
 /// and the placed field and size.
 pub fn camera(kw: &Kwargs<'_>, look: &Look, volume: &Volume, placed: &Placed) -> PyResult<Camera> {
     let pose = look.study.start_pose();
-    let optics = optics(kw, look.study.preset(), volume, placed.fov)?;
+    let optics = optics(
+        kw,
+        look.study.preset(),
+        look.look.as_ref(),
+        volume,
+        placed.fov,
+    )?;
     optics
         .camera(pose.eye_mm, pose.look_at_mm, pose.up, placed.size)
         .map_err(to_py)

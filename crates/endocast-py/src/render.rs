@@ -53,7 +53,9 @@ struct View {
 ///   `background` (r, g, b), `threads`;
 /// - camera: `eye`, `look_at`, `up` (LPS mm), `fov` (degrees), `near` (mm), `size`
 ///   (width, height; default 512 × 512), `lens` (pinhole, equidistant, equisolid,
-///   orthographic), `distortion` (k1, k2), `vignetting`;
+///   orthographic), `distortion` (k1, k2), `vignetting` (default: the look's lens, with
+///   `look="realistic"` a rigid endoscope's barrel distortion and vignetting; `(0, 0)` and 0
+///   for an ideal lens);
 /// - stereo: `stereo` (anaglyph, red-cyan, dubois, side-by-side, top-bottom, pair),
 ///   `eye_separation`, `focus` (mm), in any look (the geometry drawn in each eye, `still`
 ///   averaging each eye);
@@ -63,7 +65,8 @@ struct View {
 ///   `secretion` (off, on, accumulate), `secretion_iso`, `wetness` (0–1), `texture`
 ///   (mucosa, grid, none or a PNG file, its colour kept), `texture_scale` (mm),
 ///   `specular_map` (a PNG file, grey: bright is glossier), `attenuation` (mm, 0: none),
-///   `still` (average this many jittered frames, 1–256);
+///   `lighting` (phong, ibl: a built-in lit sphere, or "ibl:FILE.png": yours), `still` (average
+///   this many jittered frames, 1–256);
 /// - lumen: `lumen_threshold`, `bright_lumen`;
 /// - geometry: `meshes` (STL, OBJ or PLY files, world mm), `overlays` (DICOM segmentations,
 ///   each segment a surface in its colour, and dose grids, isodose surfaces at `FILE:LEVELS`

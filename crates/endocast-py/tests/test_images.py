@@ -90,6 +90,27 @@ def test_the_realistic_look_is_the_clis(cli, tmp_path):
     assert np.abs(plain.astype(int) - rgba.astype(int)).max() > 20
 
 
+def test_the_realistic_looks_endoscope_lens_and_lighting_are_the_clis(cli, tmp_path):
+    layered = tmp_path / "layered.nii.gz"
+    cli("phantom", "layered", "-o", layered)
+    volume = endocast.open(layered)
+    # The default lens of the look (a rigid endoscope's) on both sides, and it is the one
+    # given explicitly; the ideal lens differs.
+    rgba, _ = endocast.render(volume, size=(40, 32), look="realistic")
+    np.testing.assert_array_equal(rgba[..., :3], cli_image(cli, tmp_path, layered, "--look",
+                                                           "realistic"))
+    explicit, _ = endocast.render(volume, size=(40, 32), look="realistic",
+                                  distortion=(-0.166, 0.0246), vignetting=0.6)
+    np.testing.assert_array_equal(rgba, explicit)
+    ideal, _ = endocast.render(volume, size=(40, 32), look="realistic", distortion=(0, 0),
+                               vignetting=0)
+    assert np.abs(ideal.astype(int) - rgba.astype(int)).max() > 20
+    lit, _ = endocast.render(volume, size=(40, 32), look="realistic", lighting="ibl")
+    np.testing.assert_array_equal(lit[..., :3], cli_image(cli, tmp_path, layered, "--look",
+                                                          "realistic", "--lighting", "ibl"))
+    assert np.abs(lit.astype(int) - rgba.astype(int)).max() > 5
+
+
 def test_bad_look_values_name_the_keyword(colon):
     volume = endocast.open(colon)
     for options, needle in [
@@ -98,6 +119,9 @@ def test_bad_look_values_name_the_keyword(colon):
         (dict(secretion="on"), "secretion only applies to the clinical or realistic look"),
         (dict(mode="peel", peel="first"), "peel"),
         (dict(still=0), "still must be between 1"),
+        (dict(distortion=(float("nan"), 0.0)), "distortion must be two finite numbers"),
+        (dict(look="realistic", lighting="ibl:missing.png"), "missing.png"),
+        (dict(lighting="ibl"), "lighting only applies to the clinical or realistic look"),
     ]:
         with pytest.raises(endocast.EndocastError, match=needle):
             endocast.render(volume, size=(8, 8), **options)
@@ -106,7 +130,8 @@ def test_bad_look_values_name_the_keyword(colon):
 def test_help_documents_every_option():
     render_doc = endocast.render.__doc__
     for option in ["preset", "eye", "look_at", "lens", "stereo", "peel_threshold", "tf_after",
-                   "look", "secretion", "wetness", "texture", "still", "lumen_threshold",
+                   "look", "secretion", "wetness", "texture", "lighting", "still",
+                   "lumen_threshold",
                    "meshes", "overlays"]:
         assert option in render_doc, option
     assert "nibabel" in endocast.as_volume.__doc__

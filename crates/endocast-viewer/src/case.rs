@@ -8,7 +8,7 @@ use crate::geometry::{with_mesh, Toggles};
 use crate::session::{Controls, Session, NO_PRESET};
 use endocast_core::animation::KeyFrame;
 use endocast_core::camera::Projection;
-use endocast_core::look::LookKind;
+use endocast_core::look::{Lighting, LookKind};
 use endocast_core::presets::Preset;
 use endocast_core::render::Mode;
 use endocast_core::views::slices::Window;
@@ -62,6 +62,7 @@ fn controls_of(c: &Controls, mesh_files: &[PathBuf]) -> CaseControls {
         peel: Some(CasePeel::of(&c.peel)),
         geometry: Some(geometry_of(c.geometry, mesh_files)),
         look: Some(c.look.name().into()),
+        lighting: Some(c.lighting.name().into()),
     }
 }
 
@@ -124,6 +125,11 @@ impl SessionCase for Case {
             Some(name) => LookKind::from_name(name).ok_or_else(|| bad("look", name))?,
             None => here.look().kind,
         };
+        let lighting = match &c.lighting {
+            Some(name) => endocast_io::lit_sphere::named_or_file(name)
+                .map_err(|e| CaseError::new(path, format!("lighting: {e}")))?,
+            None => Lighting::Phong,
+        };
         Ok(Some(Controls {
             preset,
             base: defaults.clone(),
@@ -140,6 +146,7 @@ impl SessionCase for Case {
             peel: peel.map_err(to_case_error)?,
             geometry: c.geometry.as_ref().map(toggles).unwrap_or_default(),
             look,
+            lighting,
         }))
     }
 

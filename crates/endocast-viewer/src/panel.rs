@@ -9,7 +9,7 @@ use crate::state::{Action, Ready};
 use crate::tf_colours::colour_strip_ui;
 use crate::tf_editor::histogram_ui;
 use endocast_core::camera::Projection;
-use endocast_core::look::LookKind;
+use endocast_core::look::{Lighting, LookKind};
 use endocast_core::navigate::LumenSide;
 use endocast_core::presets;
 use endocast_core::render::{Mode, PeelLayer, PeelSettings, Unpeeled};
@@ -255,6 +255,18 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
                 ui.selectable_value(&mut c.look, kind, kind.name());
             }
         });
+    if c.look != LookKind::Plain {
+        let was = matches!(c.lighting, Lighting::LitSphere(_));
+        let mut ibl = was;
+        ui.checkbox(&mut ibl, "image-based lighting (lit sphere)");
+        if ibl != was {
+            c.lighting = if ibl {
+                Lighting::built_in_ibl()
+            } else {
+                Lighting::Phong
+            };
+        }
+    }
     ui.checkbox(&mut c.stereo, "stereo (red/cyan anaglyph)");
     if c.mode == Mode::Peel {
         peel_ui(ui, &mut c.peel, c.iso_hu, (lo, hi));

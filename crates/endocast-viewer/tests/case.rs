@@ -3,6 +3,7 @@
 
 use crate::common::{settled, tube_session};
 use endocast_core::annotate::STROKE_COLOR;
+use endocast_core::look::Lighting;
 use endocast_core::presets::Preset;
 use endocast_core::render::{PeelLayer, TransferFunction, Unpeeled};
 use endocast_viewer::case::{Autosave, Case, SessionCase};
@@ -40,6 +41,7 @@ fn changed_look(c: &mut Controls) {
     c.peel.unpeeled = Unpeeled::Context;
     c.geometry.grid = true;
     c.geometry.markers = true;
+    c.lighting = Lighting::built_in_ibl();
 }
 
 #[test]
@@ -139,6 +141,8 @@ fn a_version_2_case_reopens_with_the_presets_look() {
     let mut case = Case::of(&session, 1);
     let controls = case.controls.as_mut().unwrap();
     (controls.tf, controls.peel, controls.geometry) = (None, None, None);
+    // Nor the lighting (added later): Phong.
+    controls.lighting = None;
     case.write(&path).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     std::fs::write(&path, text.replace("\"version\": 3", "\"version\": 2")).unwrap();

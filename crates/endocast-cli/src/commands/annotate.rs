@@ -245,9 +245,13 @@ fn pick(pixels: &[[f64; 2]], view: &PickView, volume: &Volume) -> Result<Vec<DVe
         .look
         .on_scan(volume, &LumenArgs::default(), Some(pose), view.fov)?;
     let (lo, hi) = volume.geometry().world_bounds();
-    let optics = view
-        .lens
-        .optics(look.study.preset(), view.fov, 0.0, (hi - lo).length())?;
+    let optics = view.lens.optics(
+        look.study.preset(),
+        look.look.as_ref(),
+        view.fov,
+        0.0,
+        (hi - lo).length(),
+    )?;
     let camera: Camera = optics
         .camera(pose.eye_mm, pose.look_at_mm, pose.up, view.size)
         .context("invalid camera")?;

@@ -124,9 +124,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
     }
     let (lo, hi) = renderer.volume().geometry().world_bounds();
+    // Every row sees through the look's lens (the realistic look's endoscope), so the look
+    // and the plain rows compare on the same cameras.
+    let look = cells.iter().find_map(|c| c.look.as_ref());
     let optics = args
         .lens
-        .optics(preset, args.fov, 0.0, (hi - lo).length())?;
+        .optics(preset, look, args.fov, 0.0, (hi - lo).length())?;
     let renderer = Arc::new(renderer);
     let scene = args.scene.scene()?;
     let options = RenderOptions::new().quality(args.quality);

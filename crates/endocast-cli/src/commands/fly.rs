@@ -153,7 +153,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     let (lo, hi) = loaded.volume.geometry().world_bounds();
     let optics = args
         .lens
-        .optics(preset, args.fov_deg, 0.0, (hi - lo).length())?;
+        .optics(preset, look.as_ref(), args.fov_deg, 0.0, (hi - lo).length())?;
     let marks = args.case.annotations(&loaded.volume)?;
     let renderer = Arc::new(Renderer::for_many_frames(loaded.volume));
     let options = FlightOptions {

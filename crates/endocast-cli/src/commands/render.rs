@@ -12,7 +12,7 @@ use crate::structure;
 use crate::study_report;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use endocast_core::look::{self, MAX_STILL_FRAMES};
+use endocast_core::look::{self, Look, MAX_STILL_FRAMES};
 use endocast_core::presets::Preset;
 use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
 use endocast_core::study::Study;
@@ -103,7 +103,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let settings = &look.settings;
     let preset = look.study.preset();
-    let camera = camera(args, preset, &loaded.volume, &look.study)?;
+    let camera = camera(
+        args,
+        preset,
+        look.look.as_ref(),
+        &loaded.volume,
+        &look.study,
+    )?;
     if let Some(path) = &args.show_structure {
         structure::write(path, &loaded.volume, &look.study)?;
     }
@@ -178,17 +184,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 }
 
 /// The camera of the study's start (the user's pose, or inside the structure the preset
-/// means looking along its path, or the whole object framed), with `--up` and the lens options.
+/// means looking along its path, or the whole object framed), with `--up` and the lens options
+/// over `look`'s lens.
 fn camera(
     args: &RenderArgs,
     preset: Option<&Preset>,
+    look: Option<&Look>,
     volume: &Volume,
     study: &Study,
 ) -> Result<Camera> {
     let pose = args.pose.with_up(study.start_pose());
     let (lo, hi) = volume.geometry().world_bounds();
     let height_mm = (hi - lo).length();
-    let optics = args.lens.optics(preset, args.fov, args.near, height_mm)?;
+    let optics = args
+        .lens
+        .optics(preset, look, args.fov, args.near, height_mm)?;
     optics
         .camera(pose.eye_mm, pose.look_at_mm, pose.up, args.size)
         .context("invalid camera")

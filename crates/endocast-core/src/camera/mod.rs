@@ -530,9 +530,12 @@ impl Camera {
         }
     }
 
-    /// The brightness (0–1) the lens's vignetting leaves at image point `(x, y)`.
+    /// The brightness (0–1) the lens leaves at image point `(x, y)`: its vignetting, and the
+    /// soft edge of the round field stop where a strong barrel distortion folds
+    /// ([`Lens::field_stop`]; beyond it [`Camera::ray`] gives no ray and the frame shows the
+    /// background, as outside a fisheye's circle).
     pub fn vignetting(&self, x: f64, y: f64) -> f64 {
-        if self.lens.vignetting == 0.0 {
+        if !self.lens.darkens() {
             return 1.0;
         }
         let (w, h) = (self.width as f64, self.height as f64);
@@ -542,7 +545,8 @@ impl Camera {
         } else {
             (w / h).powi(2) + 1.0
         };
-        self.lens.brightness((u * u + v * v) / edge2)
+        let r2 = u * u + v * v;
+        self.lens.brightness(r2 / edge2) * self.lens.field_stop(r2.sqrt(), 2.0 / h)
     }
 
     /// The image position `(x, y)` in pixels where world point `p_mm` projects, or `None` where

@@ -6,6 +6,7 @@ use super::clipped::overlay;
 use super::footprint::Footprints;
 use super::gbuffer::GBuffer;
 use super::lanes::{load, map, map3, Lanes, LANES};
+use super::lit_sphere::TipView;
 use super::shading::{Shading, Surface8};
 use super::smooth::{Planes, SmoothBands, BAND_ROWS, DEPTH, HIT, NORMAL, SECRETION};
 use super::LookError;
@@ -81,8 +82,8 @@ impl Rows<'_> {
     fn shade(&self, y: usize, planes: &Planes, color: &mut [Premultiplied], depth: &mut [f32]) {
         let w = color.len();
         depth.copy_from_slice(&planes[DEPTH][..w]);
-        let tip = self.camera.eye_mm().as_vec3();
-        let vignetting = self.camera.lens().vignetting > 0.0;
+        let tip = TipView::of(self.camera);
+        let vignetting = self.camera.lens().darkens();
         for x0 in (0..w).step_by(LANES) {
             let lanes = |c: usize| load(&planes[c], x0);
             let depth = lanes(DEPTH);
@@ -99,7 +100,7 @@ impl Rows<'_> {
                 out.fill(Premultiplied::default());
                 continue;
             }
-            let mut rgb = self.shading.colors8(&surface, tip);
+            let mut rgb = self.shading.colors8(&surface, &tip);
             if vignetting {
                 let x = |k: usize| (x0 + k) as f64 + 0.5;
                 let v = map(|k| self.camera.vignetting(x(k), y as f64 + 0.5) as f32);

@@ -4,6 +4,7 @@
 use super::settings::{RayPassSettings, SecretionMode};
 use super::shading::Shading;
 use super::texture::Texture;
+use crate::camera::{Lens, Projection};
 use std::sync::Arc;
 
 /// How a view looks.
@@ -39,6 +40,27 @@ impl LookKind {
         Self::ALL
             .into_iter()
             .find(|k| k.name().eq_ignore_ascii_case(name.trim()))
+    }
+
+    /// The lens a camera of `projection` has in this look when the user gives none: the
+    /// realistic look sees through a rigid endoscope ([`Lens::RIGID_ENDOSCOPE`] on a pinhole),
+    /// the others through an ideal lens. A fisheye projection is itself the wide-angle lens's
+    /// compression of the field (equidistant: `r = f θ`, a barrel-distorted pinhole), and the
+    /// endoscope's coefficients were measured against a rectilinear image, so they are not
+    /// stacked on it by default (given explicitly they still apply, to the normalised position
+    /// in the image circle); it keeps the endoscope's vignetting, halved because a fisheye's is
+    /// relative to its image circle (the endoscope's periphery: 0.7 there, as on the pinhole's
+    /// inscribed circle). An orthographic view is no endoscope's.
+    pub fn default_lens(self, projection: Projection) -> Lens {
+        let endoscope = Lens::RIGID_ENDOSCOPE;
+        match (self, projection) {
+            (Self::Realistic, Projection::Pinhole) => endoscope,
+            (Self::Realistic, p) if p.is_fisheye() => Lens {
+                vignetting: endoscope.vignetting / 2.0,
+                ..Lens::default()
+            },
+            _ => Lens::default(),
+        }
     }
 }
 
@@ -90,6 +112,8 @@ impl PresetLook {
 /// Both stages' settings of a clinical or realistic look.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Look {
+    /// Which look these are the settings of (its default lens: [`LookKind::default_lens`]).
+    pub kind: LookKind,
     /// What the ray pass finds (changing it marches the rays again).
     pub ray: RayPassSettings,
     /// How the G-buffer is shaded (changing it does not).
@@ -113,8 +137,9 @@ impl Look {
         };
         match kind {
             LookKind::Plain => None,
-            LookKind::Clinical => Some(Look { ray, shading }),
+            LookKind::Clinical => Some(Look { kind, ray, shading }),
             LookKind::Realistic => Some(Look {
+                kind,
                 ray: RayPassSettings {
                     secretion: preset.secretion_mode,
                     ..ray

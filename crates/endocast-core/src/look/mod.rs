@@ -10,8 +10,9 @@
 //!    ([`SecretionMode::Accumulate`]). Rays start with interleaved offsets (§4.3), so sampling
 //!    bands break up into a fine pattern that smoothing and still frames average away.
 //! 2. The **deferred stage** ([`shade`], settings [`Shading`]) reads only the G-buffer:
-//!    depth-aware image-space smoothing of depth, normals and secretion ([`smooth`]), Phong with
-//!    the light at the endoscope's tip and its fall-off with distance, wetness (a low-power
+//!    depth-aware image-space smoothing of depth, normals and secretion ([`smooth`]), Phong (or
+//!    image-based lighting from a [`LitSphere`], [`Lighting`]) with the light at the
+//!    endoscope's tip and its fall-off with distance, wetness (a low-power
 //!    view-dependent darkening and highlights, strongest on the detail texture's darker texels:
 //!    a specular map, or one given; raised by the secretion's density and nearness), a
 //!    tri-planar, mip-mapped detail texture ([`Texture`], colour or grey; each pixel reads the
@@ -69,6 +70,7 @@ mod gbuffer;
 mod geometry;
 mod kind;
 mod lanes;
+mod lit_sphere;
 mod reduced;
 mod secretion;
 mod settings;
@@ -87,6 +89,8 @@ mod geometry_tests;
 #[cfg(test)]
 mod stereo_tests;
 #[cfg(test)]
+mod optics_tests;
+#[cfg(test)]
 mod tests;
 #[cfg(test)]
 mod texture_tests;
@@ -95,6 +99,7 @@ pub use deferred::shade;
 pub use gbuffer::{GBuffer, RayPass};
 pub use geometry::shade_with_scene;
 pub use kind::{Look, LookKind, PresetLook};
+pub use lit_sphere::{Lighting, LitSphere, LitSphereError};
 pub use reduced::{shade_reduced, shade_reduced_with_scene};
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;

@@ -1,6 +1,7 @@
 //! The deferred stage: a [`GBuffer`] smoothed and shaded into a frame, without the volume.
 //!
-//! Per pixel (Krüger et al. §4.4): Phong lighting from a light at the endoscope's tip, falling
+//! Per pixel (Krüger et al. §4.4): Phong lighting from a light at the endoscope's tip (or
+//! image-based lighting, its diffuse term from a lit sphere: [`super::LitSphere`]), falling
 //! off with distance; a tri-planar detail texture modulating the tissue colour; wetness as a
 //! low-power view-dependent darkening (wet tissue turns dark where it turns away) plus sharp
 //! highlights where it faces the tip, stronger on the texture's darker texels and where there is
@@ -9,9 +10,9 @@
 //! and highlighted by the secretion surface's own normal, fading in where the layer thins.
 
 use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
+use super::lit_sphere::{or_normal, Lighting, TipView};
 use super::texture::{Texture, LUMA};
 use super::{check, LookError};
-use glam::Vec3;
 use std::sync::Arc;
 
 /// Share of the colour the full wet darkening takes away at grazing view.
@@ -77,6 +78,10 @@ pub struct Shading {
     pub fog_mm: f32,
     /// Radius of the depth-aware smoothing before shading, pixels, 0–8 (0: none). Default 2.
     pub smoothing_px: usize,
+    /// How the tissue and the mucus film are lit: Phong (`ambient + diffuse · cos`, the
+    /// default) or a lit sphere's diffuse light ([`Lighting::LitSphere`]: `ambient` and
+    /// `diffuse` unused); the highlights are the specular model's either way.
+    pub lighting: Lighting,
 }
 
 impl Default for Shading {
@@ -96,6 +101,7 @@ impl Default for Shading {
             attenuation_mm: Some(40.0),
             fog_mm: 1.5,
             smoothing_px: 2,
+            lighting: Lighting::Phong,
         }
     }
 }
@@ -164,8 +170,8 @@ impl Shading {
     /// where it thins). Secretion raises the wetness with its density (its fog) and the
     /// nearness of its first layer (the tip's light there).
     #[inline(always)]
-    pub(super) fn colors8(&self, s: &Surface8, tip: Vec3) -> [Lanes; 3] {
-        let tip = tip.to_array();
+    pub(super) fn colors8(&self, s: &Surface8, view: &TipView) -> [Lanes; 3] {
+        let tip = view.at.to_array();
         let to_tip = normalize_or_zero(map3(|a, k| tip[a] - s.hit[a][k]));
         // The normals turned toward the tip: the cosine with the light is |n · to tip|.
         let cos = cosines(&s.normal, &to_tip);
@@ -191,8 +197,7 @@ impl Shading {
             let raised = (1.0 - self.wetness) * fog[k] * near * self.wetness.min(0.5) * 2.0;
             (self.wetness + raised).clamp(0.0, 1.0)
         });
-        let lit = map(|k| self.ambient + self.diffuse * cos[k]);
-        let film_lit = map(|k| self.ambient + self.diffuse * film_cos[k]);
+        let (lit, film_lit) = self.diffuse8(s, (&cos, &film_cos), &to_tip, view);
         let darkening = map(|k| 1.0 - wet[k] * WET_DARKENING * (1.0 - cos[k] * cos[k]));
         let tissue = map3(|c, k| {
             let detail = 1.0 + self.texture_strength * (2.0 * texel[c][k] - 1.0);
@@ -237,6 +242,31 @@ impl Shading {
             }
         };
         (texel, specular_map)
+    }
+
+    /// The diffuse light of eight hits' tissue and mucus film (their cosines with the light
+    /// at the tip `cos`): Phong's, or the lit sphere's at their normals.
+    #[inline(always)]
+    fn diffuse8(
+        &self,
+        s: &Surface8,
+        (cos, film_cos): (&Lanes, &Lanes),
+        to_tip: &[Lanes; 3],
+        view: &TipView,
+    ) -> (Lanes, Lanes) {
+        match &self.lighting {
+            Lighting::Phong => (
+                map(|k| self.ambient + self.diffuse * cos[k]),
+                map(|k| self.ambient + self.diffuse * film_cos[k]),
+            ),
+            Lighting::LitSphere(sphere) => {
+                let film_normal = or_normal(&s.secretion_normal, &s.normal);
+                (
+                    sphere.light8(&s.normal, to_tip, view),
+                    sphere.light8(&film_normal, to_tip, view),
+                )
+            }
+        }
     }
 
     /// Highlights of eight hits: sharp (Phong exponent `shininess`) where the light reflects

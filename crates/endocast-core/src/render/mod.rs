@@ -658,9 +658,9 @@ impl Prepared {
     }
 }
 
-/// Darkens a ray's colour by the camera lens's vignetting at pixel `(x, y)`.
+/// Darkens a ray's colour by the camera lens's vignetting (and field stop) at pixel `(x, y)`.
 fn vignette(camera: &Camera, x: usize, y: usize, out: &mut PixelOut) {
-    if camera.lens().vignetting > 0.0 {
+    if camera.lens().darkens() {
         let f = camera.vignetting(x as f64 + 0.5, y as f64 + 0.5) as f32;
         out.accum.rgb *= f;
     }

@@ -29,11 +29,13 @@
 //! ```
 
 mod framing;
+mod lens;
 mod options;
 mod route;
 mod start;
 
 pub use framing::{object_bounds, object_framing};
+pub use lens::LensOptions;
 pub use options::{named, LookOptions, OptionError, PeelOptions, ViewOptions};
 pub use route::{StudyPath, StudyPathError};
 pub use start::LOOK_AHEAD_MM;

@@ -5,7 +5,7 @@
 //! An [`OptionError`] names the option by its key (`iso_opacity`); a front end spells the key
 //! as its users write it ([`OptionError::message`]: `--iso-opacity` on the command line).
 
-use crate::look::{Look, LookKind, PresetLook, SecretionMode, Texture};
+use crate::look::{Lighting, Look, LookKind, PresetLook, SecretionMode, Texture};
 use crate::render::{Mode, PeelLayer, RenderSettings, TransferFunction, Unpeeled};
 use std::fmt;
 use std::sync::Arc;
@@ -165,6 +165,8 @@ pub struct LookOptions {
     pub specular_map: Option<Arc<Texture>>,
     /// The distance at which the tip's light halves, mm (0: no fall-off).
     pub attenuation: Option<f32>,
+    /// Phong or image-based lighting.
+    pub lighting: Option<Lighting>,
 }
 
 impl LookOptions {
@@ -178,6 +180,7 @@ impl LookOptions {
             ("texture_scale", self.texture_scale.is_some()),
             ("specular_map", self.specular_map.is_some()),
             ("attenuation", self.attenuation.is_some()),
+            ("lighting", self.lighting.is_some()),
         ];
         keys.iter().filter(|(_, on)| *on).map(|(k, _)| *k).collect()
     }
@@ -236,6 +239,9 @@ impl LookOptions {
                 ));
             }
             look.shading.attenuation_mm = (mm > 0.0).then_some(mm);
+        }
+        if let Some(lighting) = &self.lighting {
+            look.shading.lighting.clone_from(lighting);
         }
         let invalid =
             |e: crate::look::LookError| OptionError::new("look", format!("is invalid: {e}"));

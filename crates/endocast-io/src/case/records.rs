@@ -35,6 +35,9 @@ pub struct CaseControls {
     /// The endoscope's look: plain, clinical or realistic (absent: the preset's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub look: Option<String>,
+    /// The look's lighting: phong or ibl, as `--lighting` takes it (absent: phong).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lighting: Option<String>,
 }
 
 /// A transfer function's points as transfer-function files hold them (see

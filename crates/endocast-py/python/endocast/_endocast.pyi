@@ -102,7 +102,7 @@ def render(
     size: Tuple[int, int] = (512, 512),
     lens: Optional[_Lens] = None,
     distortion: Optional[Tuple[float, float]] = None,
-    vignetting: float = 0.0,
+    vignetting: Optional[float] = None,
     stereo: Optional[_Stereo] = None,
     eye_separation: Optional[float] = None,
     focus: Optional[float] = None,
@@ -120,6 +120,7 @@ def render(
     texture_scale: Optional[float] = None,
     specular_map: Optional[str] = None,
     attenuation: Optional[float] = None,
+    lighting: Optional[str] = None,
     still: int = 1,
     lumen_threshold: Optional[float] = None,
     bright_lumen: bool = False,
@@ -135,7 +136,8 @@ def render(
     (2, height, width). Without ``eye``/``look_at`` the camera is ``default_view``'s.
     ``mode="peel"`` with the ``peel*`` options peels (Borland et al.); ``look`` "clinical" or
     "realistic" draws the endoscope's look (Krüger et al.) with ``secretion``, ``wetness``,
-    ``texture``, ``attenuation``; ``still`` averages that many jittered frames. ``meshes``
+    ``texture``, ``attenuation``, ``lighting`` ("phong", "ibl" or "ibl:FILE.png"), through a
+    rigid endoscope's lens unless ``distortion``/``vignetting`` say otherwise; ``still`` averages that many jittered frames. ``meshes``
     (STL, OBJ, PLY) and ``overlays`` (DICOM SEG; RTDOSE as ``FILE`` or ``FILE:LEVEL,...``)
     are drawn with the scan as ``--mesh`` and ``--overlay`` draw them."""
 
@@ -196,7 +198,7 @@ def fly(
     near: float = 0.0,
     lens: Optional[_Lens] = None,
     distortion: Optional[Tuple[float, float]] = None,
-    vignetting: float = 0.0,
+    vignetting: Optional[float] = None,
     peel: Optional[Union[int, Literal["last"]]] = None,
     peel_threshold: Optional[float] = None,
     peel_falling: Optional[bool] = None,
@@ -211,6 +213,7 @@ def fly(
     texture_scale: Optional[float] = None,
     specular_map: Optional[str] = None,
     attenuation: Optional[float] = None,
+    lighting: Optional[str] = None,
     size: Tuple[int, int] = (384, 384),
     frame_step: float = 1.0,
     look_ahead: float = 10.0,

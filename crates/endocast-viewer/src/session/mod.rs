@@ -15,7 +15,7 @@ use crate::worker::{RenderWorker, View};
 use endocast_core::animation::KeyFrame;
 use endocast_core::annotate::{self, Annotation, Annotations, DrawOptions, Shape, SurfaceView};
 use endocast_core::camera::{Camera, CameraError, Optics, Projection, StereoRig};
-use endocast_core::look::{Look, LookKind};
+use endocast_core::look::{Lighting, Look, LookKind};
 use endocast_core::navigate::{nearest_lumen_point, snap_radius_mm, LumenSide};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
@@ -69,6 +69,8 @@ pub struct Controls {
     /// The endoscope's look: the renderer's own image (plain), or the clinical or realistic
     /// look of the preset.
     pub look: LookKind,
+    /// How the clinical or realistic look lights the tissue: Phong or a lit sphere.
+    pub lighting: Lighting,
 }
 
 impl Controls {
@@ -93,6 +95,7 @@ impl Controls {
             peel: base.peel.clone(),
             geometry: Toggles::default(),
             look: study.look().kind,
+            lighting: Lighting::Phong,
             base,
         }
     }
@@ -108,11 +111,13 @@ impl Controls {
         settings
     }
 
-    /// The optics: lens and field of view.
+    /// The optics: projection, field of view and the look's lens (the realistic look's rigid
+    /// endoscope, [`LookKind::default_lens`], as `endocast render` gives it).
     pub fn optics(&self) -> Optics {
         Optics {
             projection: self.projection,
             field: self.fov_deg,
+            lens: self.look.default_lens(self.projection),
             ..Optics::default()
         }
     }
@@ -274,6 +279,7 @@ impl Session {
         if !self.wall_is_the_studys() {
             look.ray.tissue_hu = self.controls.iso_hu;
         }
+        look.shading.lighting.clone_from(&self.controls.lighting);
         Some(look)
     }
 
