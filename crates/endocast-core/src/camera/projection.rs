@@ -45,6 +45,13 @@ impl Projection {
         }
     }
 
+    /// Every projection's name, for messages: "pinhole, equidistant, …, cube or panorama".
+    pub fn choices() -> String {
+        let names: Vec<&str> = Self::ALL.iter().map(|p| p.name()).collect();
+        let (last, rest) = names.split_last().unwrap_or((&"", &[]));
+        format!("{} or {last}", rest.join(", "))
+    }
+
     /// The projection called `name` (ASCII case ignored).
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL
