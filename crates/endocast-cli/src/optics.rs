@@ -117,9 +117,8 @@ pub fn beside(path: &Path, ending: &str) -> PathBuf {
 
 /// A projection by name.
 fn parse_projection(text: &str) -> Result<Projection, String> {
-    Projection::from_name(text).ok_or_else(|| {
-        format!("unknown lens {text:?}: use {}", Projection::choices())
-    })
+    Projection::from_name(text)
+        .ok_or_else(|| format!("unknown lens {text:?}: use {}", Projection::choices()))
 }
 
 /// A stereo output by name.

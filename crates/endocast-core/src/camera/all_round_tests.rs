@@ -99,11 +99,11 @@ fn cube_rays_agree_across_every_fold() {
     };
     for t in [0.5, 7.25, 14.5] {
         for k in 1..4 {
-            let x = ox + k as f64 * s;
+            let x = ox + f64::from(k) * s;
             close((x - 1e-9, oy + s + t), (x + 1e-9, oy + s + t));
         }
         for k in 1..3 {
-            let y = oy + k as f64 * s;
+            let y = oy + f64::from(k) * s;
             close((ox + s + t, y - 1e-9), (ox + s + t, y + 1e-9));
         }
     }
@@ -169,7 +169,7 @@ fn panorama_horizon_is_one_row_and_its_seam_is_behind() {
     let [f, r, u] = axes(&camera);
     let at = |d: DVec3| camera.project(camera.eye_mm() + d * 5.0).unwrap();
     for k in 0..36 {
-        let longitude = (k as f64 * 10.0 - 175.0).to_radians();
+        let longitude = (f64::from(k) * 10.0 - 175.0).to_radians();
         let (x, y) = at(f * longitude.cos() + r * longitude.sin());
         assert!(
             (y - 18.0).abs() < 1e-9,
