@@ -74,3 +74,16 @@ pub fn hit_share(depth: &std::path::Path) -> f64 {
     let hits = values.iter().filter(|d| d.is_finite()).count();
     hits as f64 / values.len() as f64
 }
+
+/// Pixels of `rgb` in a PNG.
+pub fn count_color(png: &std::path::Path, rgb: [u8; 3]) -> usize {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    let channels = info.line_size / info.width as usize;
+    pixels[..info.buffer_size()]
+        .chunks(channels)
+        .filter(|p| p[..3] == rgb)
+        .count()
+}

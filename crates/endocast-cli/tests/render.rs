@@ -1,6 +1,6 @@
 //! `endocast render` end to end: a phantom with a known answer, outputs, and bad options.
 
-use crate::common::{endocast, fails_with, read_npy};
+use crate::common::{count_color, endocast, fails_with, read_npy};
 
 #[test]
 fn from_the_centre_of_a_sphere_shell_every_depth_is_the_radius() {
@@ -378,19 +378,6 @@ fn lenses_and_stereo_outputs_from_the_command_line() {
         &with(&["--stereo", "anaglyph", "--lens", "orthographic"]),
         "orthographic",
     );
-}
-
-/// How many pixels of a PNG have colour `rgb`.
-fn count_color(png: &std::path::Path, rgb: [u8; 3]) -> usize {
-    let file = std::io::BufReader::new(std::fs::File::open(png).unwrap());
-    let mut reader = png::Decoder::new(file).read_info().unwrap();
-    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut pixels).unwrap();
-    let channels = info.line_size / info.width as usize;
-    pixels[..info.buffer_size()]
-        .chunks(channels)
-        .filter(|p| p[..3] == rgb)
-        .count()
 }
 
 #[test]

@@ -228,8 +228,9 @@ fn fold_faces(volume: &Volume, colon: &phantom::Colon, coverage: &Coverage) -> (
     (fraction(counts[0]), fraction(counts[1]))
 }
 
-#[test]
-fn a_forward_flight_misses_the_far_sides_of_the_folds() {
+/// The 192³ colon phantom's renderer, the phantom, its wall (nothing seen yet) and the 48
+/// poses of a forward flight along its centreline.
+fn colon_flight() -> (Arc<Renderer>, phantom::Colon, Coverage, Vec<Pose>) {
     let (volume, colon) = phantom::colon(&PhantomOptions {
         size: 192,
         ..Default::default()
@@ -238,7 +239,12 @@ fn a_forward_flight_misses_the_far_sides_of_the_folds() {
     let g = *volume.geometry();
     let wall = Coverage::new(&g, threshold_wall(&volume, -500.0), &whole(&volume)).unwrap();
     let forward = fly_through(&g, |s| line.point_at(s), line.length_vox(), 48, 6.0).unwrap();
-    let renderer = Arc::new(Renderer::new(volume));
+    (Arc::new(Renderer::new(volume)), colon, wall, forward)
+}
+
+#[test]
+fn a_forward_flight_misses_the_far_sides_of_the_folds() {
+    let (renderer, colon, wall, forward) = colon_flight();
     let ahead = fly(&renderer, &wall, &forward, 96);
     let back = fly(&renderer, &wall, &backwards(&forward), 96);
     let mut both = ahead.clone();
@@ -266,15 +272,7 @@ fn a_forward_flight_misses_the_far_sides_of_the_folds() {
 
 #[test]
 fn a_one_way_cube_flight_sees_nearly_all_the_colon_wall() {
-    let (volume, colon) = phantom::colon(&PhantomOptions {
-        size: 192,
-        ..Default::default()
-    });
-    let line = &colon.centreline;
-    let g = *volume.geometry();
-    let wall = Coverage::new(&g, threshold_wall(&volume, -500.0), &whole(&volume)).unwrap();
-    let forward = fly_through(&g, |s| line.point_at(s), line.length_vox(), 48, 6.0).unwrap();
-    let renderer = Arc::new(Renderer::new(volume));
+    let (renderer, colon, wall, forward) = colon_flight();
     // Faces of 64 pixels: the pinhole's rays are exactly the cube's front face's.
     let pinhole = fly(&renderer, &wall, &forward, 64);
     let optics = Optics {
