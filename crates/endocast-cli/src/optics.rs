@@ -15,8 +15,13 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug, Clone, Default)]
 pub struct LensArgs {
     /// Lens projection: pinhole; equidistant or equisolid (fisheye: a round image, --fov up to
-    /// 360°, default 170°); orthographic (parallel rays: --fov is the view height in mm).
-    /// Default: the preset's, else pinhole.
+    /// 360°, default 170°); orthographic (parallel rays: --fov is the view height in mm); cube
+    /// (the unfolded cube: six 90° views around the eye in a cross — up above front; left,
+    /// front, right, back in a row; down below front — labelled; a 4:3 image such as 768x576
+    /// fills it); panorama (360° equirectangular around the camera's up: front in the middle,
+    /// the seam behind at both edges, --fov the latitudes spanned, default 180; 2:1 for square
+    /// pixels, e.g. 1024x512). The cube and the panorama take no distortion, vignetting or
+    /// stereo. Default: the preset's, else pinhole.
     #[arg(long, value_name = "PROJECTION", value_parser = parse_projection)]
     pub lens: Option<Projection>,
     /// Radial lens distortion (Brown–Conrady) on image coordinates normalised to the half
@@ -125,9 +130,8 @@ pub fn beside(path: &Path, ending: &str) -> PathBuf {
 
 /// A projection by name.
 fn parse_projection(text: &str) -> Result<Projection, String> {
-    Projection::from_name(text).ok_or_else(|| {
-        format!("unknown lens {text:?}: use pinhole, equidistant, equisolid or orthographic")
-    })
+    Projection::from_name(text)
+        .ok_or_else(|| format!("unknown lens {text:?}: use {}", Projection::choices()))
 }
 
 /// A stereo output by name.

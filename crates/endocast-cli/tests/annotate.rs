@@ -1,7 +1,7 @@
 //! `endocast annotate` and `--case` on `render` and `fly`, end to end on the sphere shell
 //! (centred on the world origin, 1 mm voxels, inner wall 16.8 mm from the centre at 48³).
 
-use crate::common::{endocast, fails_with};
+use crate::common::{count_color, endocast, fails_with};
 use std::path::Path;
 
 /// The measurement's default colour (the core's `MEASURE_COLOR`).
@@ -41,19 +41,6 @@ const VIEW: [&str; 12] = [
     "--iso",
     "-480",
 ];
-
-/// Pixels of `rgb` in a PNG.
-fn count_color(png: &Path, rgb: [u8; 3]) -> usize {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
-    let mut reader = decoder.read_info().unwrap();
-    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut pixels).unwrap();
-    let channels = info.line_size / info.width as usize;
-    pixels[..info.buffer_size()]
-        .chunks(channels)
-        .filter(|p| p[..3] == rgb)
-        .count()
-}
 
 #[test]
 fn annotations_added_picked_listed_removed_and_drawn() {

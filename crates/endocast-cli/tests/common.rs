@@ -85,3 +85,16 @@ pub fn read_png_rgb(path: &std::path::Path) -> ([usize; 2], Vec<u8>) {
     pixels.truncate(info.buffer_size());
     ([info.width as usize, info.height as usize], pixels)
 }
+
+/// Pixels of `rgb` in a PNG.
+pub fn count_color(png: &std::path::Path, rgb: [u8; 3]) -> usize {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    let channels = info.line_size / info.width as usize;
+    pixels[..info.buffer_size()]
+        .chunks(channels)
+        .filter(|p| p[..3] == rgb)
+        .count()
+}

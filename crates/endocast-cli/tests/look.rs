@@ -437,6 +437,8 @@ fn a_colour_texture_changes_the_hue_a_specular_map_is_read_and_bad_files_are_ref
         let mut args = base.to_vec();
         args.extend_from_slice(&[flag, file.to_str().unwrap()]);
         fails_with(&args, problem);
+    }
+}
 
 #[test]
 fn the_realistic_look_sees_through_an_endoscope_unless_told_and_lights_by_a_lit_sphere() {

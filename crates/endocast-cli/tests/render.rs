@@ -1,6 +1,6 @@
 //! `endocast render` end to end: a phantom with a known answer, outputs, and bad options.
 
-use crate::common::{endocast, fails_with, read_npy};
+use crate::common::{count_color, endocast, fails_with, read_npy};
 
 #[test]
 fn from_the_centre_of_a_sphere_shell_every_depth_is_the_radius() {
@@ -377,5 +377,63 @@ fn lenses_and_stereo_outputs_from_the_command_line() {
     fails_with(
         &with(&["--stereo", "anaglyph", "--lens", "orthographic"]),
         "orthographic",
+    );
+}
+
+#[test]
+fn the_unfolded_cube_and_the_panorama_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let volume = dir.path().join("shell.nii.gz");
+    let v = volume.to_str().unwrap();
+    let made = endocast(&["phantom", "sphere-shell", "-o", v, "--size", "48"]);
+    assert!(made.status.success());
+    let png = dir.path().join("view.png");
+    let depth = dir.path().join("depth.npy");
+    let base = ["render", v, "-o", png.to_str().unwrap(), "--mode", "iso"];
+    let at_centre = ["--eye", "0,0,0", "--look-at", "0,0,1"];
+    let render = |extra: &[&str]| {
+        let mut args = [&base[..], &at_centre[..], extra].concat();
+        args.extend_from_slice(&["--depth-out", depth.to_str().unwrap()]);
+        let result = endocast(&args);
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert!(result.status.success(), "{extra:?}: {stderr}");
+        read_npy(&depth)
+    };
+    // The cube from the shell's centre: six faces of 16 pixels in the cross, each ray meeting
+    // the shell at its radius (0.35 × 48 mm); the six empty cells without a ray.
+    let ((h, w), depths) = render(&["--lens", "cube", "--size", "64x48"]);
+    assert_eq!((w, h), (64, 48));
+    assert_eq!(png_size(&png), (64, 48));
+    let hit = |x: usize, y: usize| depths[x + w * y].is_finite();
+    assert_eq!(depths.iter().filter(|d| d.is_finite()).count(), 6 * 16 * 16);
+    assert!(depths
+        .iter()
+        .filter(|d| d.is_finite())
+        .all(|d| (d - 16.8).abs() < 0.1));
+    let faces = [(24, 8), (8, 24), (24, 24), (40, 24), (56, 24), (24, 40)];
+    assert!(faces.iter().all(|&(x, y)| hit(x, y)), "a face without hits");
+    let empty = [(8, 8), (40, 8), (56, 8), (8, 40), (40, 40), (56, 40)];
+    assert!(
+        empty.iter().all(|&(x, y)| !hit(x, y)),
+        "an empty cell with hits"
+    );
+    assert!(count_color(&png, [255, 220, 0]) > 50, "the faces' labels");
+    // The panorama: every pixel sees the shell.
+    let ((h, w), depths) = render(&["--lens", "panorama", "--size", "64x32"]);
+    assert_eq!(((w, h), png_size(&png)), ((64, 32), (64, 32)));
+    assert!(depths.iter().all(|d| (d - 16.8).abs() < 0.1));
+    let with = |extra: &[&'static str]| -> Vec<&str> { [&base[..], extra].concat() };
+    fails_with(&with(&["--lens", "cube", "--fov", "100"]), "invalid camera");
+    fails_with(
+        &with(&["--lens", "panorama", "--fov", "200"]),
+        "invalid camera",
+    );
+    fails_with(
+        &with(&["--lens", "cube", "--stereo", "anaglyph"]),
+        "no stereo eyes",
+    );
+    fails_with(
+        &with(&["--lens", "panorama", "--vignetting", "0.3"]),
+        "no lens distortion",
     );
 }

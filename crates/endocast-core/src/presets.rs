@@ -35,7 +35,8 @@ pub const FISHEYE_DEFAULT_FOV_DEG: f64 = 170.0;
 /// `field` a caller asked for (if any): the projection defaults to the preset's, else a
 /// pinhole; the field to the preset's field of view — a fisheye's
 /// [`FISHEYE_DEFAULT_FOV_DEG`] when the preset's own lens is no fisheye — or, orthographic,
-/// `default_height_mm`. The field is not checked against the projection's range here (the
+/// `default_height_mm`; the cube and the panorama take their own
+/// ([`Projection::default_field`]). The field is not checked against the projection's range here (the
 /// camera does that).
 pub fn lens_defaults(
     preset: Option<&Preset>,
@@ -46,14 +47,15 @@ pub fn lens_defaults(
     let projection = projection
         .or(preset.map(|p| p.projection))
         .unwrap_or(Projection::Pinhole);
-    let field = match (field, projection) {
-        (Some(field), _) => field,
-        (None, Projection::Orthographic) => default_height_mm,
-        (None, p) if p.is_fisheye() && preset.is_none_or(|p| !p.projection.is_fisheye()) => {
-            FISHEYE_DEFAULT_FOV_DEG
-        }
-        (None, _) => preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg),
-    };
+    let field = field
+        .or(projection.default_field())
+        .unwrap_or(match projection {
+            Projection::Orthographic => default_height_mm,
+            p if p.is_fisheye() && preset.is_none_or(|p| !p.projection.is_fisheye()) => {
+                FISHEYE_DEFAULT_FOV_DEG
+            }
+            _ => preset.map_or(DEFAULT_FOV_DEG, |p| p.fov_deg),
+        });
     (projection, field)
 }
 

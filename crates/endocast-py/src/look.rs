@@ -230,7 +230,8 @@ pub fn optics(
         .map(|name| {
             Projection::from_name(&name).ok_or_else(|| {
                 error(format!(
-                    "unknown lens {name:?}: use pinhole, equidistant, equisolid or orthographic"
+                    "unknown lens {name:?}: use {}",
+                    Projection::choices()
                 ))
             })
         })

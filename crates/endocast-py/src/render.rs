@@ -9,7 +9,7 @@ use endocast_core::camera::StereoRig;
 use endocast_core::look::{stereo_view, still_view, Look, MAX_STILL_FRAMES};
 use endocast_core::render::{Camera, Frame, Prepared};
 use endocast_core::views::stereo::{self, StereoOutput};
-use endocast_core::views::Image;
+use endocast_core::views::{lens_marks, Image};
 use endocast_io::{Limits, RenderKind};
 use numpy::ndarray::{Array, IxDyn};
 use numpy::IntoPyArray;
@@ -107,7 +107,9 @@ pub fn render<'py>(
                 let frame = look
                     .in_pool(|| still_view(&prepared, look.look.as_ref(), &camera, still))
                     .map_err(to_py)?;
-                Ok((single(&frame, look.settings.background), partial))
+                let mut view = single(&frame, look.settings.background);
+                lens_marks::draw_rgba(&mut view.rgba, &camera);
+                Ok((view, partial))
             }
             Some(stereo) => {
                 let view = look.in_pool(|| {

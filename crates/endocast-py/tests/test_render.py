@@ -47,6 +47,24 @@ def test_render_equals_the_cli(volume, colon, cli, tmp_path, options, flags):
     assert np.isfinite(depth).any()
 
 
+@pytest.mark.parametrize("lens, size", [("cube", (96, 72)), ("panorama", (96, 48))])
+def test_the_cube_and_the_panorama_equal_the_cli(volume, colon, cli, tmp_path, lens, size):
+    (w, h), png, npy = size, tmp_path / "cli.png", tmp_path / "depth.npy"
+    cli("render", colon, "--preset", "colonoscopy", "--lens", lens, "--size", f"{w}x{h}",
+        "-o", png, "--depth-out", npy)
+    rgba, depth = endocast.render(volume, preset="colonoscopy", lens=lens, size=size)
+    np.testing.assert_array_equal(rgba[..., :3], read_png_rgb(png))
+    np.testing.assert_array_equal(depth, np.load(npy).reshape(h, w))
+    if lens == "cube":
+        # The cross's top-left cell is empty: no ray, transparent; the front face sees the wall.
+        assert np.isnan(depth[:24, :24]).all() and (rgba[:24, :24, 3] == 0).all()
+        assert np.isfinite(depth[24:48, 24:48]).all()
+    else:
+        assert np.isfinite(depth).all(), "from inside the gas every direction meets the wall"
+    with pytest.raises(endocast.EndocastError, match="stereo"):
+        endocast.render(volume, preset="colonoscopy", lens=lens, stereo="anaglyph", size=size)
+
+
 def test_default_view_is_inside_the_colon(volume):
     eye, look_at, up = endocast.default_view(volume, preset="colonoscopy")
     rgba, depth = endocast.render(volume, preset="colonoscopy", eye=eye, look_at=look_at, up=up,

@@ -233,6 +233,7 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
     colour_strip_ui(ui, (lo, hi), &mut c.tf);
     ui.add(egui::Slider::new(&mut c.iso_hu, lo..=hi).text("isovalue"));
     ui.add(egui::Slider::new(&mut c.iso_opacity, 0.0..=1.0).text("surface opacity"));
+    let before = c.projection;
     egui::ComboBox::from_label("lens")
         .selected_text(c.projection.name())
         .show_ui(ui, |ui| {
@@ -240,10 +241,16 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
                 Projection::Pinhole,
                 Projection::Equidistant,
                 Projection::Equisolid,
+                Projection::Cube,
+                Projection::Panorama,
             ] {
                 ui.selectable_value(&mut c.projection, p, p.name());
             }
         });
+    // The cube's fixed 90° and the panorama's whole sphere, not the last lens's field.
+    if c.projection != before {
+        c.fov_deg = c.projection.default_field().unwrap_or(c.fov_deg);
+    }
     let (fov_lo, fov_hi) = c.projection.field_range();
     // A pinhole cannot take a fisheye's field.
     c.fov_deg = c.fov_deg.clamp(fov_lo, fov_hi);

@@ -58,7 +58,8 @@ pub struct FlyArgs {
     #[arg(long, value_name = "MM", default_value_t = LOOK_AHEAD_MM)]
     pub(crate) look_ahead: f64,
     /// Vertical field of view, degrees (default: the preset's, else 90; fisheye 170; key frames
-    /// carry their own); view height in mm for an orthographic lens.
+    /// carry their own); view height in mm for an orthographic lens; 90 (fixed) for the cube;
+    /// the latitudes spanned (default 180) for the panorama, which key frames leave as it is.
     #[arg(long = "fov", value_name = "DEG")]
     fov_deg: Option<f64>,
     #[command(flatten)]

@@ -18,7 +18,7 @@ use endocast_core::render::{Camera, Frame, Prepared, RenderSettings, Renderer};
 use endocast_core::study::Study;
 use endocast_core::tissue::short;
 use endocast_core::views::stereo::{self, StereoOutput};
-use endocast_core::views::Image;
+use endocast_core::views::{lens_marks, Image};
 use endocast_core::Volume;
 use endocast_io::{ImageFormat, RenderKind};
 use glam::DVec3;
@@ -49,7 +49,8 @@ pub struct RenderArgs {
     #[command(flatten)]
     pose: PoseArgs,
     /// Vertical field of view in degrees: 10–170 for a pinhole, up to 360 for a fisheye
-    /// (default: the preset's, else 90; fisheye 170); view height in mm for orthographic.
+    /// (default: the preset's, else 90; fisheye 170); view height in mm for orthographic;
+    /// 90 (fixed) for the cube; the latitudes spanned, 10–180 (default 180), for the panorama.
     #[arg(long, value_name = "DEG")]
     fov: Option<f64>,
     /// Distance from the eye to the near plane, mm (may lie inside tissue).
@@ -154,6 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 let spacing = renderer.volume().geometry().spacing_mm();
                 draw_marks(&mut image, marks, &camera, &frame.depth_mm, spacing);
             }
+            lens_marks::draw(&mut image, &camera);
             endocast_io::write_image_rgb8(&args.output, w, h, image.rgb())
                 .context("cannot write the image")?;
             frame

@@ -67,6 +67,11 @@ impl Lens {
         self.vignetting > 0.0 || self.image_radius().is_some()
     }
 
+    /// Whether the lens neither distorts nor darkens the image.
+    pub fn is_plain(&self) -> bool {
+        self.is_ideal() && self.vignetting == 0.0
+    }
+
     /// The radial factor `1 + k1·r² + k2·r⁴` at undistorted radius² `r2`.
     fn factor(&self, r2: f64) -> f64 {
         let [k1, k2] = self.distortion;

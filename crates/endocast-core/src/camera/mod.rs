@@ -14,19 +14,27 @@
 //! - equidistant fisheye: the angle from the axis is `θ = r·φ` (`r = |(u, v)|`);
 //! - equisolid fisheye: `r = sin(θ/2) / sin(φ/2)`;
 //! - orthographic: parallel rays along `forward` from `eye + right·u·h + up·v·h`, `h` half the
-//!   view height in mm.
+//!   view height in mm;
+//! - the all-round views map pixels to directions themselves: the unfolded cube's six 90°
+//!   pinhole faces in a cross ([`cube`]), the 360° equirectangular panorama ([`panorama`]).
+//!   Neither takes a lens's distortion or vignetting, nor stereo eyes: refused.
 //!
 //! A fisheye's image is the circle `r ≤ 1` (a real endoscope's round picture); pixels outside it
 //! have no ray. The lens's distortion acts on `(u, v)` before the projection (see [`lens`]).
 
+pub mod cube;
 mod framing;
 pub mod lens;
+pub mod panorama;
 mod projection;
 mod stereo;
 
 #[cfg(test)]
+mod all_round_tests;
+#[cfg(test)]
 mod tests;
 
+pub use cube::{CubeLayout, Face};
 pub use framing::{default_up, framing_eye, framing_pose};
 pub use lens::Lens;
 pub use projection::Projection;
@@ -82,6 +90,21 @@ pub enum CameraError {
     /// A stereo eye cannot be made.
     #[error("stereo: {0}")]
     BadStereo(String),
+    /// An all-round view (cube, panorama) was given a lens's distortion or vignetting.
+    #[error("a {0} view takes no lens distortion or vignetting")]
+    AllRoundLens(&'static str),
+}
+
+/// Refuses stereo eyes for a projection that has none: orthographic (parallel rays) and the
+/// all-round views (an eye offset along the camera's right is no offset at all for the right
+/// and left faces, and a reversed one behind the eye).
+fn no_stereo_eyes(projection: Projection) -> Result<(), CameraError> {
+    match projection {
+        Projection::Orthographic | Projection::Cube | Projection::Panorama => Err(
+            CameraError::BadStereo(format!("a {} camera has no stereo eyes", projection.name())),
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// A ray in world millimetres: where it starts and its unit direction.
@@ -141,7 +164,7 @@ impl Optics {
     /// field of view); an orthographic view keeps its height.
     pub fn with_fov(self, fov_deg: f64) -> Self {
         match self.projection {
-            Projection::Orthographic => self,
+            Projection::Orthographic | Projection::Cube | Projection::Panorama => self,
             _ => Self {
                 field: fov_deg,
                 ..self
@@ -250,7 +273,8 @@ impl Camera {
     }
 
     /// The same camera with another projection and field: degrees across the image height for
-    /// pinhole (10°–170°) and fisheye (10°–360°), mm of view height for orthographic.
+    /// pinhole (10°–170°) and fisheye (10°–360°), mm of view height for orthographic, 90° for
+    /// the cube, degrees of latitude for the panorama (10°–180°).
     pub fn with_projection(self, projection: Projection, field: f64) -> Result<Self, CameraError> {
         let (min, max) = projection.field_range();
         if !(min..=max).contains(&field) {
@@ -262,14 +286,16 @@ impl Camera {
                 unit: projection.field_unit(),
             });
         }
-        if projection == Projection::Orthographic && self.eye_shift.is_some() {
-            return Err(CameraError::BadStereo(
-                "an orthographic camera has no stereo eyes".into(),
-            ));
+        if self.eye_shift.is_some() {
+            no_stereo_eyes(projection)?;
+        }
+        if projection.is_all_round() && !self.lens.is_plain() {
+            return Err(CameraError::AllRoundLens(projection.name()));
         }
         let half = match projection {
-            Projection::Pinhole => (field.to_radians() / 2.0).tan(),
+            Projection::Pinhole | Projection::Cube => (field.to_radians() / 2.0).tan(),
             Projection::Equidistant | Projection::Equisolid => field.to_radians() / 2.0,
+            Projection::Panorama => field.to_radians() / 2.0,
             Projection::Orthographic => field / 2.0,
         };
         Ok(Self {
@@ -290,6 +316,9 @@ impl Camera {
         }
         if !(0.0..=1.0).contains(&lens.vignetting) {
             return Err(CameraError::BadLens("vignetting", lens.vignetting, "0…1"));
+        }
+        if self.projection.is_all_round() && !lens.is_plain() {
+            return Err(CameraError::AllRoundLens(self.projection.name()));
         }
         Ok(Self { lens, ..self })
     }
@@ -313,11 +342,7 @@ impl Camera {
             offset_mm,
             focus_mm,
         } = shift;
-        if self.projection == Projection::Orthographic {
-            return Err(CameraError::BadStereo(
-                "an orthographic camera has no stereo eyes".into(),
-            ));
-        }
+        no_stereo_eyes(self.projection)?;
         if !offset_mm.is_finite() || !focus_mm.is_finite() || focus_mm <= offset_mm.abs() {
             return Err(CameraError::BadStereo(format!(
                 "the focus distance {focus_mm} mm must be finite and larger than the eye offset {offset_mm} mm"
@@ -438,11 +463,19 @@ impl Camera {
     }
 
     /// The ray through image point `(x, y)` in pixels (pixel centres at half-integers, row 0 at
-    /// the top), or `None` where the lens forms no image (outside a fisheye's circle, or beyond
-    /// the fold of a strong barrel distortion). The one definition of pixel → ray.
+    /// the top), or `None` where the lens forms no image (outside a fisheye's circle, beyond
+    /// the fold of a strong barrel distortion, in an empty cell of the cube's cross). The one
+    /// definition of pixel → ray.
     pub fn ray(&self, x: f64, y: f64) -> Option<Ray> {
-        let (w, h) = (self.width as f64, self.height as f64);
         let (x, y) = (x + self.pixel_offset[0], y + self.pixel_offset[1]);
+        if self.projection.is_all_round() {
+            let dir = self.all_round_direction(x, y)?;
+            return Some(Ray {
+                origin: self.eye_mm,
+                dir,
+            });
+        }
+        let (w, h) = (self.width as f64, self.height as f64);
         let a = 2.0 * x / w - 1.0;
         let b = 1.0 - 2.0 * y / h;
         // An ideal lens leaves the radius as it is (and skips the `hypot`).
@@ -488,6 +521,31 @@ impl Camera {
                     dir: self.forward,
                 })
             }
+            Projection::Cube | Projection::Panorama => unreachable!("handled above"),
+        }
+    }
+
+    /// The camera's axes: forward, right, up.
+    fn axes(&self) -> [DVec3; 3] {
+        [self.forward, self.right, self.up]
+    }
+
+    /// The unit direction at image point `(x, y)` of the cube or the panorama, if any.
+    fn all_round_direction(&self, x: f64, y: f64) -> Option<DVec3> {
+        match self.projection {
+            Projection::Cube => CubeLayout::new(self.size()).direction(self.axes(), x, y),
+            _ => panorama::direction(self.axes(), self.size(), 2.0 * self.half, (x, y)),
+        }
+    }
+
+    /// The image point of the cube or the panorama where direction `d` is seen, if any.
+    fn all_round_position(&self, d: DVec3) -> Option<(f64, f64)> {
+        if d == DVec3::ZERO {
+            return None;
+        }
+        match self.projection {
+            Projection::Cube => Some(CubeLayout::new(self.size()).position(self.axes(), d)),
+            _ => panorama::position(self.axes(), self.size(), 2.0 * self.half, d),
         }
     }
 
@@ -519,14 +577,13 @@ impl Camera {
     }
 
     /// Distance along a unit ray `direction` from its start to the near plane (pinhole,
-    /// orthographic) or sphere (fisheye), mm.
+    /// orthographic, each face of the cube) or sphere (fisheye, panorama), mm.
     pub fn near_distance_along(&self, direction: DVec3) -> f64 {
-        if self.near_mm == 0.0 {
-            0.0
-        } else if self.projection.is_fisheye() {
-            self.near_mm
-        } else {
-            self.near_mm / direction.dot(self.forward).max(1e-9)
+        match self.projection {
+            _ if self.near_mm == 0.0 => 0.0,
+            Projection::Equidistant | Projection::Equisolid | Projection::Panorama => self.near_mm,
+            Projection::Cube => CubeLayout::near_along(self.axes(), direction, self.near_mm),
+            _ => self.near_mm / direction.dot(self.forward).max(1e-9),
         }
     }
 
@@ -550,9 +607,14 @@ impl Camera {
     }
 
     /// The image position `(x, y)` in pixels where world point `p_mm` projects, or `None` where
-    /// it is not seen (behind a pinhole or orthographic camera, outside a fisheye's field). The
-    /// inverse of [`Camera::ray`].
+    /// it is not seen (behind a pinhole or orthographic camera, outside a fisheye's field or
+    /// the panorama's latitudes, at the eye of an all-round view). The inverse of
+    /// [`Camera::ray`].
     pub fn project(&self, p_mm: DVec3) -> Option<(f64, f64)> {
+        if self.projection.is_all_round() {
+            let (x, y) = self.all_round_position(p_mm - self.eye_mm)?;
+            return Some((x - self.pixel_offset[0], y - self.pixel_offset[1]));
+        }
         let (u, v) = match self.projection {
             Projection::Pinhole => self.pinhole_uv(p_mm)?,
             Projection::Equidistant | Projection::Equisolid => self.fisheye_uv(p_mm)?,
@@ -563,6 +625,7 @@ impl Camera {
                 }
                 (d.dot(self.right) / self.half, d.dot(self.up) / self.half)
             }
+            Projection::Cube | Projection::Panorama => unreachable!("handled above"),
         };
         let (u, v) = self.lens.distort((u, v));
         let (w, h) = (self.width as f64, self.height as f64);

@@ -1,4 +1,5 @@
 use super::*;
+use crate::camera::{Optics, Projection};
 use crate::phantom::{self, PhantomOptions};
 use crate::pose::{fly_through, Pose};
 use crate::render::{Mode, Premultiplied, RenderSettings, Renderer};
@@ -32,10 +33,21 @@ fn iso_settings() -> RenderSettings {
 
 /// Records the frames of `poses` (90° cameras of `size²` pixels) into a fresh coverage.
 fn fly(renderer: &Arc<Renderer>, wall: &Coverage, poses: &[Pose], size: usize) -> Coverage {
+    fly_with(renderer, wall, poses, &Optics::default(), [size, size])
+}
+
+/// Records the frames of `poses` seen through `optics` at `size` pixels into a fresh coverage.
+fn fly_with(
+    renderer: &Arc<Renderer>,
+    wall: &Coverage,
+    poses: &[Pose],
+    optics: &Optics,
+    size: [usize; 2],
+) -> Coverage {
     let prepared = renderer.prepare(&iso_settings()).unwrap();
     let mut coverage = wall.clone();
     for p in poses {
-        let camera = Camera::look_at(p.eye_mm, p.look_at_mm, p.up, 90.0, [size, size]).unwrap();
+        let camera = optics.camera(p.eye_mm, p.look_at_mm, p.up, size).unwrap();
         coverage.record(&camera, &prepared.render(&camera)).unwrap();
     }
     coverage
@@ -216,8 +228,9 @@ fn fold_faces(volume: &Volume, colon: &phantom::Colon, coverage: &Coverage) -> (
     (fraction(counts[0]), fraction(counts[1]))
 }
 
-#[test]
-fn a_forward_flight_misses_the_far_sides_of_the_folds() {
+/// The 192³ colon phantom's renderer, the phantom, its wall (nothing seen yet) and the 48
+/// poses of a forward flight along its centreline.
+fn colon_flight() -> (Arc<Renderer>, phantom::Colon, Coverage, Vec<Pose>) {
     let (volume, colon) = phantom::colon(&PhantomOptions {
         size: 192,
         ..Default::default()
@@ -226,7 +239,12 @@ fn a_forward_flight_misses_the_far_sides_of_the_folds() {
     let g = *volume.geometry();
     let wall = Coverage::new(&g, threshold_wall(&volume, -500.0), &whole(&volume)).unwrap();
     let forward = fly_through(&g, |s| line.point_at(s), line.length_vox(), 48, 6.0).unwrap();
-    let renderer = Arc::new(Renderer::new(volume));
+    (Arc::new(Renderer::new(volume)), colon, wall, forward)
+}
+
+#[test]
+fn a_forward_flight_misses_the_far_sides_of_the_folds() {
+    let (renderer, colon, wall, forward) = colon_flight();
     let ahead = fly(&renderer, &wall, &forward, 96);
     let back = fly(&renderer, &wall, &backwards(&forward), 96);
     let mut both = ahead.clone();
@@ -250,6 +268,35 @@ fn a_forward_flight_misses_the_far_sides_of_the_folds() {
     let (toward_start, toward_end) = fold_faces(volume, &colon, &back);
     eprintln!("backward: fold faces looking back {toward_start:.3}, looking on {toward_end:.3}");
     assert!(toward_start < toward_end - 0.2);
+}
+
+#[test]
+fn a_one_way_cube_flight_sees_nearly_all_the_colon_wall() {
+    let (renderer, colon, wall, forward) = colon_flight();
+    // Faces of 64 pixels: the pinhole's rays are exactly the cube's front face's.
+    let pinhole = fly(&renderer, &wall, &forward, 64);
+    let optics = Optics {
+        projection: Projection::Cube,
+        ..Optics::default()
+    };
+    let cube = fly_with(&renderer, &wall, &forward, &optics, [256, 192]);
+    let (p, c) = (pinhole.seen_fraction(), cube.seen_fraction());
+    eprintln!("colon coverage one way: pinhole {p:.4}, unfolded cube {c:.4}");
+    // Vos et al. measured 99.5 % with the cube; the issue asks for 98 %.
+    assert!(c >= 0.98, "the cube saw {c}");
+    assert!(c > p + 0.05, "cube {c}, pinhole {p}");
+    let mut both = cube.clone();
+    both.merge(&pinhole).unwrap();
+    assert_eq!(
+        both.seen_count(),
+        cube.seen_count(),
+        "the front face is the pinhole's view"
+    );
+    // The fold faces looking on to the caecum, turned away from a forward camera, are in the
+    // cube's back face.
+    let (toward_start, toward_end) = fold_faces(renderer.volume(), &colon, &cube);
+    eprintln!("cube: fold faces looking back {toward_start:.3}, looking on {toward_end:.3}");
+    assert!(toward_start > 0.95 && toward_end > 0.95);
 }
 
 #[test]

@@ -14,7 +14,7 @@ use crate::scene::Scene;
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
 use crate::views::slices::{camera_cross_section, camera_slices, SliceOptions, Window};
 use crate::views::stereo::{self, StereoOutput};
-use crate::views::{Image, Rgb};
+use crate::views::{lens_marks, Image, Rgb};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -130,13 +130,15 @@ impl Flight {
         self.marks = marks;
     }
 
-    /// `image`, the picture of `frame` taken by `camera`, with the annotations drawn on it.
+    /// `image`, the picture of `frame` taken by `camera`, with the annotations and the lens's
+    /// marks (the cube's faces, the panorama's directions) drawn on it.
     fn with_marks(&self, mut image: Image, camera: &Camera, frame: &Frame) -> Image {
         if let Some(marks) = &self.marks {
             let spacing = self.renderer.volume().geometry().spacing_mm();
             let view = SurfaceView::new(camera, &frame.depth_mm, spacing);
             annotate::draw(&mut image, &view, marks.items(), &DrawOptions::default());
         }
+        lens_marks::draw(&mut image, camera);
         image
     }
 

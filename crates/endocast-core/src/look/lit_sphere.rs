@@ -113,7 +113,8 @@ impl LitSphere {
         // The disc's rim on the outermost texels' centres: the lookup never wraps.
         let scale = 0.5 * (1.0 - 1.0 / n as f32);
         let r = x.hypot(y).max(1.0);
-        self.map.sample(0.5 + scale * x / r, 0.5 - scale * y / r)
+        // A grey map: its three channels are equal; level 0, the map itself.
+        self.map.sample(0.5 + scale * x / r, 0.5 - scale * y / r, 0)[0]
     }
 
     /// The light of eight surface points with unit normals `normal` (either side) and unit

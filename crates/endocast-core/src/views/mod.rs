@@ -1,8 +1,9 @@
 //! Image-space views around the endoscope: an RGB [`Image`] with small drawing primitives and a
 //! built-in bitmap [`font`], the orthogonal [`slices`] through the camera, and the
 //! [`dashboard`] that puts the endoscopic view, the slices and an overview side by side, and
-//! the [`stereo`] outputs that combine two eyes' views, and the [`structure`] a command found
-//! tinted on the slices.
+//! the [`stereo`] outputs that combine two eyes' views, the [`structure`] a command found
+//! tinted on the slices, and the [`lens_marks`] that label the cube's faces and the panorama's
+//! directions.
 //!
 //! No file formats here: the writers live in `endocast-io`.
 //!
@@ -22,6 +23,7 @@
 
 pub mod dashboard;
 pub mod font;
+pub mod lens_marks;
 pub mod slices;
 pub mod stereo;
 pub mod structure;

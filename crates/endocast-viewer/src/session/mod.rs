@@ -22,7 +22,7 @@ use endocast_core::presets::{self, Preset};
 use endocast_core::render::{Mode, PeelSettings, RenderSettings, TransferFunction};
 use endocast_core::study::{Study, StudyRequest};
 use endocast_core::views::slices::Window;
-use endocast_core::views::Image;
+use endocast_core::views::{lens_marks, Image};
 use glam::DVec3;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -673,6 +673,7 @@ impl Session {
             let spacing = renderer.volume().geometry().spacing_mm();
             let view = SurfaceView::new(&camera, &frame.depth_mm, spacing);
             annotate::draw(&mut image, &view, marks.items(), &DrawOptions::default());
+            lens_marks::draw(&mut image, &camera);
             Ok(image)
         }
     }

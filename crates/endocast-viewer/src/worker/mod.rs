@@ -20,7 +20,7 @@ use endocast_core::render::{
     Renderer,
 };
 use endocast_core::views::stereo::{combine, StereoOutput};
-use endocast_core::views::Image;
+use endocast_core::views::{lens_marks, Image};
 use look_frames::{render_look, LookPass};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
@@ -281,7 +281,9 @@ fn deliverer<'a>(
     shared: &'a Shared,
     request: &'a Request,
 ) -> impl Fn(Stage, Image, &[f32], Duration) + 'a {
-    move |stage: Stage, image: Image, depth_mm: &[f32], time: Duration| {
+    move |stage: Stage, mut image: Image, depth_mm: &[f32], time: Duration| {
+        // The cube's faces and the panorama's directions labelled, as every front end shows them.
+        lens_marks::draw(&mut image, &request.view.camera);
         let frame = Delivered {
             generation: request.generation,
             stage,

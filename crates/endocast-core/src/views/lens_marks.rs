@@ -1,0 +1,102 @@
+//! The marks an all-round view needs to be read: the unfolded cube's six faces outlined and
+//! labelled (front, left, right, up, down, back; the cross's empty cells stay background), the
+//! panorama's directions named along its top edge (back at both edges: the seam). Every front
+//! end draws them with [`draw`] (or [`draw_rgba`] on an RGBA buffer), so `render`, `fly`, the
+//! workstation and Python show the same picture. Other projections get no marks.
+
+use super::{Image, Rgb};
+use crate::camera::{panorama, Camera, CubeLayout, Face, Projection};
+
+/// The labels' colour.
+const LABEL_COLOR: Rgb = [255, 220, 0];
+/// The face outlines' colour, and how much of it covers the rendered pixel under it.
+const FRAME_COLOR: (Rgb, f32) = ([200, 200, 200], 0.6);
+/// Pixels between a label and its face's corner (or the panorama's top edge).
+const MARGIN_PX: i64 = 3;
+
+/// Draws `camera`'s marks into `image`, the picture `camera` took (same size); nothing for a
+/// projection without marks.
+pub fn draw(image: &mut Image, camera: &Camera) {
+    if camera.size() != [image.width(), image.height()] {
+        return;
+    }
+    match camera.projection() {
+        Projection::Cube => cube(image, &CubeLayout::new(camera.size())),
+        Projection::Panorama => panorama_labels(image),
+        _ => {}
+    }
+}
+
+/// [`draw`] on a `width · height · 4` RGBA buffer (row 0 at the top): every pixel a mark
+/// covers takes its colour and becomes opaque.
+pub fn draw_rgba(rgba: &mut [u8], camera: &Camera) {
+    if !camera.projection().is_all_round() {
+        return;
+    }
+    let [w, h] = camera.size();
+    let rgb: Vec<u8> = rgba
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    let Ok(mut image) = Image::from_rgb(w, h, rgb) else {
+        return;
+    };
+    draw(&mut image, camera);
+    for (pixel, marked) in rgba.chunks_exact_mut(4).zip(image.rgb().chunks_exact(3)) {
+        if pixel[..3] != *marked {
+            pixel[..3].copy_from_slice(marked);
+            pixel[3] = 255;
+        }
+    }
+}
+
+/// Font pixels per glyph pixel for labels on a view `edge_px` pixels across.
+fn text_scale(edge_px: f64) -> usize {
+    if edge_px < 200.0 {
+        1
+    } else {
+        2
+    }
+}
+
+/// The cube's face outlines and labels.
+fn cube(image: &mut Image, layout: &CubeLayout) {
+    let scale = text_scale(layout.face_px);
+    for face in Face::ALL {
+        let (x0, y0) = layout.corner(face);
+        let (x0, y0) = (x0.round() as i64, y0.round() as i64);
+        let edge = layout.face_px.round() as i64;
+        outline(image, (x0, y0), edge);
+        let label = face.name().to_uppercase();
+        image.text_shadowed(x0 + MARGIN_PX, y0 + MARGIN_PX, &label, scale, LABEL_COLOR);
+    }
+}
+
+/// The one-pixel outline of the `edge × edge` square whose top-left pixel is `corner`, blended
+/// over the image.
+fn outline(image: &mut Image, (x0, y0): (i64, i64), edge: i64) {
+    let (color, amount) = FRAME_COLOR;
+    let (x1, y1) = (x0 + edge - 1, y0 + edge - 1);
+    for t in 0..edge {
+        for (x, y) in [(x0 + t, y0), (x0 + t, y1), (x0, y0 + t), (x1, y0 + t)] {
+            image.blend(x, y, color, amount);
+        }
+    }
+}
+
+/// The panorama's direction names along its top edge: each centred on its longitude, the
+/// seam's "back" at both edges.
+fn panorama_labels(image: &mut Image) {
+    let width = image.width();
+    let scale = text_scale(image.height() as f64);
+    let y = MARGIN_PX;
+    for (name, degrees) in [("LEFT", -90.0), ("FRONT", 0.0), ("RIGHT", 90.0)] {
+        let centre = panorama::column_of(degrees, width);
+        let half = (super::font::text_width(name, scale) / 2) as f64;
+        image.text_shadowed((centre - half).round() as i64, y, name, scale, LABEL_COLOR);
+    }
+    let back_width = super::font::text_width("BACK", scale) as i64;
+    image.text_shadowed(MARGIN_PX, y, "BACK", scale, LABEL_COLOR);
+    let right = width as i64 - MARGIN_PX - back_width;
+    image.text_shadowed(right, y, "BACK", scale, LABEL_COLOR);
+}
