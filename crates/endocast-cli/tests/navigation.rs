@@ -438,6 +438,7 @@ fn coverage_lists_the_patches_a_forward_flight_missed_and_views_that_see_them() 
         "{said}"
     );
     let mut bad = base.to_vec();
-    bad[bad.len() - 1] = "NaN";
+    let last = bad.len() - 1;
+    bad[last] = "NaN";
     fails_with(&bad, "--min-area");
 }
