@@ -166,7 +166,7 @@ impl<'a> ReviewSite<'a> {
     fn judge(&self, eye: DVec3, patch: &UnseenPatch) -> Candidate {
         let axis = (patch.centroid_mm - eye).normalize_or_zero();
         let stride = patch.voxels.len().div_ceil(SAMPLES).max(1);
-        let (mut visible, mut total, mut widest) = (0, 0, 0.0_f64);
+        let (mut visible, mut total, mut widest) = (0_usize, 0_usize, 0.0_f64);
         for v in patch.voxels.iter().step_by(stride) {
             let p = self.geometry.world_of(DVec3::from(v.map(|x| x as f64)));
             total += 1;
