@@ -40,6 +40,9 @@ enum Command {
     /// Fly along a path (or key frames) to a GIF, an MP4 or PNG frames, optionally as a
     /// dashboard with slices and an overview, optionally measuring the wall seen.
     Fly(Box<commands::fly::FlyArgs>),
+    /// The wall a flight missed, as patches with their area, centroid and a camera that sees
+    /// each (JSON with --json), their views (--views) and the coverage before and after them.
+    Coverage(Box<commands::coverage::CoverageArgs>),
     /// List the procedure presets: mode, transfer function, isovalues, lumen, slice window, lens.
     Presets(commands::presets::PresetsArgs),
     /// The lumen's wall (an isosurface) as a triangle mesh: STL, OBJ or PLY in world mm.
@@ -67,6 +70,7 @@ fn main() -> ExitCode {
         Command::Path(args) => commands::path::run(&args),
         Command::Fly(args) => commands::fly::run(&args),
         Command::View(args) => commands::view::run(&args),
+        Command::Coverage(args) => commands::coverage::run(&args),
         Command::Mesh(args) => commands::mesh::run(&args),
         Command::Annotate(args) => commands::annotate::run(&args),
     };

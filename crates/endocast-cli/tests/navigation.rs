@@ -375,3 +375,70 @@ fn key_frames_fly_at_constant_speed_with_their_own_look() {
     assert!(stdout.contains("7 frames"), "{stdout}");
     assert_eq!(std::fs::read_dir(&frames).unwrap().count(), 7);
 }
+
+#[test]
+fn coverage_lists_the_patches_a_forward_flight_missed_and_views_that_see_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let tube = phantom(dir.path(), "straight-tube", "48");
+    let route = tube_path(dir.path(), &tube, "p.json");
+    let views = dir.path().join("views");
+    let views = views.to_str().unwrap();
+    let base = [
+        "coverage",
+        &tube,
+        "--path",
+        &route,
+        "--iso",
+        "-480",
+        "--size",
+        "48x48",
+        "--frame-step",
+        "4",
+        "--forward-only",
+        "--min-area",
+        "1",
+    ];
+    let json = [&base[..], &["--json", "--views", views]].concat();
+    let report: serde_json::Value = serde_json::from_str(&ok(&json)).unwrap();
+    let patches = report["patches"].as_array().unwrap();
+    assert!(!patches.is_empty(), "{report}");
+    let areas: Vec<f64> = patches
+        .iter()
+        .map(|p| p["area_mm2"].as_f64().unwrap())
+        .collect();
+    assert!(areas.windows(2).all(|w| w[0] >= w[1]), "{areas:?}");
+    assert!(areas.iter().all(|&a| a >= 1.0));
+    for patch in patches {
+        for key in ["centroid", "eye", "look_at"] {
+            let point = patch[key].as_array().unwrap();
+            assert_eq!(point.len(), 3, "{key}");
+            assert!(point.iter().all(|x| x.as_f64().unwrap().is_finite()));
+        }
+        assert_eq!(patch["look_at"], patch["centroid"]);
+        assert!(
+            patch["voxels_seen_by_view"].as_u64().unwrap() > 0,
+            "{patch}"
+        );
+        assert!(Path::new(patch["view"].as_str().unwrap()).exists());
+    }
+    // Looking ahead from the path's start, the wall behind the first camera (z < −18) is the
+    // largest patch missed.
+    let centroid = |n: usize| patches[n]["centroid"][2].as_f64().unwrap();
+    assert!(centroid(0) < -14.0, "largest patch at z {}", centroid(0));
+    let (before, after) = (
+        report["coverage_before"].as_f64().unwrap(),
+        report["coverage_after"].as_f64().unwrap(),
+    );
+    assert!(before < 0.99 && after > before, "{before} → {after}");
+    assert_eq!(report["coverage_forward"], report["coverage_before"]);
+    // The words say the same.
+    let said = ok(&base);
+    assert!(
+        said.contains(&format!("{} unseen patches", report["patches_total"])),
+        "{said}"
+    );
+    let mut bad = base.to_vec();
+    let last = bad.len() - 1;
+    bad[last] = "NaN";
+    fails_with(&bad, "--min-area");
+}

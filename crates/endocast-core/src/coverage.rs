@@ -20,6 +20,10 @@
 //! later frames, closer to it, fill in. For a finer measurement record frames rendered only for
 //! coverage (a larger image or more poses) — the rule does not depend on the image size.
 
+mod patches;
+
+pub use patches::UnseenPatch;
+
 use crate::render::{Camera, Frame};
 use crate::views::{Image, Rgb};
 use crate::{Geometry, Modality, ValueMap, Volume, VolumeError};

@@ -109,7 +109,7 @@ pub fn fly<'py>(
 }
 
 /// The route `value` gives: a path file's name, or an (N, 3) array of points.
-fn read(py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<Route> {
+pub(crate) fn read(py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<Route> {
     if let Ok(file) = value.extract::<PathBuf>() {
         return read_route(&file).map_err(to_py);
     }

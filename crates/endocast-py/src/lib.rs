@@ -8,6 +8,7 @@
 //! and the same library messages in the exceptions. The GIL is released while reading,
 //! rendering and planning, so Python threads run those in parallel.
 
+mod coverage;
 mod errors;
 mod fly;
 mod image;
@@ -30,6 +31,7 @@ fn _endocast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(navigate::default_view, m)?)?;
     m.add_function(wrap_pyfunction!(navigate::path, m)?)?;
     m.add_function(wrap_pyfunction!(fly::fly, m)?)?;
+    m.add_function(wrap_pyfunction!(coverage::coverage, m)?)?;
     m.add_function(wrap_pyfunction!(look::preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(image::save_png, m)?)?;
     Ok(())

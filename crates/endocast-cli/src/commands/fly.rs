@@ -19,7 +19,7 @@ use endocast_core::flight::{
     lumen_overview, wall_coverage_near, BackwardPass, Flight, FlightOptions, FlightStereo, Layout,
     Route, Shot, ShotSettings, WallSeen,
 };
-use endocast_core::navigate::{seed_voxel, Lumen};
+use endocast_core::navigate::Lumen;
 use endocast_core::render::{RenderSettings, Renderer};
 use endocast_core::study::{Study, LOOK_AHEAD_MM};
 use endocast_core::views::slices::Window;
@@ -350,20 +350,16 @@ fn video_options(args: &FlyArgs) -> VideoOptions {
     options
 }
 
-/// The lumen around the route's start `start_mm`: the structure the study found (the aorta,
-/// not everything as bright as it) when the route starts in it, else the lumen grown from the
-/// start with the study's threshold.
-fn lumen_at_start(study: &Study, volume: &Volume, start_mm: DVec3) -> Result<Lumen> {
-    let (threshold, side) = study.lumen()?;
-    let seed = seed_voxel(volume, start_mm).context("the route starts outside the volume")?;
-    if let Some(lumen) = study.structure().filter(|l| l.contains(seed)) {
-        if let Some(what) = study.structure_name() {
-            eprintln!("the path starts in the {what}: coverage is measured on its wall");
-        }
-        return Ok(lumen.clone());
+/// The lumen around the route's start `start_mm` ([`Study::lumen_from`]), saying when it is the
+/// structure the study found.
+pub(crate) fn lumen_at_start(study: &Study, volume: &Volume, start_mm: DVec3) -> Result<Lumen> {
+    let (lumen, what) = study
+        .lumen_from(volume, start_mm)
+        .context("the route's start is not in the lumen")?;
+    if let Some(what) = what {
+        eprintln!("the path starts in the {what}: coverage is measured on its wall");
     }
-    Lumen::from_seed(volume, seed, threshold, side)
-        .with_context(|| format!("the route's start is not in a lumen {side} {threshold}"))
+    Ok(lumen)
 }
 
 /// The dashboard's slice window: `--window` when given, else the study's (`default`).

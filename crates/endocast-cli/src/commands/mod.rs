@@ -3,6 +3,7 @@
 pub mod annotate;
 pub mod bench;
 pub mod convert;
+pub mod coverage;
 pub mod fly;
 mod fly_coverage;
 pub mod info;

@@ -130,7 +130,7 @@ pub fn run(args: &PathArgs) -> Result<()> {
 }
 
 /// The study's path ([`Study::plan`]), its errors in terms of the options.
-fn plan(
+pub(crate) fn plan(
     volume: &Volume,
     study: &Study,
     from: Option<DVec3>,

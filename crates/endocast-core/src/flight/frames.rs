@@ -176,6 +176,12 @@ impl Flight {
         self.coverage.as_ref()
     }
 
+    /// Tracks the wall seen into `coverage` from now on (`None`: stops tracking); returns the
+    /// coverage tracked so far.
+    pub fn set_coverage(&mut self, coverage: Option<Coverage>) -> Option<Coverage> {
+        std::mem::replace(&mut self.coverage, coverage)
+    }
+
     /// The coverage, when tracked, ending the flight.
     pub fn into_coverage(self) -> Option<Coverage> {
         self.coverage

@@ -2,18 +2,24 @@
 //! the frames of the flight — the endoscopic view alone or a dashboard with the three slices
 //! and an overview of the lumen — while the [`Coverage`](crate::coverage::Coverage) of the wall
 //! is tracked; the settings of each shot ([`ShotSettings`]: a key frame's look); and the
-//! coverage measurement, forward and back ([`wall_coverage`], [`BackwardPass`], [`WallSeen`]).
+//! coverage measurement, forward and back ([`wall_coverage`], [`BackwardPass`], [`WallSeen`]);
+//! and the review of the wall it missed ([`review`]).
 
 mod error;
 mod frames;
 mod looks;
 mod overview;
+mod review;
 mod wall;
 
 pub use error::FlightError;
 pub use frames::{Flight, FlightOptions, FlightStereo, Layout};
 pub use looks::ShotSettings;
 pub use overview::{lumen_overview, Overview};
+pub use review::{
+    review, PatchView, Review, ReviewRequest, ReviewSite, DEFAULT_MIN_AREA_MM2, MAX_FOV_DEG,
+    MIN_FOV_DEG, REVIEW_AREA_MM2, SAFE_MM,
+};
 pub use wall::{
     wall_coverage, wall_coverage_near, BackwardPass, WallSeen, BACK_ONLY_TINT,
     LABEL_SEEN_BACK_ONLY, LABEL_SEEN_FORWARD, LABEL_UNSEEN, MASK_LABELS, REPORT_TINT,

@@ -3,7 +3,8 @@
 
 use super::Study;
 use crate::navigate::{
-    plan_in, plan_path, seed_voxel, DistanceField, LumenChoiceError, NavError, PathEnd, PlannedPath,
+    plan_in, plan_path, seed_voxel, DistanceField, Lumen, LumenChoiceError, NavError, PathEnd,
+    PlannedPath,
 };
 use crate::path::SmoothOptions;
 use crate::Volume;
@@ -85,6 +86,27 @@ impl Study {
             field,
             planned,
         })
+    }
+
+    /// The lumen a route starting at `start_mm` flies through: the structure the study found
+    /// (the aorta, not everything as bright as it) when the start is in it — then also its name
+    /// — else the lumen grown from the start at the study's threshold.
+    pub fn lumen_from(
+        &self,
+        volume: &Volume,
+        start_mm: DVec3,
+    ) -> Result<(Lumen, Option<&str>), StudyPathError> {
+        let (threshold, side) = self.lumen()?;
+        let failed = |error| StudyPathError::Navigation {
+            what: format!("{side} {}", crate::tissue::short(threshold)),
+            error,
+        };
+        let seed = seed_voxel(volume, start_mm).map_err(failed)?;
+        if let Some(lumen) = self.structure().filter(|l| l.contains(seed)) {
+            return Ok((lumen.clone(), self.structure_name()));
+        }
+        let lumen = Lumen::from_seed(volume, seed, threshold, side).map_err(failed)?;
+        Ok((lumen, None))
     }
 
     /// Why there is no start, in words.

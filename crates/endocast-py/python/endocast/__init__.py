@@ -2,7 +2,8 @@
 
 Read a scan (``open``), wrap a numpy array (``Volume.from_array``) or pass a nibabel or
 SimpleITK image as it is (``as_volume`` converts it), render the endoscope's
-view (``render``), plan a centred path through a lumen (``path``) and fly along it (``fly``).
+view (``render``), plan a centred path through a lumen (``path``), fly along it (``fly``) and review the
+wall a flight missed (``coverage``).
 The options are those of the ``endocast`` command (``--look-at`` is ``look_at=``), with the
 same defaults and presets; positions are in the patient frame, LPS millimetres, as DICOM has
 them (``Volume.affine_ras`` converts to nibabel's RAS).
@@ -20,11 +21,13 @@ render = accepting_images(_endocast.render)
 default_view = accepting_images(_endocast.default_view)
 path = accepting_images(_endocast.path)
 fly = accepting_images(_endocast.fly)
+coverage = accepting_images(_endocast.coverage)
 
 __all__ = [
     "EndocastError",
     "Volume",
     "as_volume",
+    "coverage",
     "default_view",
     "fly",
     "open",

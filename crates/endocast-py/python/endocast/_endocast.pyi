@@ -232,6 +232,29 @@ def fly(
     **options: object,
 ) -> pathlib.Path:
     """The same flight written to ``out`` (.gif, .mp4 or a folder of PNGs); returns its path."""
+def coverage(
+    volume: _VolumeLike,
+    path: Optional[Union[_Path, npt.ArrayLike]] = None,
+    *,
+    preset: Optional[str] = None,
+    iso: Optional[float] = None,
+    look: Optional[_Look] = None,
+    fov: Optional[float] = None,
+    lens: Optional[_Lens] = None,
+    size: Tuple[int, int] = (256, 256),
+    frame_step: float = 1.0,
+    look_ahead: float = 10.0,
+    min_area: float = 10.0,
+    forward_only: bool = False,
+    views: Optional[_Path] = None,
+    lumen_threshold: Optional[float] = None,
+    bright_lumen: bool = False,
+    threads: Optional[int] = None,
+    **options: object,
+) -> dict[str, Any]:
+    """Fly ``path`` (or the ``preset``'s automatic path) and review the wall it missed, as
+    ``endocast coverage --json`` reports it: ``patches`` (largest first: ``area_mm2``,
+    ``centroid``, ``eye``, ``look_at``, ...) and the coverage before and after the review."""
 def presets() -> list[str]:
     """The preset names."""
 def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:

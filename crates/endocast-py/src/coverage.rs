@@ -1,0 +1,184 @@
+//! `endocast.coverage`: the review of what a flight missed, as `endocast coverage --json`
+//! reports it.
+
+use crate::errors::{error, to_py};
+use crate::fly::read;
+use crate::kwargs::Kwargs;
+use crate::look::{optics, LookOptions};
+use crate::volume::Volume;
+use endocast_core::flight::{
+    review, FlightError, FlightOptions, Layout, PatchView, Review, ReviewRequest, Route,
+    DEFAULT_MIN_AREA_MM2, REVIEW_AREA_MM2,
+};
+use endocast_core::path::SmoothOptions;
+use endocast_core::study::LOOK_AHEAD_MM;
+use endocast_core::views::Image;
+use glam::DVec3;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::{Path, PathBuf};
+
+/// Flies `path` — an (N, 3) array of points (LPS mm) or a path file, as `fly` takes it; without
+/// it, the automatic path through the structure the `preset` finds, as `path` plans it —
+/// forward, and back unless `forward_only`, and reviews the wall it missed: the unseen wall split
+/// into patches of at least `min_area` mm² (default 10), each with a camera that sees it, whose
+/// view is rendered (written as `views/patch_NNN.png` with `views`) and added to the coverage.
+///
+/// Returns the dict `endocast coverage --json` prints: `patches` (largest first, each with
+/// `area_mm2`, `centroid`, `eye`, `look_at`, `up`, `fov_deg`, `clear`, `voxels`,
+/// `voxels_seen_by_view`, `view`), `patches_total`, `patches_at_least_300_mm2`,
+/// `min_area_mm2`, `both_ways`, `wall_voxels`, `reach_mm`, `coverage_forward`,
+/// `coverage_before` and `coverage_after` (fractions, 0–1).
+///
+/// Options: `size` (width, height; default 256 × 256), `frame_step` (mm, default 1),
+/// `look_ahead` (mm), `min_area`, `forward_only`, `views`, and `render`'s look, lens and lumen
+/// options (`preset`, `iso`, `look`, `fov`, `lens`, `lumen_threshold`, …).
+#[pyfunction]
+#[pyo3(signature = (volume, path = None, **options))]
+pub fn coverage<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, Volume>,
+    path: Option<&Bound<'py, PyAny>>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let kw = Kwargs::new(py, "coverage", options)?;
+    let volume = volume.get();
+    let look_options = LookOptions::take(&kw)?;
+    let fov = kw.take::<f64>("fov")?;
+    let size = kw.take::<[usize; 2]>("size")?.unwrap_or([256, 256]);
+    let step_mm = positive("frame_step", kw.take::<f64>("frame_step")?.unwrap_or(1.0))?;
+    let look_ahead_mm = kw.take::<f64>("look_ahead")?.unwrap_or(LOOK_AHEAD_MM);
+    let min_area_mm2 = kw.take::<f64>("min_area")?.unwrap_or(DEFAULT_MIN_AREA_MM2);
+    if !(min_area_mm2.is_finite() && min_area_mm2 >= 0.0) {
+        return Err(error(format!(
+            "min_area must be a number of mm² ≥ 0, not {min_area_mm2}"
+        )));
+    }
+    let forward_only = kw.take::<bool>("forward_only")?.unwrap_or(false);
+    let views = kw.take::<PathBuf>("views")?;
+    let given = path.map(|p| read(py, p)).transpose()?;
+    let first = match &given {
+        Some(route) => Some(route.shots(step_mm, look_ahead_mm).map_err(to_py)?),
+        None => None,
+    }
+    .and_then(|shots| shots.first().map(|s| s.pose));
+    let look = look_options.resolve(py, volume.volume(), first, fov)?;
+    let optics = optics(&kw, look.study.preset(), volume.volume(), fov)?;
+    kw.finish()?;
+    let scan = volume.volume();
+    let route = match given {
+        Some(route) => route,
+        None => {
+            let options = SmoothOptions {
+                control_spacing_mm: 5.0,
+                step_mm: 0.5,
+                ..SmoothOptions::default()
+            };
+            let planned = py.detach(|| look.study.plan(scan, None, None, &options));
+            Route::Path(planned.map_err(to_py)?.planned.path)
+        }
+    };
+    let start = route.points_mm(1.0).map_err(to_py)?[0];
+    let (lumen, _) = look.study.lumen_from(scan, start).map_err(to_py)?;
+    let request = ReviewRequest {
+        settings: look.settings.clone(),
+        look: look.look.clone(),
+        flight: FlightOptions {
+            size,
+            optics,
+            stereo: None,
+            layout: Layout::Endoscope,
+            window: look.study.window(),
+        },
+        step_mm,
+        look_ahead_mm,
+        both_ways: !forward_only,
+        min_area_mm2,
+    };
+    if let Some(dir) = &views {
+        std::fs::create_dir_all(dir).map_err(to_py)?;
+    }
+    let review = py.detach(|| {
+        look.in_pool(|| {
+            let write = |n: usize, _: &PatchView, image: &Image| match &views {
+                Some(dir) => save(&view_file(dir, n), image),
+                None => Ok(()),
+            };
+            review::<ViewError>(volume.renderer(), &lumen, &route, &request, || {}, write)
+        })
+    });
+    let review = review.map_err(|e| error(e.0))?;
+    to_dict(py, &review, &request, views.as_deref())
+}
+
+/// A flight or a view file that failed, in words.
+struct ViewError(String);
+
+impl From<FlightError> for ViewError {
+    fn from(e: FlightError) -> Self {
+        Self(e.to_string())
+    }
+}
+
+/// `value` when it is a positive finite number, else an error naming the option.
+fn positive(name: &str, value: f64) -> PyResult<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(error(format!(
+            "{name} must be a positive number of mm, not {value}"
+        )))
+    }
+}
+
+/// The view file of patch `n`, as `endocast coverage --views` names it.
+fn view_file(dir: &Path, n: usize) -> PathBuf {
+    dir.join(format!("patch_{n:03}.png"))
+}
+
+fn save(path: &Path, image: &Image) -> Result<(), ViewError> {
+    let (w, h) = (image.width() as u32, image.height() as u32);
+    endocast_io::image_out::write_png_rgb8(path, w, h, image.rgb())
+        .map_err(|e| ViewError(format!("cannot write {}: {e}", path.display())))
+}
+
+/// The review as the dict `endocast coverage --json` prints.
+fn to_dict<'py>(
+    py: Python<'py>,
+    review: &Review,
+    request: &ReviewRequest,
+    views: Option<&Path>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let v = |p: DVec3| [p.x, p.y, p.z];
+    let patches = PyList::empty(py);
+    for (n, (view, seen)) in review.views.iter().zip(&review.seen_by_view).enumerate() {
+        let patch = PyDict::new(py);
+        patch.set_item("area_mm2", view.patch.area_mm2)?;
+        patch.set_item("centroid", v(view.patch.centroid_mm))?;
+        patch.set_item("eye", v(view.pose.eye_mm))?;
+        patch.set_item("look_at", v(view.pose.look_at_mm))?;
+        patch.set_item("up", v(view.pose.up))?;
+        patch.set_item("fov_deg", view.fov_deg)?;
+        patch.set_item("clear", view.clear)?;
+        patch.set_item("voxels", view.patch.voxels.len())?;
+        patch.set_item("voxels_seen_by_view", seen)?;
+        patch.set_item("view", views.map(|d| view_file(d, n)))?;
+        patches.append(patch)?;
+    }
+    let big = |view: &&PatchView| view.patch.area_mm2 >= REVIEW_AREA_MM2;
+    let out = PyDict::new(py);
+    out.set_item("patches", patches)?;
+    out.set_item("patches_total", review.patches_total)?;
+    out.set_item(
+        "patches_at_least_300_mm2",
+        review.views.iter().filter(big).count(),
+    )?;
+    out.set_item("min_area_mm2", request.min_area_mm2)?;
+    out.set_item("both_ways", request.both_ways)?;
+    out.set_item("wall_voxels", review.flight.wall_voxels())?;
+    out.set_item("reach_mm", review.reach_mm)?;
+    out.set_item("coverage_forward", review.flight.fraction_forward())?;
+    out.set_item("coverage_before", review.before().seen_fraction())?;
+    out.set_item("coverage_after", review.after.seen_fraction())?;
+    Ok(out)
+}
