@@ -116,7 +116,7 @@ pub fn run(args: &CoverageArgs) -> Result<()> {
     let (lo, hi) = volume.geometry().world_bounds();
     let optics = args
         .lens
-        .optics(study.preset(), args.fov_deg, 0.0, (hi - lo).length())?;
+        .optics(study.preset(), look.as_ref(), args.fov_deg, 0.0, (hi - lo).length())?;
     let request = ReviewRequest {
         settings,
         look,
