@@ -389,9 +389,17 @@ fn a_colour_texture_changes_the_hue_a_specular_map_is_read_and_bad_files_are_ref
     let png = dir.path().join("look.png");
     // A 2 × 2 checker of reddish and greenish texels, and its grey twin.
     let colour = dir.path().join("colour.png");
-    write_rgb_png(&colour, 2, &[200, 60, 60, 60, 200, 60, 60, 200, 60, 200, 60, 60]);
+    write_rgb_png(
+        &colour,
+        2,
+        &[200, 60, 60, 60, 200, 60, 60, 200, 60, 200, 60, 60],
+    );
     let grey = dir.path().join("grey.png");
-    write_rgb_png(&grey, 2, &[100, 100, 100, 160, 160, 160, 160, 160, 160, 100, 100, 100]);
+    write_rgb_png(
+        &grey,
+        2,
+        &[100, 100, 100, 160, 160, 160, 160, 160, 160, 100, 100, 100],
+    );
     let look = |texture: &Path, extra: &[&str]| {
         let mut args = vec![
             "--look",
@@ -408,7 +416,10 @@ fn a_colour_texture_changes_the_hue_a_specular_map_is_read_and_bad_files_are_ref
     };
     let (coloured, greyed) = (look(&colour, &[]), look(&grey, &[]));
     let (c, g) = (hue_spread(&coloured), hue_spread(&greyed));
-    assert!(c > 0.3 && g < 0.1, "hue varies by {c} (colour) and {g} (grey)");
+    assert!(
+        c > 0.3 && g < 0.1,
+        "hue varies by {c} (colour) and {g} (grey)"
+    );
     // A specular map changes the wet look.
     let wet = |extra: &[&str]| {
         let mut args = vec!["--look", "realistic", "--wetness", "1"];

@@ -114,9 +114,13 @@ pub fn run(args: &CoverageArgs) -> Result<()> {
     let start = route.points_mm(1.0)?[0];
     let lumen = lumen_at_start(&study, &volume, start)?;
     let (lo, hi) = volume.geometry().world_bounds();
-    let optics = args
-        .lens
-        .optics(study.preset(), look.as_ref(), args.fov_deg, 0.0, (hi - lo).length())?;
+    let optics = args.lens.optics(
+        study.preset(),
+        look.as_ref(),
+        args.fov_deg,
+        0.0,
+        (hi - lo).length(),
+    )?;
     let request = ReviewRequest {
         settings,
         look,

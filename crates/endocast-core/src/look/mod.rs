@@ -87,9 +87,9 @@ mod deferred_tests;
 #[cfg(test)]
 mod geometry_tests;
 #[cfg(test)]
-mod stereo_tests;
-#[cfg(test)]
 mod optics_tests;
+#[cfg(test)]
+mod stereo_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

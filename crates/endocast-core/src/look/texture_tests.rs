@@ -96,9 +96,14 @@ fn a_far_grazing_plane_reads_coarse_mip_levels_and_does_not_alias() {
     // 20 mm over the plane, looking 31° down at it: beyond 100 mm the rays meet it at 11° or
     // less, tens to hundreds of texels per pixel.
     let eye = DVec3::new(0.0, 0.0, 20.0);
-    let camera =
-        Camera::look_at(eye, eye + DVec3::new(0.0, 1.0, -0.6), DVec3::Z, 60.0, [128, 128])
-            .unwrap();
+    let camera = Camera::look_at(
+        eye,
+        eye + DVec3::new(0.0, 1.0, -0.6),
+        DVec3::Z,
+        60.0,
+        [128, 128],
+    )
+    .unwrap();
     let gbuffer = plane(&camera, 400.0);
     let mucosa = Arc::new(Texture::built_in("mucosa").unwrap());
     let shading = |texture: Arc<Texture>| Shading {
