@@ -401,13 +401,21 @@ fn a_colour_texture_changes_the_hue_a_specular_map_is_read_and_bad_files_are_ref
         &[100, 100, 100, 160, 160, 160, 160, 160, 160, 100, 100, 100],
     );
     let look = |texture: &Path, extra: &[&str]| {
+        // The ideal lens: the endoscope's vignetting darkens the edge into 8-bit noise of hue.
         let mut args = vec![
             "--look",
             "realistic",
+            "--distortion",
+            "0,0",
+            "--vignetting",
+            "0",
+            "--secretion",
+            "off",
             "--wetness",
             "0",
+            // Texels larger than a pixel's footprint: the mip map keeps their colours apart.
             "--texture-scale",
-            "4",
+            "40",
             "--texture",
             texture.to_str().unwrap(),
         ];
