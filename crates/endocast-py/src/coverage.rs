@@ -63,7 +63,13 @@ pub fn coverage<'py>(
     }
     .and_then(|shots| shots.first().map(|s| s.pose));
     let look = look_options.resolve(py, volume.volume(), first, fov)?;
-    let optics = optics(&kw, look.study.preset(), volume.volume(), fov)?;
+    let optics = optics(
+        &kw,
+        look.study.preset(),
+        look.look.as_ref(),
+        volume.volume(),
+        fov,
+    )?;
     kw.finish()?;
     let scan = volume.volume();
     let route = match given {

@@ -98,15 +98,11 @@ mod tests {
     fn footprints_match_neighbouring_rays_in_every_projection() {
         let base = Camera::look_at(DVec3::ZERO, DVec3::Z, DVec3::Y, 90.0, [96, 64]).unwrap();
         let cameras = [
-            base.clone(),
-            base.clone()
-                .with_projection(Projection::Equidistant, 160.0)
+            base,
+            base.with_projection(Projection::Equidistant, 160.0)
                 .unwrap(),
-            base.clone()
-                .with_projection(Projection::Equisolid, 120.0)
-                .unwrap(),
-            base.clone()
-                .with_projection(Projection::Orthographic, 30.0)
+            base.with_projection(Projection::Equisolid, 120.0).unwrap(),
+            base.with_projection(Projection::Orthographic, 30.0)
                 .unwrap(),
             base.with_lens(Lens {
                 distortion: [-0.2, 0.0],

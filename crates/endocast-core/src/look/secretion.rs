@@ -507,6 +507,7 @@ mod tests {
         let mut s = Rng::new(11);
         for round in 0..20 {
             let mut lanes = [[0.0f32; LANES]; 3];
+            #[allow(clippy::needless_range_loop)] // k picks the case as well as the lane
             for k in 0..LANES {
                 let g = match (round + k) % 5 {
                     0 => Vec3::ZERO,
@@ -516,6 +517,7 @@ mod tests {
                 (lanes[0][k], lanes[1][k], lanes[2][k]) = (g.x, g.y, g.z);
             }
             let normals = on.normals(&lanes);
+            #[allow(clippy::needless_range_loop)] // k reads the lanes and the normals
             for k in 0..LANES {
                 let g = Vec3::new(lanes[0][k], lanes[1][k], lanes[2][k]);
                 let want = shader.normal(g).to_array().map(f32::to_bits);
