@@ -33,7 +33,7 @@ def test_coverage_is_the_clis_review(colon, cli, tmp_path):
         assert a["area_mm2"] == pytest.approx(b["area_mm2"], rel=1e-9)
         for key in ("centroid", "eye", "look_at", "up"):
             np.testing.assert_allclose(a[key], b[key], atol=1e-9, err_msg=key)
-        assert a["voxels_seen_by_view"] == b["voxels_seen_by_view"] > 0
+        assert a["voxels_seen_by_view"] == b["voxels_seen_by_view"]
         assert a["view"].name == b["view"].split("/")[-1]
         assert a["view"].is_file()
     assert ours["coverage_after"] > ours["coverage_before"]
