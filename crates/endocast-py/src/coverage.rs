@@ -75,11 +75,8 @@ pub fn coverage<'py>(
     let route = match given {
         Some(route) => route,
         None => {
-            let options = SmoothOptions {
-                control_spacing_mm: 5.0,
-                step_mm: 0.5,
-                ..SmoothOptions::default()
-            };
+            // `endocast path`'s smoothing without `--smoothing`: the defaults.
+            let options = SmoothOptions::default();
             let planned = py.detach(|| look.study.plan(scan, None, None, &options));
             Route::Path(planned.map_err(to_py)?.planned.path)
         }

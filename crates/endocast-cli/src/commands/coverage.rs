@@ -103,11 +103,8 @@ pub fn run(args: &CoverageArgs) -> Result<()> {
     let route = match given {
         Some(route) => route,
         None => {
-            let options = SmoothOptions {
-                control_spacing_mm: 5.0,
-                step_mm: 0.5,
-                ..SmoothOptions::default()
-            };
+            // `endocast path`'s smoothing without `--smoothing`: the defaults.
+            let options = SmoothOptions::default();
             Route::Path(plan(&volume, &study, None, None, &options)?.planned.path)
         }
     };
