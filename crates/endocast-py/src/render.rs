@@ -6,7 +6,8 @@ use crate::look::{camera, LookOptions, Placed};
 use crate::scene::{warn, SceneFiles};
 use crate::volume::Volume;
 use endocast_core::camera::StereoRig;
-use endocast_core::look::{still_view, MAX_STILL_FRAMES};
+use endocast_core::look::{still_filter, still_view, MAX_STILL_FRAMES};
+use endocast_core::render::Filter;
 use endocast_core::render::{Camera, Frame, Prepared};
 use endocast_core::views::stereo::{self, StereoOutput};
 use endocast_core::views::Image;
@@ -61,7 +62,9 @@ struct View {
 /// - the endoscope's look: `look` (plain, clinical, realistic; default the preset's),
 ///   `secretion` (off, on, accumulate), `secretion_iso`, `wetness` (0–1), `texture`
 ///   (mucosa, grid, none or a PNG file), `texture_scale` (mm), `attenuation` (mm, 0: none),
-///   `still` (average this many jittered frames, 1–256);
+///   `still` (average this many jittered frames, 1–256), `still_filter` (trilinear or bspline:
+///   tricubic B-splines, surfaces exact at the voxels and smooth normals, several times slower;
+///   default bspline when `still` is above 1);
 /// - lumen: `lumen_threshold`, `bright_lumen`;
 /// - geometry: `meshes` (STL, OBJ or PLY files, world mm), `overlays` (DICOM segmentations,
 ///   each segment a surface in its colour, and dose grids, isodose surfaces at `FILE:LEVELS`
@@ -81,6 +84,14 @@ pub fn render<'py>(
     let camera = camera(&kw, &look, volume.volume(), &placed)?;
     let stereo = stereo_options(&kw)?;
     let still = kw.take::<usize>("still")?.unwrap_or(1);
+    let filter = match kw.take::<String>("still_filter")? {
+        Some(name) => Some(Filter::from_name(&name).ok_or_else(|| {
+            error(format!(
+                "still_filter must be trilinear or bspline, not {name:?}"
+            ))
+        })?),
+        None => None,
+    };
     let files = SceneFiles::take(&kw)?;
     kw.finish()?;
     if !(1..=MAX_STILL_FRAMES).contains(&still) {
@@ -97,6 +108,11 @@ pub fn render<'py>(
     Limits::default()
         .check_frames(Path::new("size"), camera.size(), kind, 1)
         .map_err(to_py)?;
+    let voxels = volume.volume().voxels().len();
+    let (filter, memory) = Limits::default().still_filter(still_filter(still, filter), voxels);
+    if let Some(memory) = memory {
+        warn(py, &[memory])?;
+    }
     let renderer = volume.renderer().clone();
     let (view, partial) = py.detach(|| -> PyResult<(View, Vec<String>)> {
         let mut prepared = renderer.prepare(&look.settings).map_err(to_py)?;
@@ -105,7 +121,7 @@ pub fn render<'py>(
         match &stereo {
             None => {
                 let frame = look
-                    .in_pool(|| still_view(&prepared, look.look.as_ref(), &camera, still))
+                    .in_pool(|| still_view(&prepared, look.look.as_ref(), &camera, still, filter))
                     .map_err(to_py)?;
                 Ok((single(&frame, look.settings.background), partial))
             }

@@ -98,6 +98,7 @@ def test_bad_look_values_name_the_keyword(colon):
         (dict(secretion="on"), "secretion only applies to the clinical or realistic look"),
         (dict(mode="peel", peel="first"), "peel"),
         (dict(still=0), "still must be between 1"),
+        (dict(still=2, still_filter="cubic"), "still_filter must be trilinear or bspline"),
     ]:
         with pytest.raises(endocast.EndocastError, match=needle):
             endocast.render(volume, size=(8, 8), **options)
@@ -106,7 +107,8 @@ def test_bad_look_values_name_the_keyword(colon):
 def test_help_documents_every_option():
     render_doc = endocast.render.__doc__
     for option in ["preset", "eye", "look_at", "lens", "stereo", "peel_threshold", "tf_after",
-                   "look", "secretion", "wetness", "texture", "still", "lumen_threshold",
+                   "look", "secretion", "wetness", "texture", "still", "still_filter",
+                   "lumen_threshold",
                    "meshes", "overlays"]:
         assert option in render_doc, option
     assert "nibabel" in endocast.as_volume.__doc__

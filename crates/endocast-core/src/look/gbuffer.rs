@@ -7,7 +7,8 @@ use super::LookError;
 use crate::camera::Camera;
 use crate::render::quality::{reduced_camera, upsample};
 use crate::render::{
-    Crossing, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, RenderStats, Renderer,
+    Crossing, Filter, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, RenderStats,
+    Renderer,
 };
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -135,12 +136,18 @@ impl RayPass {
     /// Marches every pixel of `camera` at `quality` (below full, the buffer is traced at the
     /// reduced size and upsampled depth-aware to the camera's).
     pub fn trace(&self, camera: &Camera, quality: Quality) -> GBuffer {
-        self.trace_shifted(camera, quality, 0.0)
+        self.trace_shifted(camera, quality, 0.0, Filter::Trilinear)
     }
 
     /// [`Self::trace`] with every ray's sample grid shifted by `grid_shift` steps (a still
-    /// frame's jitter).
-    pub(crate) fn trace_shifted(&self, camera: &Camera, quality: Quality, shift: f32) -> GBuffer {
+    /// frame's jitter), the volume reconstructed as `filter` says.
+    pub(crate) fn trace_shifted(
+        &self,
+        camera: &Camera,
+        quality: Quality,
+        shift: f32,
+        filter: Filter,
+    ) -> GBuffer {
         let start = Instant::now();
         let full = camera.size();
         let small = match quality {
@@ -152,13 +159,13 @@ impl RayPass {
         // The look shades the G-buffer itself: the renderer only finds the surfaces.
         let options = RenderOptions {
             grid_shift: shift,
-            ..RenderOptions::new().layers(layers).unlit()
+            ..RenderOptions::new().layers(layers).unlit().filter(filter)
         };
         let mut frame = Frame::default();
         // Nothing cancels it.
         let _ = self.prepared.render_with(&small, &options, &mut frame);
         let (secretion, surface) = if with_secretion {
-            self.continue_to_tissue(&small, &mut frame)
+            self.continue_to_tissue(&small, &mut frame, filter)
         } else {
             (vec![0.0; frame.len()], Vec::new())
         };
@@ -182,10 +189,15 @@ impl RayPass {
     /// Carries every ray of `frame` (traced by `camera` to its secretion hit) on to the tissue:
     /// replaces its depth with the tissue's, fills its hit positions and normals, and returns
     /// the secretion per pixel and the normals of the secretion's surface at the secretion hits
-    /// (NaN where no tissue lies behind).
-    fn continue_to_tissue(&self, camera: &Camera, frame: &mut Frame) -> (Vec<f32>, Vec<[f32; 3]>) {
+    /// (NaN where no tissue lies behind), sampling as `filter` says.
+    fn continue_to_tissue(
+        &self,
+        camera: &Camera,
+        frame: &mut Frame,
+        filter: Filter,
+    ) -> (Vec<f32>, Vec<[f32; 3]>) {
         let renderer = self.prepared.renderer();
-        let on = Continuation::new(renderer, &self.settings);
+        let on = Continuation::new(renderer, &self.settings, filter);
         let (w, n) = (frame.width, frame.len());
         (frame.hit_mm, frame.normal) = (vec![[f32::NAN; 3]; n], vec![[f32::NAN; 3]; n]);
         let mut surface = vec![[f32::NAN; 3]; n];

@@ -85,7 +85,7 @@ pub use kind::{Look, LookKind, PresetLook};
 pub use reduced::{shade_reduced, shade_reduced_with_scene};
 pub use settings::{RayPassSettings, SecretionMode};
 pub use shading::Shading;
-pub use still::{still, still_frame, still_view, MAX_STILL_FRAMES};
+pub use still::{still, still_filter, still_frame, still_view, MAX_STILL_FRAMES};
 pub use texture::{Texture, TextureError, BUILT_IN_TEXTURES, MAX_TEXELS};
 
 use thiserror::Error;

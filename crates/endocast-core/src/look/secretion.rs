@@ -4,7 +4,7 @@
 
 use super::lanes::{map, map3, Lanes, LANES};
 use super::settings::{RayPassSettings, SecretionMode};
-use crate::render::{with_avx2, Lighting, Renderer, Sampler, Shader};
+use crate::render::{with_avx2, Filter, Lighting, Renderer, Sampler, Shader};
 use glam::{DAffine3, DVec3, Vec3};
 
 /// Bisection steps refining the tissue hit (then linear interpolation in the last bracket):
@@ -54,8 +54,8 @@ pub(crate) struct Continuation<'a> {
 
 impl<'a> Continuation<'a> {
     /// The continuation of rays traced to the secretion threshold over `renderer`'s volume
-    /// with `settings`.
-    pub fn new(renderer: &'a Renderer, settings: &RayPassSettings) -> Self {
+    /// with `settings`, reconstructing it as `filter` says.
+    pub fn new(renderer: &'a Renderer, settings: &RayPassSettings, filter: Filter) -> Self {
         let volume = renderer.volume();
         let geometry = volume.geometry();
         let map = volume.value_map();
@@ -64,7 +64,7 @@ impl<'a> Continuation<'a> {
         let dims = volume.dims();
         let step_vox = settings.secretion_step_vox;
         Self {
-            sampler: renderer.sampler(),
+            sampler: renderer.sampler_for(filter),
             voxel_from_world: geometry.voxel_from_world(),
             extent: DVec3::from(dims.map(|n| (n - 1) as f64)),
             shader: Shader::new(geometry.world_from_voxel().matrix3, Lighting::default()),
@@ -404,7 +404,7 @@ mod tests {
         let volume = layered(&options).0;
         let (geometry, dims) = (*volume.geometry(), volume.dims());
         let renderer = Renderer::new(volume);
-        let on = Continuation::new(&renderer, &RayPassSettings::default());
+        let on = Continuation::new(&renderer, &RayPassSettings::default(), Filter::Trilinear);
         let mut s = Rng::new(7);
         let (mut inside, mut outside) = (0, 0);
         for round in 0..40 {

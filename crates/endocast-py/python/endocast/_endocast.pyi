@@ -120,6 +120,7 @@ def render(
     texture_scale: Optional[float] = None,
     attenuation: Optional[float] = None,
     still: int = 1,
+    still_filter: Optional[Literal["trilinear", "bspline"]] = None,
     lumen_threshold: Optional[float] = None,
     bright_lumen: bool = False,
     threads: Optional[int] = None,
@@ -134,7 +135,8 @@ def render(
     (2, height, width). Without ``eye``/``look_at`` the camera is ``default_view``'s.
     ``mode="peel"`` with the ``peel*`` options peels (Borland et al.); ``look`` "clinical" or
     "realistic" draws the endoscope's look (Krüger et al.) with ``secretion``, ``wetness``,
-    ``texture``, ``attenuation``; ``still`` averages that many jittered frames. ``meshes``
+    ``texture``, ``attenuation``; ``still`` averages that many jittered frames, reconstructed by
+    ``still_filter`` (default "bspline", tricubic B-splines, when ``still`` is above 1). ``meshes``
     (STL, OBJ, PLY) and ``overlays`` (DICOM SEG; RTDOSE as ``FILE`` or ``FILE:LEVEL,...``)
     are drawn with the scan as ``--mesh`` and ``--overlay`` draw them."""
 

@@ -1,13 +1,14 @@
 //! The endoscope's clinical or realistic look in the workstation: the look's ray pass (kept
 //! while its settings stay) traced at half resolution while the camera moves, then the full
-//! frame, both with the view's geometry composited, then jittered frames averaged into a still, each
-//! level delivered as it finishes; a new view stops it between levels and between still frames.
+//! frame, both with the view's geometry composited, then jittered frames averaged into a still (of
+//! the stills' filter: B-spline stills start again after the trilinear full frame), each level
+//! delivered as it finishes; a new view stops it between levels and between still frames.
 
 use super::{Deliver, View, STILL_FRAMES};
 use endocast_core::look::{shade_reduced_with_scene, still_frame, Look, RayPass, RayPassSettings};
 use endocast_core::render::progressive::Stage;
 use endocast_core::render::quality::reduced_camera;
-use endocast_core::render::{Frame, Quality, RenderSettings, Renderer, Still};
+use endocast_core::render::{Filter, Frame, Quality, RenderSettings, Renderer, Still};
 use endocast_core::views::Image;
 use std::sync::Arc;
 use std::time::Instant;
@@ -38,13 +39,14 @@ impl LookPass {
     }
 }
 
-/// Renders `view` in `look` level by level, handing each to `deliver`; stops (without error)
-/// as soon as `superseded` says a newer view waits, between levels and still frames.
+/// Renders `view` in `look` level by level, its still's frames reconstructed by `still_filter`,
+/// handing each to `deliver`; stops (without error) as soon as `superseded` says a newer view
+/// waits, between levels and still frames.
 pub(crate) fn render_look(
     passes: &mut LookPass,
     renderer: &Arc<Renderer>,
     view: &View,
-    look: &Look,
+    (look, still_filter): (&Look, Filter),
     superseded: &dyn Fn() -> bool,
     deliver: &Deliver<'_>,
 ) -> Result<(), String> {
@@ -67,20 +69,26 @@ pub(crate) fn render_look(
     if view.moving {
         return Ok(());
     }
+    let frame_of = |k: usize, filter: Filter| {
+        still_frame(pass, camera, shading, scene, k, filter).map_err(|e| e.to_string())
+    };
+    if superseded() {
+        return Ok(());
+    }
+    let start = Instant::now();
+    let full = frame_of(0, Filter::Trilinear)?;
+    show(Stage::Full, &full, start);
     let mut still = Still::new();
-    for k in 0..STILL_FRAMES {
+    if still_filter == Filter::Trilinear {
+        still.add(&full);
+    }
+    while still.frames() < STILL_FRAMES {
         if superseded() {
             return Ok(());
         }
         let start = Instant::now();
-        let frame = still_frame(pass, camera, shading, scene, k).map_err(|e| e.to_string())?;
-        still.add(&frame);
-        let stage = if k == 0 {
-            Stage::Full
-        } else {
-            Stage::Still(k + 1)
-        };
-        show(stage, still.frame(), start);
+        still.add(&frame_of(still.frames(), still_filter)?);
+        show(Stage::Still(still.frames()), still.frame(), start);
     }
     Ok(())
 }

@@ -16,11 +16,12 @@ use endocast_core::camera::StereoRig;
 use endocast_core::look::Look;
 use endocast_core::render::progressive::{progressive, PreviewPlanner, ProgressiveOptions, Stage};
 use endocast_core::render::{
-    Camera, Cancelled, Frame, Layers, Prepared, Progress, Quality, RenderOptions, RenderSettings,
-    Renderer,
+    Camera, Cancelled, Filter, Frame, Layers, Prepared, Progress, Quality, RenderOptions,
+    RenderSettings, Renderer,
 };
 use endocast_core::views::stereo::{combine, StereoOutput};
 use endocast_core::views::Image;
+use endocast_io::Limits;
 use look_frames::{render_look, LookPass};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
@@ -30,7 +31,8 @@ use std::time::{Duration, Instant};
 /// Hands a finished stage of a frame to the UI: its quality, image, depths and render time.
 pub(crate) type Deliver<'a> = dyn Fn(Stage, Image, &[f32], Duration) + 'a;
 
-/// Frames averaged into the still when the view stands (the full frame included).
+/// Frames averaged into the still when the view stands (the full frame included where the
+/// still is trilinear; B-spline stills average this many frames of the spline after it).
 pub const STILL_FRAMES: usize = 8;
 
 /// The time the first preview after an input may take: a mode whose quarter-resolution frame
@@ -223,12 +225,15 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
     let mut scene = SceneRef::default();
     let mut planner = PreviewPlanner::default();
     let mut look_pass = LookPass::default();
+    let still_filter = still_filter(renderer);
     while let Some(request) = next_request(shared) {
         if let Some(look) = &request.view.look {
             let superseded = || shared.generation.load(Ordering::Acquire) != request.generation;
             let deliver = deliverer(shared, &request);
             let view = &request.view;
-            if let Err(e) = render_look(&mut look_pass, renderer, view, look, &superseded, &deliver)
+            let looks = (look, still_filter);
+            if let Err(e) =
+                render_look(&mut look_pass, renderer, view, looks, &superseded, &deliver)
             {
                 lock(&shared.latest).error = Some(e);
                 (shared.on_frame)();
@@ -254,9 +259,20 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
         }
         if let Some(p) = &prepared {
             // A superseded frame simply ends; the next request is already waiting.
-            let _ = render_request(shared, p, &request, &mut planner);
+            let _ = render_request(shared, p, &request, &mut planner, still_filter);
         }
     }
+}
+
+/// The filter of the stills of a standing view: the library's default for stills, or
+/// trilinear (and a warning) where the B-spline's coefficients would not fit the memory.
+fn still_filter(renderer: &Renderer) -> Filter {
+    let voxels = renderer.volume().voxels().len();
+    let (filter, warning) = Limits::default().still_filter(Filter::STILL_DEFAULT, voxels);
+    if let Some(warning) = warning {
+        eprintln!("warning: {warning}");
+    }
+    filter
 }
 
 /// Blocks until a request is waiting (and takes it) or the worker is told to stop.
@@ -305,6 +321,7 @@ fn render_request(
     prepared: &Prepared,
     request: &Request,
     planner: &mut PreviewPlanner,
+    still_filter: Filter,
 ) -> Result<(), Cancelled> {
     let view = &request.view;
     let deliver = deliverer(shared, request);
@@ -319,6 +336,7 @@ fn render_request(
                 },
                 still_frames: if view.moving { 1 } else { STILL_FRAMES },
                 layers: Layers::NONE,
+                still_filter,
             };
             progressive(
                 prepared,
