@@ -30,7 +30,7 @@ for view in realistic hybrid; do
 done | tee "$out/times.txt"
 python3 - "$out/times.txt" "$frames" <<'PY'
 import sys, statistics
-rows = [l.split() for l in open(sys.argv[1]).read().splitlines()[1:]]
+rows = [l.split() for l in open(sys.argv[1]).read().splitlines() if not l.startswith("view")]
 n = int(sys.argv[2])
 per = {}
 for view, rnd, f, t1, tn in rows:
