@@ -1,5 +1,7 @@
 //! Parsers for the command line's small values: triples, image sizes.
 
+use endocast_core::render::Filter;
+
 /// Three comma-separated numbers.
 fn parse_triple<T: std::str::FromStr>(text: &str) -> Result<[T; 3], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
@@ -57,6 +59,11 @@ pub fn parse_size(text: &str) -> Result<[usize; 2], String> {
             .ok_or_else(|| format!("{s:?} is not a positive pixel count"))
     };
     Ok([parse(w)?, parse(h)?])
+}
+
+/// A reconstruction filter by name: `trilinear` or `bspline`.
+pub fn parse_filter(text: &str) -> Result<Filter, String> {
+    Filter::from_name(text).ok_or_else(|| format!("unknown filter {text:?}: trilinear or bspline"))
 }
 
 /// A pixel `X,Y`.

@@ -2,7 +2,7 @@
 
 use crate::error::{ReadError, Result};
 use endocast_core::look::{GBuffer, Look};
-use endocast_core::render::{Frame, Layers, StereoFrames};
+use endocast_core::render::{BSplineCoefficients, Filter, Frame, Layers, StereoFrames};
 use endocast_core::views::Image;
 use std::path::Path;
 
@@ -91,6 +91,24 @@ impl Limits {
             return Err(over(count));
         }
         usize::try_from(count).map_err(|_| over(count))
+    }
+
+    /// The filter a still of a volume of `voxels` voxels can use: `filter`, or trilinear and a
+    /// warning saying why where the B-spline's coefficients (a second copy of the volume,
+    /// [`BSplineCoefficients::BYTES_PER_VOXEL`] bytes a voxel) would take more than
+    /// [`Limits::max_frame_bytes`], the share of memory a view's frames may take.
+    pub fn still_filter(&self, filter: Filter, voxels: usize) -> (Filter, Option<String>) {
+        let bytes = (voxels as u64).saturating_mul(BSplineCoefficients::BYTES_PER_VOXEL as u64);
+        if filter != Filter::BSpline || bytes <= self.max_frame_bytes {
+            return (filter, None);
+        }
+        let warning = format!(
+            "the B-spline still of {voxels} voxels needs {} MiB for its coefficients, over the \
+             {} MiB allowed: the still is trilinear",
+            bytes >> 20,
+            self.max_frame_bytes >> 20
+        );
+        (Filter::Trilinear, Some(warning))
     }
 
     /// Refuses a series of more than [`Limits::max_slices`] files or slices.
@@ -340,6 +358,23 @@ mod tests {
         ));
         assert!(limits.check_dims(p, &[u64::MAX, 2, 2]).is_err());
         assert!(Limits::default().max_voxels > 1_000_000);
+    }
+
+    #[test]
+    fn spline_stills_fall_back_to_trilinear_beyond_the_memory_limit() {
+        let limits = Limits::for_memory(4 << 30);
+        let fits = (limits.max_frame_bytes / 4) as usize;
+        assert_eq!(
+            limits.still_filter(Filter::BSpline, fits),
+            (Filter::BSpline, None)
+        );
+        let (filter, warning) = limits.still_filter(Filter::BSpline, fits + 1);
+        assert_eq!(filter, Filter::Trilinear);
+        assert!(warning.unwrap().contains("trilinear"));
+        assert_eq!(
+            limits.still_filter(Filter::Trilinear, usize::MAX).0,
+            Filter::Trilinear
+        );
     }
 
     #[test]

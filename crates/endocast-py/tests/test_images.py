@@ -123,6 +123,7 @@ def test_bad_look_values_name_the_keyword(colon):
         (dict(distortion=(float("nan"), 0.0)), "distortion must be two finite numbers"),
         (dict(look="realistic", lighting="ibl:missing.png"), "missing.png"),
         (dict(lighting="ibl"), "lighting only applies to the clinical or realistic look"),
+        (dict(still=2, still_filter="cubic"), "still_filter must be trilinear or bspline"),
     ]:
         with pytest.raises(endocast.EndocastError, match=needle):
             endocast.render(volume, size=(8, 8), **options)
@@ -131,7 +132,7 @@ def test_bad_look_values_name_the_keyword(colon):
 def test_help_documents_every_option():
     render_doc = endocast.render.__doc__
     for option in ["preset", "eye", "look_at", "lens", "stereo", "peel_threshold", "tf_after",
-                   "look", "secretion", "wetness", "texture", "lighting", "still",
+                   "look", "secretion", "wetness", "texture", "lighting", "still", "still_filter",
                    "lumen_threshold",
                    "meshes", "overlays"]:
         assert option in render_doc, option

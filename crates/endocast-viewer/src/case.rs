@@ -147,6 +147,8 @@ impl SessionCase for Case {
             geometry: c.geometry.as_ref().map(toggles).unwrap_or_default(),
             look,
             lighting,
+            // A viewing preference of the workstation, not of the case: kept as it is.
+            still_filter: session.controls.still_filter,
         }))
     }
 

@@ -12,7 +12,7 @@ use endocast_core::camera::Projection;
 use endocast_core::look::{Lighting, LookKind};
 use endocast_core::navigate::LumenSide;
 use endocast_core::presets;
-use endocast_core::render::{Mode, PeelLayer, PeelSettings, Unpeeled};
+use endocast_core::render::{Filter, Mode, PeelLayer, PeelSettings, Unpeeled};
 use endocast_io::SeriesSummary;
 use std::path::Path;
 use std::sync::Arc;
@@ -274,6 +274,13 @@ fn view_controls_ui(ui: &mut egui::Ui, session: &mut Session) {
             };
         }
     }
+    let mut spline = c.still_filter == Filter::BSpline;
+    ui.checkbox(&mut spline, "B-spline stills (sharper, slower)");
+    c.still_filter = if spline {
+        Filter::BSpline
+    } else {
+        Filter::Trilinear
+    };
     ui.checkbox(&mut c.stereo, "stereo (red/cyan anaglyph)");
     if c.mode == Mode::Peel {
         peel_ui(ui, &mut c.peel, c.iso_hu, (lo, hi));

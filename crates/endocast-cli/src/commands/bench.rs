@@ -18,7 +18,7 @@ use endocast_core::phantom::{self, PhantomOptions};
 use endocast_core::pose::{fly_through, Pose};
 use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{
-    Camera, Frame, FrameReuse, Layers, Mode, PeelLayer, Prepared, Quality, RenderOptions,
+    Camera, Filter, Frame, FrameReuse, Layers, Mode, PeelLayer, Prepared, Quality, RenderOptions,
     RenderSettings, Renderer, StereoFrames,
 };
 use endocast_core::scene::Scene;
@@ -418,8 +418,15 @@ fn measure_look(
             let rig = StereoRig::for_view(args.stereo.eye_separation, args.stereo.focus, nearest)
                 .context("invalid --stereo options")?;
             let start = Instant::now();
-            let eyes = look::stereo_frame(pass, (camera, &rig), shading, None, 0, frames)
-                .context("invalid stereo camera or look")?;
+            let eyes = look::stereo_frame(
+                pass,
+                (camera, &rig),
+                shading,
+                None,
+                (0, Filter::Trilinear),
+                frames,
+            )
+            .context("invalid stereo camera or look")?;
             let samples = eyes[0].stats.samples + eyes[1].stats.samples;
             shared.add(start.elapsed(), samples, one_ms);
             let start = Instant::now();

@@ -8,7 +8,7 @@ use crate::camera::{Optics, StereoRig};
 use crate::coverage::Coverage;
 use crate::look::{shade_with_scene, stereo_frame, Look, RayPass};
 use crate::render::{
-    Camera, Frame, Prepared, Quality, RenderSettings, RenderStats, Renderer, StereoFrames,
+    Camera, Filter, Frame, Prepared, Quality, RenderSettings, RenderStats, Renderer, StereoFrames,
 };
 use crate::scene::Scene;
 use crate::views::dashboard::{Dashboard, DashboardInfo, DashboardLayout};
@@ -268,8 +268,14 @@ impl Flight {
                         let slot = &mut self.look_pass;
                         let pass = look_pass(slot, &self.renderer, settings, look)?;
                         let (scene, pair) = (self.scene.as_deref(), &mut self.frames);
-                        let eyes =
-                            stereo_frame(pass, (&camera, &rig), &look.shading, scene, 0, pair);
+                        let eyes = stereo_frame(
+                            pass,
+                            (&camera, &rig),
+                            &look.shading,
+                            scene,
+                            (0, Filter::Trilinear),
+                            pair,
+                        );
                         pair.eyes = eyes?;
                     }
                     None => prepared.render_stereo_into(&camera, &rig, &mut self.frames)?,

@@ -8,7 +8,8 @@ use super::LookError;
 use crate::camera::Camera;
 use crate::render::quality::{reduced_camera, upsample};
 use crate::render::{
-    Crossing, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, RenderStats, Renderer,
+    Crossing, Filter, Frame, Mode, Prepared, Quality, RenderOptions, RenderSettings, RenderStats,
+    Renderer,
 };
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -142,12 +143,18 @@ impl RayPass {
     /// Marches every pixel of `camera` at `quality` (below full, the buffer is traced at the
     /// reduced size and upsampled depth-aware to the camera's).
     pub fn trace(&self, camera: &Camera, quality: Quality) -> GBuffer {
-        self.trace_shifted(camera, quality, 0.0)
+        self.trace_shifted(camera, quality, 0.0, Filter::Trilinear)
     }
 
     /// [`Self::trace`] with every ray's sample grid shifted by `grid_shift` steps (a still
-    /// frame's jitter).
-    pub(crate) fn trace_shifted(&self, camera: &Camera, quality: Quality, shift: f32) -> GBuffer {
+    /// frame's jitter), the volume reconstructed as `filter` says.
+    pub(crate) fn trace_shifted(
+        &self,
+        camera: &Camera,
+        quality: Quality,
+        shift: f32,
+        filter: Filter,
+    ) -> GBuffer {
         let start = Instant::now();
         let full = camera.size();
         let small = match quality {
@@ -158,30 +165,36 @@ impl RayPass {
         // Nothing cancels it.
         let _ = self
             .prepared
-            .render_with(&small, &self.first_options(shift), &mut frame);
-        let mut gbuffer = self.finish(&small, frame, camera);
+            .render_with(&small, &self.first_options(shift, filter), &mut frame);
+        let mut gbuffer = self.finish(&small, frame, camera, filter);
         gbuffer.stats.time = start.elapsed();
         gbuffer
     }
 
     /// The renderer's options of the first threshold's search, every sample grid shifted by
-    /// `shift` steps: the look shades the G-buffer itself, the renderer only finds the
-    /// surfaces.
-    pub(super) fn first_options(&self, shift: f32) -> RenderOptions<'static> {
+    /// `shift` steps, the volume reconstructed as `filter` says: the look shades the G-buffer
+    /// itself, the renderer only finds the surfaces.
+    pub(super) fn first_options(&self, shift: f32, filter: Filter) -> RenderOptions<'static> {
         let layers = self.settings.traced_layers();
         RenderOptions {
             grid_shift: shift,
-            ..RenderOptions::new().layers(layers).unlit()
+            ..RenderOptions::new().layers(layers).unlit().filter(filter)
         }
     }
 
     /// The G-buffer of `frame`, the first threshold's search from `camera` (with
     /// [`Self::first_options`]): each ray carried on to the tissue, upsampled to the size of
     /// `full` (the camera at full size) where `camera` is smaller, and the pixels of `full`
-    /// whose rays start inside the tissue marked.
-    pub(super) fn finish(&self, camera: &Camera, mut frame: Frame, full: &Camera) -> GBuffer {
+    /// whose rays start inside the tissue marked; the continuation samples as `filter` says.
+    pub(super) fn finish(
+        &self,
+        camera: &Camera,
+        mut frame: Frame,
+        full: &Camera,
+        filter: Filter,
+    ) -> GBuffer {
         let (secretion, surface) = if self.settings.secretion != SecretionMode::Off {
-            self.continue_to_tissue(camera, &mut frame)
+            self.continue_to_tissue(camera, &mut frame, filter)
         } else {
             (vec![0.0; frame.len()], Vec::new())
         };
@@ -205,10 +218,15 @@ impl RayPass {
     /// Carries every ray of `frame` (traced by `camera` to its secretion hit) on to the tissue:
     /// replaces its depth with the tissue's, fills its hit positions and normals, and returns
     /// the secretion per pixel and the normals of the secretion's surface at the secretion hits
-    /// (NaN where no tissue lies behind).
-    fn continue_to_tissue(&self, camera: &Camera, frame: &mut Frame) -> (Vec<f32>, Vec<[f32; 3]>) {
+    /// (NaN where no tissue lies behind), sampling as `filter` says.
+    fn continue_to_tissue(
+        &self,
+        camera: &Camera,
+        frame: &mut Frame,
+        filter: Filter,
+    ) -> (Vec<f32>, Vec<[f32; 3]>) {
         let renderer = self.prepared.renderer();
-        let on = Continuation::new(renderer, &self.settings);
+        let on = Continuation::new(renderer, &self.settings, filter);
         let (w, n) = (frame.width, frame.len());
         // Zeroed (the allocator's fresh pages), then every pixel written in parallel.
         (frame.hit_mm, frame.normal) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);

@@ -4,7 +4,7 @@
 
 use super::lanes::{map, map3, normalize_or_zero, Lanes, LANES};
 use super::settings::{RayPassSettings, SecretionMode};
-use crate::render::{with_avx2, Renderer, Sampler};
+use crate::render::{with_avx2, Filter, Renderer, Sampler};
 use glam::{DAffine3, DVec3, Mat3};
 
 /// Bisection steps refining the tissue hit (then linear interpolation in the last bracket):
@@ -66,8 +66,8 @@ pub(crate) struct Continuation<'a> {
 
 impl<'a> Continuation<'a> {
     /// The continuation of rays traced to the secretion threshold over `renderer`'s volume
-    /// with `settings`.
-    pub fn new(renderer: &'a Renderer, settings: &RayPassSettings) -> Self {
+    /// with `settings`, reconstructing it as `filter` says.
+    pub fn new(renderer: &'a Renderer, settings: &RayPassSettings, filter: Filter) -> Self {
         let volume = renderer.volume();
         let geometry = volume.geometry();
         let map = volume.value_map();
@@ -76,7 +76,7 @@ impl<'a> Continuation<'a> {
         let dims = volume.dims();
         let step_vox = settings.secretion_step_vox;
         Self {
-            sampler: renderer.sampler(),
+            sampler: renderer.sampler_for(filter),
             voxel_from_world: geometry.voxel_from_world(),
             extent: DVec3::from(dims.map(|n| (n - 1) as f64)),
             // The inverse transpose of the linear part, as `Shader::new` makes it.
@@ -445,7 +445,7 @@ mod tests {
         let volume = layered(&options).0;
         let (geometry, dims) = (*volume.geometry(), volume.dims());
         let renderer = Renderer::new(volume);
-        let on = Continuation::new(&renderer, &RayPassSettings::default());
+        let on = Continuation::new(&renderer, &RayPassSettings::default(), Filter::Trilinear);
         let mut s = Rng::new(7);
         let (mut inside, mut outside) = (0, 0);
         for round in 0..40 {
@@ -499,7 +499,7 @@ mod tests {
         })
         .0;
         let renderer = Renderer::new(volume);
-        let mut on = Continuation::new(&renderer, &RayPassSettings::default());
+        let mut on = Continuation::new(&renderer, &RayPassSettings::default(), Filter::Trilinear);
         // A sheared, anisotropic grid, as `Continuation::new` turns it.
         let linear = glam::DMat3::from_cols_array(&[0.7, 0.1, 0.0, 0.05, 1.3, 0.2, 0.0, -0.3, 2.1]);
         on.world_from_gradient = linear.inverse().transpose().as_mat3();

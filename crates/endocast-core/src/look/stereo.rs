@@ -16,13 +16,14 @@ use super::shading::Shading;
 use super::still::{still_frame, still_view};
 use super::{Look, LookError};
 use crate::camera::{Camera, StereoRig};
-use crate::render::{Frame, Prepared, StereoFrames, Still};
+use crate::render::{Filter, Frame, Prepared, StereoFrames, Still};
 use crate::scene::Scene;
 use std::time::Instant;
 
 /// Frame `k` of a stereo still of `camera` under `rig` ([`stereo_still`]): the left and right
 /// eyes shaded by `shading` with `scene` composited, each jittered as
-/// [`super::still_frame`]`(k)` jitters a mono frame; frame 0 shares the eyes' searches, its
+/// [`super::still_frame`]`(k)` jitters a mono frame, the volume reconstructed by `filter`;
+/// frame 0 shares the eyes' searches, its
 /// ray-pass frames and start-up buffers kept in `pair` (reused from call to call). Fails on a
 /// rig without eyes (see [`StereoRig::eyes`]) and as [`shade_with_scene`] does.
 pub fn stereo_frame(
@@ -30,22 +31,22 @@ pub fn stereo_frame(
     (camera, rig): (&Camera, &StereoRig),
     shading: &Shading,
     scene: Option<&Scene>,
-    k: usize,
+    (k, filter): (usize, Filter),
     pair: &mut StereoFrames,
 ) -> Result<[Frame; 2], LookError> {
     let eyes = rig.eyes(camera)?;
     if k > 0 {
-        let [left, right] = eyes.map(|eye| still_frame(pass, &eye, shading, scene, k));
+        let [left, right] = eyes.map(|eye| still_frame(pass, &eye, shading, scene, k, filter));
         return Ok([left?, right?]);
     }
-    let options = pass.first_options(0.0);
+    let options = pass.first_options(0.0, filter);
     pass.prepared()
         .render_stereo_with(camera, rig, &options, pair)?;
     let mut shaded = [Frame::default(), Frame::default()];
     for ((eye, first), out) in eyes.iter().zip(&mut pair.eyes).zip(&mut shaded) {
         let start = Instant::now();
         let searched = first.stats.time;
-        let mut gbuffer = pass.finish(eye, std::mem::take(first), eye);
+        let mut gbuffer = pass.finish(eye, std::mem::take(first), eye, filter);
         gbuffer.stats.time = searched + start.elapsed();
         *out = shade_with_scene(&gbuffer, eye, shading, scene)?;
     }
@@ -53,18 +54,19 @@ pub fn stereo_frame(
 }
 
 /// The left and right eyes of `camera` under `rig` in a look, each the average of `frames`
-/// (at least one) jittered frames ([`stereo_frame`]): the stereo pair of [`super::still`].
+/// (at least one) jittered frames reconstructed by `filter` ([`stereo_frame`]): the stereo
+/// pair of [`super::still`].
 pub fn stereo_still(
     pass: &RayPass,
     (camera, rig): (&Camera, &StereoRig),
     shading: &Shading,
     scene: Option<&Scene>,
-    frames: usize,
+    (frames, filter): (usize, Filter),
 ) -> Result<[Frame; 2], LookError> {
     let mut pair = StereoFrames::default();
     let mut stills = [Still::new(), Still::new()];
     for k in 0..frames.max(1) {
-        let eyes = stereo_frame(pass, (camera, rig), shading, scene, k, &mut pair)?;
+        let eyes = stereo_frame(pass, (camera, rig), shading, scene, (k, filter), &mut pair)?;
         for (still, eye) in stills.iter_mut().zip(&eyes) {
             still.add(eye);
         }
@@ -73,25 +75,25 @@ pub fn stereo_still(
 }
 
 /// The stereo pair of [`still_view`]: the left and right eyes of `camera` under `rig`, each
-/// the average of `frames` jittered frames, drawn as `look` says with `prepared`'s scene
-/// composited from each eye, or `prepared`'s own pair without a look (one frame: the
-/// renderer's shared pair, [`Prepared::render_stereo`]).
+/// the average of `frames` jittered frames reconstructed by `filter`, drawn as `look` says
+/// with `prepared`'s scene composited from each eye, or `prepared`'s own pair without a look
+/// (one frame: the renderer's shared pair, [`Prepared::render_stereo`]).
 pub fn stereo_view(
     prepared: &Prepared,
     look: Option<&Look>,
     (camera, rig): (&Camera, &StereoRig),
-    frames: usize,
+    (frames, filter): (usize, Filter),
 ) -> Result<[Frame; 2], LookError> {
     if let Some(look) = look {
         let pass = RayPass::new(prepared.renderer(), prepared.settings(), &look.ray)?;
         let scene = prepared.scene().map(|s| &**s);
-        return stereo_still(&pass, (camera, rig), &look.shading, scene, frames);
+        return stereo_still(&pass, (camera, rig), &look.shading, scene, (frames, filter));
     }
     if frames <= 1 {
         return Ok(prepared.render_stereo(camera, rig)?);
     }
     let [left, right] = rig
         .eyes(camera)?
-        .map(|eye| still_view(prepared, None, &eye, frames));
+        .map(|eye| still_view(prepared, None, &eye, frames, filter));
     Ok([left?, right?])
 }

@@ -6,7 +6,7 @@ use super::geometry_tests::{
 };
 use super::*;
 use crate::camera::StereoRig;
-use crate::render::{Frame, Quality, StereoFrames};
+use crate::render::{Filter, Frame, Quality, StereoFrames};
 
 /// Eyes 2 mm apart, focused on the wall (18 mm ahead).
 const RIG: StereoRig = StereoRig {
@@ -27,7 +27,15 @@ fn each_eye_of_a_look_pair_is_the_mono_look_from_that_eye() {
         let (scene, _, _) = blue_sphere(&volume, WALL_K + 2.0, 4.0);
         let (shading, scene) = (red_and_green(), Some(&scene));
         let mut buffers = StereoFrames::default();
-        let pair = stereo_frame(&pass, (&camera, &RIG), &shading, scene, 0, &mut buffers).unwrap();
+        let pair = stereo_frame(
+            &pass,
+            (&camera, &RIG),
+            &shading,
+            scene,
+            (0, Filter::Trilinear),
+            &mut buffers,
+        )
+        .unwrap();
         let eyes = RIG.eyes(&camera).unwrap();
         for (eye, frame) in eyes.iter().zip(&pair) {
             let gbuffer = pass.trace(eye, Quality::Full);
@@ -43,9 +51,16 @@ fn each_eye_of_a_look_pair_is_the_mono_look_from_that_eye() {
             "{secretion:?}: {right_shared} samples shared, {right_alone} alone"
         );
         // Still frames past the first are the mono still's, eye by eye.
-        let stills = stereo_still(&pass, (&camera, &RIG), &shading, scene, 2).unwrap();
+        let stills = stereo_still(
+            &pass,
+            (&camera, &RIG),
+            &shading,
+            scene,
+            (2, Filter::Trilinear),
+        )
+        .unwrap();
         for (eye, frame) in eyes.iter().zip(&stills) {
-            let mono = still(&pass, eye, &shading, scene, 2).unwrap();
+            let mono = still(&pass, eye, &shading, scene, 2, Filter::Trilinear).unwrap();
             assert_eq!(pixels(frame), pixels(&mono), "{secretion:?}");
         }
     }
@@ -57,8 +72,22 @@ fn each_eye_shows_the_sphere_solid_in_front_and_stippled_behind_by_its_own_depth
     let (pass, camera) = (ray_pass(&volume, SecretionMode::Off), camera(&volume));
     let (scene, centre, radius) = blue_sphere(&volume, WALL_K + 4.0, 5.0);
     let shading = red_and_green();
-    let plain = stereo_still(&pass, (&camera, &RIG), &shading, None, 1).unwrap();
-    let with = stereo_still(&pass, (&camera, &RIG), &shading, Some(&scene), 1).unwrap();
+    let plain = stereo_still(
+        &pass,
+        (&camera, &RIG),
+        &shading,
+        None,
+        (1, Filter::Trilinear),
+    )
+    .unwrap();
+    let with = stereo_still(
+        &pass,
+        (&camera, &RIG),
+        &shading,
+        Some(&scene),
+        (1, Filter::Trilinear),
+    )
+    .unwrap();
     let eyes = RIG.eyes(&camera).unwrap();
     for (eye, (plain, with)) in eyes.iter().zip(plain.iter().zip(&with)) {
         let n = sphere_through_wall(eye, [plain, with], &volume, (centre, radius));
@@ -77,6 +106,12 @@ fn a_rig_without_eyes_is_an_error() {
         ..RIG
     };
     let shading = red_and_green();
-    let pair = stereo_still(&pass, (&camera, &rig), &shading, None, 1);
+    let pair = stereo_still(
+        &pass,
+        (&camera, &rig),
+        &shading,
+        None,
+        (1, Filter::Trilinear),
+    );
     assert!(matches!(pair, Err(LookError::Camera(_))), "{pair:?}");
 }

@@ -4,7 +4,7 @@ use super::*;
 use crate::phantom::profile::{paint, ramp, AIR_HU, TISSUE_HU};
 use crate::phantom::{layered, rasterize, Layered, PhantomOptions, SECRETION_HU};
 use crate::render::quality::reduced_camera;
-use crate::render::{Camera, Quality, RenderSettings, Renderer};
+use crate::render::{Camera, Filter, Quality, RenderSettings, Renderer};
 use crate::Volume;
 use glam::{DVec3, Vec3};
 use std::sync::Arc;
@@ -370,10 +370,16 @@ fn half_quality_and_stills_give_the_camera_s_size() {
     let shading = Look::of_kind(LookKind::Realistic, &PresetLook::CT)
         .unwrap()
         .shading;
-    let converged = still(&pass, &camera, &shading, None, 4).unwrap();
+    let converged = still(&pass, &camera, &shading, None, 4, Filter::Trilinear).unwrap();
     let single = shade(&full, &camera, &shading).unwrap();
     assert_eq!([converged.width, converged.height], [20, 20]);
     assert_ne!(converged.color, single.color);
+    // The B-spline still (values exact at the voxels) finds the same tissue behind the same
+    // secretion, shaded otherwise.
+    let spline = still(&pass, &camera, &shading, None, 2, Filter::BSpline).unwrap();
+    let (d, d_spline) = (converged.depth_mm[centre], spline.depth_mm[centre]);
+    assert!((d - d_spline).abs() < 0.1, "{d} {d_spline}");
+    assert_ne!(spline.color, converged.color);
     // Both stages at half size, the shaded frame upsampled: the camera's size, the same
     // surface at the centre; a G-buffer larger than the camera is refused.
     let small = reduced_camera(&camera, Quality::Half.reduced_size(camera.size()));

@@ -3,6 +3,7 @@
 //! driver.
 
 use super::progressive::{progressive, ProgressiveOptions, Stage};
+use super::Filter;
 use super::*;
 use crate::phantom::{self, PhantomOptions, SphereShell};
 use glam::DVec3;
@@ -330,6 +331,7 @@ fn the_progressive_sequence_ends_in_the_full_image_unless_the_view_changes() {
     let generation = AtomicU64::new(7);
     let options = ProgressiveOptions {
         still_frames: 3,
+        still_filter: Filter::Trilinear,
         ..ProgressiveOptions::default()
     };
     let delivered = Mutex::new(Vec::new());
@@ -356,6 +358,19 @@ fn the_progressive_sequence_ends_in_the_full_image_unless_the_view_changes() {
         Stage::Still(3),
     ];
     assert_eq!(delivered.into_inner().unwrap(), expected);
+    // B-spline stills start again after the (trilinear) full frame.
+    let spline = ProgressiveOptions {
+        still_filter: Filter::BSpline,
+        ..options.clone()
+    };
+    let mut stages = Vec::new();
+    progressive(&prepared, &camera, &generation, 7, &spline, |stage, _| {
+        stages.push(stage);
+    })
+    .unwrap();
+    let stills = [Stage::Still(1), Stage::Still(2), Stage::Still(3)];
+    assert_eq!(stages[..3], expected[..3]);
+    assert_eq!(stages[3..], stills);
     // The view changes while the half preview is shown: nothing more comes.
     let mut stages = Vec::new();
     let result = progressive(&prepared, &camera, &generation, 7, &options, |stage, _| {

@@ -93,10 +93,12 @@ use crate::camera::Ray;
 pub use bricks::{Activity, BitSet, BrickGrid, BRICK_VOX};
 use cell_mask::CellMask;
 pub use frame::{Frame, Layers, Premultiplied, RenderStats, DEPTH_LAYERS};
-pub use options::{Cancelled, Progress, Quality, RenderOptions};
+pub use options::{Cancelled, Filter, Progress, Quality, RenderOptions};
 pub use progressive::{progressive, PreviewPlanner};
 pub use reuse::FrameReuse;
-pub use sample::{Accum, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader};
+pub use sample::{
+    Accum, BSplineCoefficients, BrickedVoxels, Lanes, Lighting, SampleGrid, Sampler, Shader,
+};
 pub use settings::{
     Crossing, Mode, PeelLayer, PeelSettings, RenderSettings, SettingsError, Unpeeled,
 };
@@ -113,7 +115,7 @@ use ray_task::{PixelOut, RayTask};
 use simd::rays4::RaySetup;
 #[cfg(target_arch = "x86_64")]
 pub(crate) use simd::with_avx2;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 use stereo::SearchStarts;
 use tiles::{Control, Pixel, Tiling};
@@ -122,13 +124,15 @@ use traverse::{BrickDda, VoxelRay};
 use crate::scene::Scene;
 use crate::Volume;
 
-/// A volume ready for rendering: the volume and its brick grid (built once), and for sessions
-/// of many frames its voxels brick by brick.
+/// A volume ready for rendering: the volume and its brick grid (built once), for sessions
+/// of many frames its voxels brick by brick, and for B-spline stills its spline's coefficients
+/// (built by the first frame that asks).
 #[derive(Debug, Clone)]
 pub struct Renderer {
     volume: Volume,
     grid: BrickGrid,
     bricked: Option<BrickedVoxels>,
+    spline: OnceLock<BSplineCoefficients>,
     /// Whether the AVX2 paths run where the CPU has them (tests turn them off to check the
     /// paths other CPUs take against them).
     simd: bool,
@@ -142,6 +146,7 @@ impl Renderer {
             volume,
             grid,
             bricked: None,
+            spline: OnceLock::new(),
             simd: true,
         }
     }
@@ -178,6 +183,21 @@ impl Renderer {
         } else {
             sampler.scalar()
         }
+    }
+
+    /// The sampler of the voxels reconstructing as `filter` says (the B-spline's coefficients
+    /// built on first use: 4 bytes a voxel, a parallel pass).
+    pub(crate) fn sampler_for(&self, filter: Filter) -> Sampler<'_> {
+        match filter {
+            Filter::Trilinear => self.sampler(),
+            Filter::BSpline => Sampler::with_spline(&self.volume, self.spline_coefficients()),
+        }
+    }
+
+    /// The coefficients of the volume's B-spline, built on the first call.
+    pub fn spline_coefficients(&self) -> &BSplineCoefficients {
+        self.spline
+            .get_or_init(|| BSplineCoefficients::new(&self.volume))
     }
 
     /// The volume.
@@ -318,6 +338,9 @@ pub struct Prepared {
     voxel_from_world: DAffine3,
     /// Geometry drawn with the volume ([`Self::set_scene`]).
     scene: Option<Arc<Scene>>,
+    /// The brick classification (and the peel's transfer function's active bricks) for the
+    /// B-spline's wider footprint ([`Activity::dilated`]), made by the first frame that asks.
+    spline_activity: OnceLock<(Activity, Option<BitSet>)>,
 }
 
 /// A pixel's ray in the world and in voxel space, and its part inside the volume (mm).
@@ -346,6 +369,7 @@ impl Prepared {
             step_mm: d.step_mm,
             voxel_from_world,
             scene: None,
+            spline_activity: OnceLock::new(),
         })
     }
 
@@ -361,6 +385,7 @@ impl Prepared {
         self.params = d.params;
         self.shader = d.shader;
         self.step_mm = d.step_mm;
+        self.spline_activity = OnceLock::new();
         Ok(())
     }
 
@@ -389,21 +414,36 @@ impl Prepared {
         self.step_mm
     }
 
-    /// The integrators for frames of `camera`.
-    fn integrator(&self, camera: &Camera) -> Integrator<'_> {
-        let (table, active) = match &self.after {
-            Some((table, active)) => (table, active),
-            None => (&self.table, &self.activity.tf),
+    /// The integrators for frames of `camera` reconstructing as `filter` says (B-splines: the
+    /// wider footprint's brick classification, and surfaces found by their samples).
+    fn integrator(&self, camera: &Camera, filter: Filter) -> Integrator<'_> {
+        let (activity, after_active) = match filter {
+            Filter::Trilinear => (&self.activity, self.after.as_ref().map(|(_, a)| a)),
+            Filter::BSpline => {
+                let (activity, after) = self.spline_activity.get_or_init(|| {
+                    let grid = &self.renderer.grid;
+                    let after = self.after.as_ref().map(|(_, a)| a.dilated(grid.bricks()));
+                    (self.activity.dilated(grid), after)
+                });
+                (activity, after.as_ref())
+            }
         };
+        let table = self.after.as_ref().map_or(&self.table, |(table, _)| table);
+        let mut params = self.params;
+        // The exact search solves the trilinear cell's cubic.
+        params.exact_hits &= filter == Filter::Trilinear;
         let mut integrator = Integrator {
-            sampler: self.renderer.sampler(),
+            sampler: self.renderer.sampler_for(filter),
             grid: &self.renderer.grid,
-            activity: &self.activity,
+            activity,
             cells: &self.cells,
             table: &self.table,
-            after: Classified { table, active },
+            after: Classified {
+                table,
+                active: after_active.unwrap_or(&activity.tf),
+            },
             shader: self.shader,
-            params: self.params,
+            params,
             eye_side: None,
         };
         // Every ray starting at the eye (t = 0) shares its crossing side: decided once.
@@ -463,7 +503,7 @@ impl Prepared {
         if let Some(max) = options.max_distance_mm {
             assert_eq!(max.len(), w * h, "one maximum distance per pixel");
         }
-        let integrator = self.integrator(camera);
+        let integrator = self.integrator(camera, options.filter);
         let scene = self.scene.as_ref().filter(|s| !s.is_empty());
         let placed = scene.map(|s| s.placed(camera));
         let tile = |rect| self.tile(&integrator, camera, options, placed.as_ref(), rect);

@@ -76,6 +76,37 @@ impl Quality {
     }
 }
 
+/// How a frame reconstructs the volume between its voxels.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum Filter {
+    /// Trilinear values and central-difference gradients: every interactive frame.
+    #[default]
+    Trilinear,
+    /// Tricubic B-splines (Krüger et al. §4.3): surfaces exact at the voxels, smooth normals,
+    /// many times slower per frame — for stills (see [`super::BSplineCoefficients`]).
+    BSpline,
+}
+
+impl Filter {
+    /// Both filters.
+    pub const ALL: [Filter; 2] = [Self::Trilinear, Self::BSpline];
+
+    /// The name the front ends use: `trilinear`, `bspline`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Trilinear => "trilinear",
+            Self::BSpline => "bspline",
+        }
+    }
+
+    /// The filter called `name` (ASCII case ignored).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|f| f.name().eq_ignore_ascii_case(name.trim()))
+    }
+}
+
 /// Options of one render call (see [`super::Prepared::render_with`]), built from
 /// [`RenderOptions::new`] (a plain full-quality frame, no optional layer, not interruptible).
 #[derive(Clone, Copy, Default)]
@@ -93,6 +124,8 @@ pub struct RenderOptions<'a> {
     /// Iso mode: find the surfaces (depths and the optional layers) but do not shade them; the
     /// colour stays transparent. For passes that use only the geometry, like a look's ray pass.
     pub(crate) unlit: bool,
+    /// How samples reconstruct the volume.
+    pub(crate) filter: Filter,
 }
 
 impl fmt::Debug for RenderOptions<'_> {
@@ -106,6 +139,7 @@ impl fmt::Debug for RenderOptions<'_> {
             .field("grid_shift", &self.grid_shift)
             .field("starts", &self.starts.is_some())
             .field("unlit", &self.unlit)
+            .field("filter", &self.filter)
             .finish()
     }
 }
@@ -168,6 +202,12 @@ impl<'a> RenderOptions<'a> {
             progress: Some(progress),
             ..self
         }
+    }
+
+    /// Reconstruct the volume with `filter` (trilinear by default; B-splines build their
+    /// coefficients once per renderer, on the first frame that asks).
+    pub fn filter(self, filter: Filter) -> Self {
+        Self { filter, ..self }
     }
 
     /// The optional layers asked for.

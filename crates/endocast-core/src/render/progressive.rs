@@ -34,7 +34,7 @@
 //! ```
 
 use super::frame::{Frame, Layers};
-use super::options::{Cancelled, Progress, Quality, RenderOptions};
+use super::options::{Cancelled, Filter, Progress, Quality, RenderOptions};
 use super::still::Still;
 use super::{Camera, Prepared};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -47,8 +47,8 @@ pub enum Stage {
     Preview(Quality),
     /// The full-quality frame, as [`Prepared::render`] makes it.
     Full,
-    /// The average of this many jittered full-quality frames (2 or more; the first is the full
-    /// frame).
+    /// The average of this many jittered full-quality frames: with the trilinear filter 2 or
+    /// more, the first being the full frame; with B-splines 1 or more, all the spline's.
     Still(usize),
 }
 
@@ -60,8 +60,11 @@ pub struct ProgressiveOptions {
     /// Frames averaged into the last still, the full frame included (default 8; 1 or 0: no
     /// still after the full frame).
     pub still_frames: usize,
-    /// Optional layers of every frame (default none; a still's are its full frame's).
+    /// Optional layers of every frame (default none; a still's are its first frame's).
     pub layers: Layers,
+    /// How the still's frames reconstruct the volume (default trilinear; the
+    /// previews and the full frame are always trilinear).
+    pub still_filter: Filter,
 }
 
 impl Default for ProgressiveOptions {
@@ -70,12 +73,14 @@ impl Default for ProgressiveOptions {
             previews: vec![Quality::Quarter, Quality::Half],
             still_frames: 8,
             layers: Layers::NONE,
+            still_filter: Filter::Trilinear,
         }
     }
 }
 
 /// Renders `camera`'s view with `prepared` level by level — the previews, the full frame, then
-/// stills of 2, 3, … `still_frames` frames — handing each finished one to `deliver`, as long as
+/// stills of 2, 3, … `still_frames` frames (B-spline stills start again: 1, 2, …
+/// `still_frames` frames of the spline) — handing each finished one to `deliver`, as long as
 /// `generation` still holds `seen` (the value read with the view). Returns [`Cancelled`] as soon
 /// as it changes: before a level starts, or through the cancel flag of the level in flight.
 pub fn progressive(
@@ -108,10 +113,13 @@ pub fn progressive(
     prepared.render_with(camera, &base, &mut frame)?;
     deliver(Stage::Full, &frame);
     let mut still = Still::new();
-    still.add(&frame);
-    while still.frames() < options.still_frames {
+    if options.still_filter == Filter::Trilinear {
+        still.add(&frame);
+    }
+    let still_options = base.filter(options.still_filter);
+    while options.still_frames > 1 && still.frames() < options.still_frames {
         check()?;
-        still.render_next(prepared, camera, &base)?;
+        still.render_next(prepared, camera, &still_options)?;
         deliver(Stage::Still(still.frames()), still.frame());
     }
     Ok(())

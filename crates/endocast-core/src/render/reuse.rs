@@ -131,7 +131,7 @@ impl Prepared {
         let start = std::time::Instant::now();
         let ball = self.clear_ball(camera);
         let rising = self
-            .integrator(camera)
+            .integrator(camera, options.filter)
             .rising_at(ball.0, self.params.lower.iso);
         self.fill_starts(camera, ball, rising, reuse);
         let result = self.render_with(camera, &options.search_starts(&reuse.starts), frame);

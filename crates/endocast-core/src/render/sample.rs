@@ -8,8 +8,13 @@ use crate::Volume;
 use glam::{DMat3, Mat3, Vec3, Vec3A};
 
 pub(super) mod bricked;
+pub(super) mod bspline;
+#[cfg(test)]
+mod bspline_tests;
 
 pub use bricked::BrickedVoxels;
+pub use bspline::BSplineCoefficients;
+use bspline::Spline;
 
 /// Trilinear reconstruction of a volume's stored values, in `f32`, with positions clamped to the
 /// voxel centres' hull (so a gradient stencil at the border reads the border value).
@@ -22,6 +27,9 @@ pub use bricked::BrickedVoxels;
 /// CPU has it (detected at run time): one gather per pair of x-neighbours fetches eight cells'
 /// corners at once, and the arithmetic is the scalar path's operation for operation (no fused
 /// multiply-add), so both give bit-identical values.
+///
+/// A still may reconstruct by tricubic B-splines instead ([`Self::with_spline`]): then every
+/// value and gradient is the spline's, one sample at a time.
 #[derive(Debug, Clone, Copy)]
 pub struct Sampler<'a> {
     /// The voxels and their layout, as the batches read them.
@@ -29,6 +37,8 @@ pub struct Sampler<'a> {
     /// Where batches run on AVX2 (the CPU has it, x has two voxels or more for the paired
     /// gathers, and every index fits the gathers' `i32`).
     avx2: Option<Avx2>,
+    /// The B-spline reconstruction, where a still asked for it (no AVX2 batches then).
+    spline: Option<Spline<'a>>,
 }
 
 impl<'a> Sampler<'a> {
@@ -39,6 +49,7 @@ impl<'a> Sampler<'a> {
         Self {
             grid: VoxelGrid::new(volume),
             avx2: Avx2::detect().filter(|_| nx >= 2 && fits),
+            spline: None,
         }
     }
 
@@ -58,6 +69,20 @@ impl<'a> Sampler<'a> {
                 ..plain.grid
             },
             avx2: Some(avx2),
+            spline: None,
+        }
+    }
+
+    /// A sampler over `volume` reconstructing by its tricubic B-splines, whose prefiltered
+    /// `coefficients` are given ([`bspline`]'s module doc says which spline does what).
+    ///
+    /// # Panics
+    ///
+    /// When the coefficients were built for a volume of other dimensions.
+    pub fn with_spline(volume: &'a Volume, coefficients: &'a BSplineCoefficients) -> Self {
+        Self {
+            spline: Some(Spline::new(volume, coefficients)),
+            ..Self::new(volume).scalar()
         }
     }
 
@@ -110,9 +135,12 @@ impl<'a> Sampler<'a> {
         t.map(|t| self.value(line.at(t)))
     }
 
-    /// The trilinearly interpolated stored value at voxel position `p`.
+    /// The reconstructed stored value at voxel position `p`: trilinear, or the spline's.
     #[inline(always)]
     pub fn value(&self, p: Vec3) -> f32 {
+        if let Some(spline) = &self.spline {
+            return spline.value(p);
+        }
         let grid = &self.grid;
         let p = p.clamp(Vec3::ZERO, grid.extent);
         // p ≥ 0, so truncation is the floor; `as i32` saturates and maps NaN to 0.
@@ -131,10 +159,13 @@ impl<'a> Sampler<'a> {
         lerp(lerp(c.x, c.y, fy), lerp(c.z, c.w, fy), fz)
     }
 
-    /// Gradient of the stored value by central differences one voxel apart, stored units per
-    /// voxel, in voxel index space (the six samples as one batch).
+    /// Gradient of the stored value by central differences one voxel apart (the six samples as
+    /// one batch), or the spline's own, stored units per voxel, in voxel index space.
     #[inline]
     pub fn gradient(&self, p: Vec3) -> Vec3 {
+        if let Some(spline) = &self.spline {
+            return spline.gradient(p);
+        }
         // Lanes: +x, −x, +y, −y, +z, −z (and two unused); `p ± 1` along one axis, `p` along the
         // others.
         let plus_minus = |a: f32, lane: usize| {
@@ -164,6 +195,12 @@ impl<'a> Sampler<'a> {
     /// lanes.
     #[inline]
     pub fn gradients8_lanes(&self, lanes: &[Lanes; 3]) -> [Lanes; 3] {
+        if let Some(spline) = &self.spline {
+            let g: [Vec3; 8] = std::array::from_fn(|k| {
+                spline.gradient(Vec3::new(lanes[0][k], lanes[1][k], lanes[2][k]))
+            });
+            return std::array::from_fn(|axis| g.map(|g| g[axis]));
+        }
         let lanes = *lanes;
         let at = |axis: usize, offset: f32| {
             let mut moved = lanes;

@@ -34,7 +34,7 @@ pub(super) use starts::forward_depths as forward_depths_f32;
 
 #[cfg(target_arch = "x86_64")]
 use super::simd::rays4::LateStarts;
-use super::{Frame, Mode, Prepared, RenderOptions, BRICK_VOX};
+use super::{Filter, Frame, Mode, Prepared, RenderOptions, BRICK_VOX};
 
 use crate::camera::{Camera, CameraError, Projection, StereoRig};
 use glam::{DVec3, Vec3};
@@ -236,7 +236,7 @@ impl Prepared {
     /// with an ideal lens and no near plane, and its eye lies inside the volume on the side of
     /// the isovalue its searches start from.
     pub(super) fn eye_starts_late(&self, camera: &Camera) -> bool {
-        let integrator = self.integrator(camera);
+        let integrator = self.integrator(camera, Filter::Trilinear);
         let surface_first = matches!(self.settings.mode, Mode::Iso | Mode::Hybrid);
         let pinhole = camera.projection() == Projection::Pinhole && camera.lens().is_ideal();
         let sampled = surface_first && integrator.sampled_hits();

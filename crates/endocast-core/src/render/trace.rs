@@ -2,7 +2,7 @@
 
 use super::integrate::Probe;
 use super::traverse::VoxelRay;
-use super::{vignette, Prepared};
+use super::{vignette, Filter, Prepared};
 use crate::camera::Camera;
 use crate::render::RenderStats;
 
@@ -51,7 +51,7 @@ impl Probe for Vec<TraceSample> {
 impl Prepared {
     /// Traces pixel `(x, y)` of `camera` and returns every sample (the `--debug-pixel` aid).
     pub fn trace_pixel(&self, camera: &Camera, x: usize, y: usize) -> PixelTrace {
-        let integrator = self.integrator(camera);
+        let integrator = self.integrator(camera, Filter::Trilinear);
         let mut samples = Vec::new();
         let mut stats = RenderStats::default();
         let mut out = self.pixel(&integrator, camera, x, y, &mut stats, &mut samples);

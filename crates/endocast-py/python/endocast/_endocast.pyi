@@ -122,6 +122,7 @@ def render(
     attenuation: Optional[float] = None,
     lighting: Optional[str] = None,
     still: int = 1,
+    still_filter: Optional[Literal["trilinear", "bspline"]] = None,
     lumen_threshold: Optional[float] = None,
     bright_lumen: bool = False,
     threads: Optional[int] = None,
@@ -137,7 +138,9 @@ def render(
     ``mode="peel"`` with the ``peel*`` options peels (Borland et al.); ``look`` "clinical" or
     "realistic" draws the endoscope's look (Krüger et al.) with ``secretion``, ``wetness``,
     ``texture``, ``attenuation``, ``lighting`` ("phong", "ibl" or "ibl:FILE.png"), through a
-    rigid endoscope's lens unless ``distortion``/``vignetting`` say otherwise; ``still`` averages that many jittered frames. ``meshes``
+    rigid endoscope's lens unless ``distortion``/``vignetting`` say otherwise; ``still``
+    averages that many jittered frames, reconstructed by ``still_filter`` ("trilinear", the
+    default, or "bspline": tricubic B-splines, about ten times slower a frame). ``meshes``
     (STL, OBJ, PLY) and ``overlays`` (DICOM SEG; RTDOSE as ``FILE`` or ``FILE:LEVEL,...``)
     are drawn with the scan as ``--mesh`` and ``--overlay`` draw them."""
 

@@ -19,7 +19,7 @@ use endocast_core::look::{Lighting, Look, LookKind};
 use endocast_core::navigate::{nearest_lumen_point, snap_radius_mm, LumenSide};
 use endocast_core::pose::Pose;
 use endocast_core::presets::{self, Preset};
-use endocast_core::render::{Mode, PeelSettings, RenderSettings, TransferFunction};
+use endocast_core::render::{Filter, Mode, PeelSettings, RenderSettings, TransferFunction};
 use endocast_core::study::{Study, StudyRequest};
 use endocast_core::views::slices::Window;
 use endocast_core::views::{lens_marks, Image};
@@ -71,6 +71,9 @@ pub struct Controls {
     pub look: LookKind,
     /// How the clinical or realistic look lights the tissue: Phong or a lit sphere.
     pub lighting: Lighting,
+    /// How the still of a standing view reconstructs the volume (trilinear, or B-splines:
+    /// sharper, each frame about ten times slower).
+    pub still_filter: Filter,
 }
 
 impl Controls {
@@ -96,6 +99,7 @@ impl Controls {
             geometry: Toggles::default(),
             look: study.look().kind,
             lighting: Lighting::Phong,
+            still_filter: Filter::Trilinear,
             base,
         }
     }
@@ -269,6 +273,7 @@ impl Session {
             moving,
             scene,
             look,
+            still_filter: self.controls.still_filter,
         })
     }
 

@@ -1,8 +1,9 @@
 //! The endoscope's clinical or realistic look in the workstation: the look's ray pass (kept
 //! while its settings stay) traced at half resolution while the camera moves, then the full
-//! frame, both with the view's geometry composited, then jittered frames averaged into a still,
-//! each level delivered as it finishes (with stereo on, both eyes as a red/cyan anaglyph); a
-//! new view stops it between levels and between still frames.
+//! frame, both with the view's geometry composited, then jittered frames averaged into a still
+//! (of the stills' filter: B-spline stills start again after the trilinear full frame), each
+//! level delivered as it finishes (with stereo on, both eyes as a red/cyan anaglyph); a new
+//! view stops it between levels and between still frames.
 
 use super::{Deliver, View, STILL_FRAMES};
 use endocast_core::look::{
@@ -11,7 +12,7 @@ use endocast_core::look::{
 use endocast_core::render::progressive::Stage;
 use endocast_core::render::quality::reduced_camera;
 use endocast_core::render::{
-    Camera, Frame, Quality, RenderSettings, Renderer, StereoFrames, Still,
+    Camera, Filter, Frame, Quality, RenderSettings, Renderer, StereoFrames, Still,
 };
 use endocast_core::views::stereo::{combine, StereoOutput};
 use endocast_core::views::Image;
@@ -44,14 +45,15 @@ impl LookPass {
     }
 }
 
-/// Renders `view` in `look` level by level, handing each to `deliver` (with stereo on, both
-/// eyes combined into a red/cyan anaglyph); stops (without error) as soon as `superseded`
-/// says a newer view waits, between levels and still frames.
+/// Renders `view` in `look` level by level, its still's frames after the full frame
+/// reconstructed by `still_filter`, handing each to `deliver` (with stereo on, both eyes
+/// combined into a red/cyan anaglyph); stops (without error) as soon as `superseded` says a
+/// newer view waits, between levels and still frames.
 pub(crate) fn render_look(
     passes: &mut LookPass,
     renderer: &Arc<Renderer>,
     view: &View,
-    look: &Look,
+    (look, still_filter): (&Look, Filter),
     superseded: &dyn Fn() -> bool,
     deliver: &Deliver<'_>,
 ) -> Result<(), String> {
@@ -89,19 +91,30 @@ pub(crate) fn render_look(
     }
     let mut stills = vec![Still::new(); eyes.len()];
     let mut pair = StereoFrames::default();
-    for k in 0..STILL_FRAMES {
+    // A B-spline still averages `STILL_FRAMES` frames of its own after the full frame.
+    let frames = STILL_FRAMES + usize::from(still_filter != Filter::Trilinear);
+    for k in 0..frames {
         if superseded() {
             return Ok(());
         }
         let start = Instant::now();
-        let frames = still_frames(pass, view, look, k, &mut pair)?;
+        // The full frame is trilinear; a B-spline still starts again after it.
+        let filter = if k == 0 {
+            Filter::Trilinear
+        } else {
+            still_filter
+        };
+        if k == 1 && filter != Filter::Trilinear {
+            stills.iter_mut().for_each(|s| *s = Still::new());
+        }
+        let frames = still_frames(pass, view, look, (k, filter), &mut pair)?;
         for (still, frame) in stills.iter_mut().zip(&frames) {
             still.add(frame);
         }
         let stage = if k == 0 {
             Stage::Full
         } else {
-            Stage::Still(k + 1)
+            Stage::Still(stills[0].frames())
         };
         show(
             stage,
@@ -121,20 +134,22 @@ fn preview(pass: &RayPass, eye: &Camera, look: &Look, view: &View) -> Result<Fra
     shade_reduced_with_scene(&traced, eye, &look.shading, scene).map_err(|e| e.to_string())
 }
 
-/// Still frame `k` of `view` in `look`: one eye, or both of a stereo view (their searches
-/// shared through `pair`'s buffers).
+/// Still frame `k` of `view` in `look`, reconstructed by `filter`: one eye, or both of a
+/// stereo view (their searches shared through `pair`'s buffers).
 fn still_frames(
     pass: &RayPass,
     view: &View,
     look: &Look,
-    k: usize,
+    (k, filter): (usize, Filter),
     pair: &mut StereoFrames,
 ) -> Result<Vec<Frame>, String> {
     let (camera, shading) = (&view.camera, &look.shading);
     let scene = view.scene.0.as_deref();
     let frames = match &view.stereo {
-        Some(rig) => stereo_frame(pass, (camera, rig), shading, scene, k, pair).map(Vec::from),
-        None => still_frame(pass, camera, shading, scene, k).map(|f| vec![f]),
+        Some(rig) => {
+            stereo_frame(pass, (camera, rig), shading, scene, (k, filter), pair).map(Vec::from)
+        }
+        None => still_frame(pass, camera, shading, scene, k, filter).map(|f| vec![f]),
     };
     frames.map_err(|e| e.to_string())
 }

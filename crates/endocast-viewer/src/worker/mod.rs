@@ -16,11 +16,12 @@ use endocast_core::camera::StereoRig;
 use endocast_core::look::Look;
 use endocast_core::render::progressive::{progressive, PreviewPlanner, ProgressiveOptions, Stage};
 use endocast_core::render::{
-    Camera, Cancelled, Frame, Layers, Prepared, Progress, Quality, RenderOptions, RenderSettings,
-    Renderer,
+    Camera, Cancelled, Filter, Frame, Layers, Prepared, Progress, Quality, RenderOptions,
+    RenderSettings, Renderer,
 };
 use endocast_core::views::stereo::{combine, StereoOutput};
 use endocast_core::views::{lens_marks, Image};
+use endocast_io::Limits;
 use look_frames::{render_look, LookPass};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
@@ -30,7 +31,8 @@ use std::time::{Duration, Instant};
 /// Hands a finished stage of a frame to the UI: its quality, image, depths and render time.
 pub(crate) type Deliver<'a> = dyn Fn(Stage, Image, &[f32], Duration) + 'a;
 
-/// Frames averaged into the still when the view stands (the full frame included).
+/// Frames averaged into the still when the view stands (the full frame included where the
+/// still is trilinear; B-spline stills average this many frames of the spline after it).
 pub const STILL_FRAMES: usize = 8;
 
 /// The time the first preview after an input may take: a mode whose quarter-resolution frame
@@ -53,6 +55,9 @@ pub struct View {
     /// The endoscope's clinical or realistic look instead of the renderer's own image (with
     /// stereo on, in both eyes).
     pub look: Option<Look>,
+    /// How the still's frames after the full frame reconstruct the volume (B-splines fall
+    /// back to trilinear where their coefficients would not fit the memory).
+    pub still_filter: Filter,
 }
 
 /// A finished frame of some view.
@@ -223,12 +228,16 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
     let mut scene = SceneRef::default();
     let mut planner = PreviewPlanner::default();
     let mut look_pass = LookPass::default();
+    let mut warned = false;
     while let Some(request) = next_request(shared) {
+        let still_filter = still_filter(renderer, request.view.still_filter, &mut warned);
         if let Some(look) = &request.view.look {
             let superseded = || shared.generation.load(Ordering::Acquire) != request.generation;
             let deliver = deliverer(shared, &request);
             let view = &request.view;
-            if let Err(e) = render_look(&mut look_pass, renderer, view, look, &superseded, &deliver)
+            let looks = (look, still_filter);
+            if let Err(e) =
+                render_look(&mut look_pass, renderer, view, looks, &superseded, &deliver)
             {
                 lock(&shared.latest).error = Some(e);
                 (shared.on_frame)();
@@ -254,9 +263,21 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
         }
         if let Some(p) = &prepared {
             // A superseded frame simply ends; the next request is already waiting.
-            let _ = render_request(shared, p, &request, &mut planner);
+            let _ = render_request(shared, p, &request, &mut planner, still_filter);
         }
     }
+}
+
+/// The filter of the stills of a standing view: `requested`, or trilinear (and a warning, the
+/// first time, `warned` after it) where the B-spline's coefficients would not fit the memory.
+fn still_filter(renderer: &Renderer, requested: Filter, warned: &mut bool) -> Filter {
+    let voxels = renderer.volume().voxels().len();
+    let (filter, warning) = Limits::default().still_filter(requested, voxels);
+    if let Some(warning) = warning.filter(|_| !*warned) {
+        eprintln!("warning: {warning}");
+        *warned = true;
+    }
+    filter
 }
 
 /// Blocks until a request is waiting (and takes it) or the worker is told to stop.
@@ -307,6 +328,7 @@ fn render_request(
     prepared: &Prepared,
     request: &Request,
     planner: &mut PreviewPlanner,
+    still_filter: Filter,
 ) -> Result<(), Cancelled> {
     let view = &request.view;
     let deliver = deliverer(shared, request);
@@ -321,6 +343,7 @@ fn render_request(
                 },
                 still_frames: if view.moving { 1 } else { STILL_FRAMES },
                 layers: Layers::NONE,
+                still_filter,
             };
             progressive(
                 prepared,
