@@ -114,6 +114,20 @@ fn looks_secretion_wetness_texture_and_attenuation_change_the_image() {
     // A converged still differs from the single frame.
     let still = render(&volume, &png, &["--look", "realistic", "--still", "4"]);
     assert_ne!(still, realistic);
+    // B-spline stills are asked for by name; trilinear is the default.
+    let args = ["--look", "realistic", "--still", "2"];
+    let trilinear = render(
+        &volume,
+        &png,
+        &[&args[..], &["--still-filter", "trilinear"]].concat(),
+    );
+    assert_eq!(trilinear, render(&volume, &png, &args));
+    let spline = render(
+        &volume,
+        &png,
+        &[&args[..], &["--still-filter", "bspline"]].concat(),
+    );
+    assert_ne!(spline, trilinear);
 }
 
 /// A closed octahedron of half-diagonal 1 mm around `(0, 0, z)` (world mm), as OBJ text.
@@ -287,7 +301,7 @@ fn bad_look_values_are_refused_with_a_clear_message() {
     let png = dir.path().join("bad.png");
     let png = png.to_str().unwrap();
     let base = ["render", volume, "-o", png, "--size", "16x16"];
-    let cases: [(&[&str], &str); 10] = [
+    let cases: [(&[&str], &str); 11] = [
         (&["--look", "photo"], "--look \"photo\" is unknown"),
         (
             &["--look", "realistic", "--secretion", "some"],
@@ -316,6 +330,10 @@ fn bad_look_values_are_refused_with_a_clear_message() {
             "--secretion only applies to the clinical or realistic look",
         ),
         (&["--look", "realistic", "--still", "0"], "--still"),
+        (
+            &["--still", "2", "--still-filter", "cubic"],
+            "unknown filter",
+        ),
     ];
     for (extra, needle) in cases {
         let mut args = base.to_vec();
