@@ -109,6 +109,9 @@ impl ReviewTools {
     pub fn next(&mut self, session: &mut Session) -> String {
         let Some(n) = self.visited.iter().position(|v| !v) else {
             return match &self.found {
+                Some(found) if found.views.is_empty() => {
+                    format!("no unseen patch of at least {DEFAULT_MIN_AREA_MM2} mm²")
+                }
                 Some(_) => "every listed patch has been visited".into(),
                 None => "no review yet: press \"Review unseen\"".into(),
             };
