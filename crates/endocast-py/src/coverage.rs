@@ -8,7 +8,7 @@ use crate::look::{optics, LookOptions};
 use crate::volume::Volume;
 use endocast_core::flight::{
     review, FlightError, FlightOptions, Layout, PatchView, Review, ReviewRequest, Route,
-    DEFAULT_MIN_AREA_MM2, REVIEW_AREA_MM2,
+    DEFAULT_MIN_AREA_MM2, REVIEW_AREA_MM2, REVIEW_FRAME_PX, REVIEW_STEP_MM,
 };
 use endocast_core::path::SmoothOptions;
 use endocast_core::study::LOOK_AHEAD_MM;
@@ -45,8 +45,11 @@ pub fn coverage<'py>(
     let volume = volume.get();
     let look_options = LookOptions::take(&kw)?;
     let fov = kw.take::<f64>("fov")?;
-    let size = kw.take::<[usize; 2]>("size")?.unwrap_or([256, 256]);
-    let step_mm = positive("frame_step", kw.take::<f64>("frame_step")?.unwrap_or(1.0))?;
+    let size = kw.take::<[usize; 2]>("size")?.unwrap_or(REVIEW_FRAME_PX);
+    let step_mm = positive(
+        "frame_step",
+        kw.take::<f64>("frame_step")?.unwrap_or(REVIEW_STEP_MM),
+    )?;
     let look_ahead_mm = kw.take::<f64>("look_ahead")?.unwrap_or(LOOK_AHEAD_MM);
     let min_area_mm2 = kw.take::<f64>("min_area")?.unwrap_or(DEFAULT_MIN_AREA_MM2);
     if !(min_area_mm2.is_finite() && min_area_mm2 >= 0.0) {

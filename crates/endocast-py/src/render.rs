@@ -36,8 +36,9 @@ struct View {
 }
 
 /// Renders `volume` as `endocast render` does and returns `(rgba, depth)`: RGBA uint8
-/// (height, width, 4; the colour over the background, alpha 255) and the depth of the first
-/// isosurface hit, float32 mm from the eye (height, width; NaN where none). A stereo pair
+/// (height, width, 4; the colour over the background, alpha 255 but 0 in the unfolded cube's
+/// empty cells) and the depth of the first isosurface hit, float32 mm from the eye (height,
+/// width; NaN where none). A stereo pair
 /// (`stereo="pair"`) gives (2, height, width, 4) and (2, height, width); a combined stereo
 /// image gives the left eye's depth.
 ///
@@ -54,7 +55,7 @@ struct View {
 ///   `background` (r, g, b), `threads`;
 /// - camera: `eye`, `look_at`, `up` (LPS mm), `fov` (degrees), `near` (mm), `size`
 ///   (width, height; default 512 × 512), `lens` (pinhole, equidistant, equisolid,
-///   orthographic), `distortion` (k1, k2), `vignetting` (default: the look's lens, with
+///   orthographic, cube, panorama), `distortion` (k1, k2), `vignetting` (default: the look's lens, with
 ///   `look="realistic"` a rigid endoscope's barrel distortion and vignetting; `(0, 0)` and 0
 ///   for an ideal lens);
 /// - stereo: `stereo` (anaglyph, red-cyan, dubois, side-by-side, top-bottom, pair),

@@ -48,8 +48,7 @@ def test_render_equals_the_cli(volume, colon, cli, tmp_path, options, flags):
 
 
 @pytest.mark.parametrize("lens, size", [
-    pytest.param("cube", (96, 72), marks=pytest.mark.skip(
-        reason="open (issue 36): the cube's empty cells come back opaque from Python")),
+    ("cube", (96, 72)),
     ("panorama", (96, 48)),
 ])
 def test_the_cube_and_the_panorama_equal_the_cli(volume, colon, cli, tmp_path, lens, size):

@@ -12,6 +12,7 @@ use crate::loading::{Loading, Request};
 use crate::mark_tool::MarkTool;
 use crate::overview::OverviewView;
 use crate::panel::controls_ui;
+use crate::review::ReviewTools;
 use crate::scene::ScanSource;
 use crate::session::Session;
 use crate::slice_viewer::{slice_viewer_ui, SliceViewer};
@@ -235,6 +236,7 @@ impl ViewerApp {
                     shown: None,
                     marks: MarkTool::default(),
                     last_input: None,
+                    review: ReviewTools::default(),
                 });
                 self.loading = None;
             }
@@ -249,6 +251,7 @@ impl ViewerApp {
         let finished = [
             ready.tools.poll(&mut ready.session),
             ready.meshes.poll(&mut ready.session),
+            ready.review.poll(),
         ];
         if let Some(message) = finished.into_iter().flatten().last() {
             self.message = message;

@@ -31,6 +31,7 @@ pub const HELP: &[(&str, &str)] = &[
     ("P / Space", "play / pause the key frames"),
     ("C", "collision on / off"),
     ("Z", "centre in the lumen (across the view)"),
+    ("N", "next unseen patch (after \"Review unseen\")"),
     ("H", "back to the start"),
     ("+ / -", "faster / slower"),
 ];

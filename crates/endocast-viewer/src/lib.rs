@@ -64,6 +64,9 @@ mod overview;
 #[cfg(feature = "window")]
 mod panel;
 pub mod planner;
+pub mod review;
+#[cfg(feature = "window")]
+mod review_ui;
 pub mod scene;
 pub mod session;
 #[cfg(feature = "window")]

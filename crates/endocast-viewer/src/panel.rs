@@ -68,6 +68,14 @@ pub(crate) fn controls_ui(
                 action = Some(Action::Message(m));
             }
         });
+    egui::CollapsingHeader::new("Unseen patches")
+        .default_open(false)
+        .show(ui, |ui| {
+            if let Some(m) = crate::review_ui::review_ui(&mut ready.review, ui, &mut ready.session)
+            {
+                action = Some(Action::Message(m));
+            }
+        });
     egui::CollapsingHeader::new("Export the flight")
         .default_open(false)
         .show(ui, |ui| {

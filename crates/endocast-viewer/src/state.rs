@@ -6,6 +6,7 @@ use crate::geometry_ui::MeshLoader;
 use crate::jobs::Job;
 use crate::mark_tool::MarkTool;
 use crate::overview::OverviewView;
+use crate::review::ReviewTools;
 use crate::session::Session;
 use crate::slice_viewer::SliceViewer;
 use crate::slices::SlicesView;
@@ -32,6 +33,8 @@ pub(crate) struct Ready {
     pub marks: MarkTool,
     /// The last time the camera was moved by input.
     pub last_input: Option<Instant>,
+    /// The review of the wall a flight missed.
+    pub review: ReviewTools,
 }
 
 /// What the control panel asks of the application.

@@ -39,6 +39,7 @@ pub(crate) fn view_ui(ui: &mut egui::Ui, ready: &mut Ready) {
         }
     }
     moved |= keyboard(ui, &mut ready.session);
+    moved |= next_patch_key(ui, ready);
     if moved {
         ready.last_input = Some(Instant::now());
     }
@@ -83,6 +84,16 @@ fn keyboard(ui: &egui::Ui, session: &mut Session) -> bool {
         ui.ctx().request_repaint();
     }
     moved
+}
+
+/// N: the endoscope to the next unseen patch of the review (the status bar says which); true
+/// when pressed.
+fn next_patch_key(ui: &egui::Ui, ready: &mut Ready) -> bool {
+    if ui.ctx().wants_keyboard_input() || !ui.input(|i| i.key_pressed(egui::Key::N)) {
+        return false;
+    }
+    ready.review.next_said_later(&mut ready.session);
+    true
 }
 
 /// Acts on the command keys; true when the camera moved.

@@ -8,6 +8,7 @@ mod common;
 mod flight;
 mod harness;
 mod plan_export;
+mod review;
 mod series;
 mod ui;
 mod ui_case;

@@ -17,7 +17,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use endocast_core::flight::{
     review, FlightOptions, Layout, PatchView, Review, ReviewRequest, Route, DEFAULT_MIN_AREA_MM2,
-    REVIEW_AREA_MM2,
+    REVIEW_AREA_MM2, REVIEW_STEP_MM,
 };
 use endocast_core::path::SmoothOptions;
 use endocast_core::render::Renderer;
@@ -49,7 +49,7 @@ pub struct CoverageArgs {
     #[arg(long = "fov", value_name = "DEG")]
     fov_deg: Option<f64>,
     /// Distance between the flight's frames along the route, mm.
-    #[arg(long, value_name = "MM", default_value_t = 1.0)]
+    #[arg(long, value_name = "MM", default_value_t = REVIEW_STEP_MM)]
     frame_step: f64,
     /// How far ahead on the path the camera looks, mm.
     #[arg(long, value_name = "MM", default_value_t = LOOK_AHEAD_MM)]

@@ -87,6 +87,8 @@ pub struct Flight {
     look: Option<Look>,
     /// The look's ray pass and the settings it was made for.
     look_pass: Option<(RenderSettings, RayPass)>,
+    /// The camera of the last frame rendered (the left eye's for a pair).
+    last_camera: Option<Camera>,
 }
 
 impl Flight {
@@ -104,6 +106,7 @@ impl Flight {
             frames: StereoFrames::default(),
             look: None,
             look_pass: None,
+            last_camera: None,
         }
     }
 
@@ -180,6 +183,13 @@ impl Flight {
     /// coverage tracked so far.
     pub fn set_coverage(&mut self, coverage: Option<Coverage>) -> Option<Coverage> {
         std::mem::replace(&mut self.coverage, coverage)
+    }
+
+    /// The camera of the last frame rendered (the left eye's for a stereo pair) and that
+    /// frame's depth, mm along each ray (NaN where none); `None` before the first frame.
+    pub fn last_view(&self) -> Option<(Camera, &[f32])> {
+        let depth = self.frames.eyes[0].depth_mm.as_slice();
+        self.last_camera.map(|camera| (camera, depth))
     }
 
     /// The coverage, when tracked, ending the flight.
@@ -297,6 +307,7 @@ impl Flight {
         if let Some(coverage) = &mut self.coverage {
             coverage.record(&seen_by, &self.frames.eyes[0])?;
         }
+        self.last_camera = Some(seen_by);
         Ok((camera, eyes, stats))
     }
 

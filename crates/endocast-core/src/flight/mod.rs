@@ -18,7 +18,7 @@ pub use looks::ShotSettings;
 pub use overview::{lumen_overview, Overview};
 pub use review::{
     review, PatchView, Review, ReviewRequest, ReviewSite, DEFAULT_MIN_AREA_MM2, MAX_FOV_DEG,
-    MIN_FOV_DEG, REVIEW_AREA_MM2, SAFE_MM,
+    MIN_FOV_DEG, REVIEW_AREA_MM2, REVIEW_FRAME_PX, REVIEW_STEP_MM, SAFE_MM, VIEW_TINT,
 };
 pub use wall::{
     wall_coverage, wall_coverage_near, BackwardPass, WallSeen, BACK_ONLY_TINT,

@@ -21,7 +21,7 @@ use crate::navigate::{DistanceField, Lumen};
 use crate::pose::Pose;
 use crate::render::{RenderSettings, Renderer};
 use crate::views::slices::Window;
-use crate::views::Image;
+use crate::views::{Image, Rgb};
 use crate::Geometry;
 use glam::DVec3;
 use std::sync::Arc;
@@ -30,6 +30,13 @@ use std::sync::Arc;
 pub const REVIEW_AREA_MM2: f64 = 300.0;
 /// Patches smaller than this are not listed by default, mm² (a few voxels of noise on a CT).
 pub const DEFAULT_MIN_AREA_MM2: f64 = 10.0;
+/// Colour and strength of the tint on the wall the flight never saw in each patch's view: the
+/// patch (and any other unseen wall in sight) stands out while its shape stays readable.
+pub const VIEW_TINT: (Rgb, f32) = ([230, 40, 40], 0.45);
+/// Distance between a review flight's frames along the route by default, mm.
+pub const REVIEW_STEP_MM: f64 = 1.0;
+/// Size of a review flight's frames and its patches' views by default, pixels.
+pub const REVIEW_FRAME_PX: [usize; 2] = [256, 256];
 /// How far a review eye off the route keeps from the wall, mm (less in a narrower lumen).
 pub const SAFE_MM: f64 = 3.0;
 /// Narrowest field of view of a patch's view, degrees.
@@ -237,6 +244,9 @@ pub struct Review {
     pub patches_total: usize,
     /// The flight's coverage with the views' frames added.
     pub after: Coverage,
+    /// The coverage (0–1) once the views `0..=n` are added, for each `n` (same order as
+    /// `views`): what a reader who has visited the first patches has seen.
+    pub after_each: Vec<f64>,
 }
 
 impl Review {
@@ -247,7 +257,8 @@ impl Review {
 }
 
 /// Flies `route` through `lumen` as `request` says, lists the patches it missed and renders a
-/// view of each (handed to `on_view` with its index), adding the views to the coverage.
+/// view of each (handed to `on_view` with its index; the wall the flight never saw tinted in
+/// [`VIEW_TINT`]), adding the views to the coverage.
 /// `after_frame` is called after each frame of the flight (for progress).
 pub fn review<E: From<FlightError>>(
     renderer: &Arc<Renderer>,
@@ -282,14 +293,22 @@ pub fn review<E: From<FlightError>>(
     camera.set_look(request.look.clone());
     let mut after = before.clone();
     let mut seen_by_view = Vec::with_capacity(views.len());
+    let mut after_each = Vec::with_capacity(views.len());
     for (n, view) in views.iter().enumerate() {
         camera.set_coverage(Some(after.cleared()));
-        let (image, _) = camera.frame(n, &view_shot(view), settings)?;
+        let (mut image, _) = camera.frame(n, &view_shot(view), settings)?;
+        if let Some((seen_from, depth)) = camera.last_view() {
+            let (color, amount) = VIEW_TINT;
+            before
+                .tint_unseen(&mut image, &seen_from, depth, color, amount)
+                .map_err(FlightError::from)?;
+        }
         let own = camera
             .set_coverage(None)
             .expect("the view was given a coverage");
         seen_by_view.push(view.patch.seen_in(&own));
         after.merge(&own).map_err(FlightError::from)?;
+        after_each.push(after.seen_fraction());
         on_view(n, view, &image)?;
     }
     Ok(Review {
@@ -299,6 +318,7 @@ pub fn review<E: From<FlightError>>(
         seen_by_view,
         patches_total,
         after,
+        after_each,
     })
 }
 

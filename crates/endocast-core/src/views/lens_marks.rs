@@ -27,13 +27,24 @@ pub fn draw(image: &mut Image, camera: &Camera) {
     }
 }
 
-/// [`draw`] on a `width · height · 4` RGBA buffer (row 0 at the top): every pixel a mark
-/// covers takes its colour and becomes opaque.
+/// [`draw`] on a `width · height · 4` RGBA buffer (row 0 at the top): the pixels where the
+/// lens forms no ray (the cube's empty cells) become transparent, alpha 0 (a PNG written from
+/// RGB alone shows the background there); then every pixel a mark covers takes its colour and
+/// becomes opaque.
 pub fn draw_rgba(rgba: &mut [u8], camera: &Camera) {
     if !camera.projection().is_all_round() {
         return;
     }
     let [w, h] = camera.size();
+    if rgba.len() != 4 * w * h {
+        return;
+    }
+    for (n, pixel) in rgba.chunks_exact_mut(4).enumerate() {
+        let (x, y) = ((n % w) as f64 + 0.5, (n / w) as f64 + 0.5);
+        if camera.ray(x, y).is_none() {
+            pixel[3] = 0;
+        }
+    }
     let rgb: Vec<u8> = rgba
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
@@ -99,4 +110,37 @@ fn panorama_labels(image: &mut Image) {
     image.text_shadowed(MARGIN_PX, y, "BACK", scale, LABEL_COLOR);
     let right = width as i64 - MARGIN_PX - back_width;
     image.text_shadowed(right, y, "BACK", scale, LABEL_COLOR);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn camera(projection: Projection, field: f64, size: [usize; 2]) -> Camera {
+        Camera::look_at(DVec3::ZERO, DVec3::X, DVec3::Z, 90.0, size)
+            .unwrap()
+            .with_projection(projection, field)
+            .unwrap()
+    }
+
+    #[test]
+    fn the_cubes_empty_cells_become_transparent_and_its_faces_stay_opaque() {
+        let camera = camera(Projection::Cube, 90.0, [96, 72]);
+        let mut rgba = vec![7; 96 * 72 * 4];
+        draw_rgba(&mut rgba, &camera);
+        let alpha = |x: usize, y: usize| rgba[4 * (x + 96 * y) + 3];
+        // The cross's corners are empty; the front face (second row, second column) is not.
+        for (x, y) in [(0, 0), (23, 23), (95, 0), (0, 71), (95, 71)] {
+            assert_eq!(alpha(x, y), 0, "{x},{y}");
+        }
+        for (x, y) in [(36, 36), (12, 36), (84, 36), (36, 12), (36, 60)] {
+            assert_ne!(alpha(x, y), 0, "{x},{y}");
+        }
+        // The panorama has a ray at every pixel: nothing becomes transparent.
+        let panorama = camera(Projection::Panorama, 180.0, [48, 24]);
+        let mut rgba = vec![7; 48 * 24 * 4];
+        draw_rgba(&mut rgba, &panorama);
+        assert!(rgba.chunks_exact(4).all(|p| p[3] != 0));
+    }
 }

@@ -62,6 +62,10 @@ fn a_forward_flight_plus_the_review_of_its_patches_sees_the_colon_wall() {
     );
     assert!(before < 0.97, "a forward flight misses wall: {before}");
     assert!(after >= 0.98, "before {before}, after {after}");
+    // The coverage grows with each patch visited, ending at the review's.
+    assert_eq!(review.after_each.len(), review.views.len());
+    assert!(review.after_each.windows(2).all(|w| w[0] <= w[1]));
+    assert_eq!(review.after_each.last(), Some(&after));
     assert_eq!(shown, review.views.len());
     // Every patch is seen by its own view, from an eye with a clear line of sight.
     for (view, seen) in review.views.iter().zip(&review.seen_by_view) {
