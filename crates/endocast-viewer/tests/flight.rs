@@ -5,7 +5,8 @@ use endocast_core::render::progressive::Stage;
 use endocast_viewer::controller::LocalMove;
 use std::time::Duration;
 
-fn forward(mm: f64) -> LocalMove {
+/// A step of `mm` straight ahead.
+pub(crate) fn forward(mm: f64) -> LocalMove {
     LocalMove {
         forward_mm: mm,
         ..LocalMove::default()

@@ -21,6 +21,13 @@ fn finished(tools: &mut ReviewTools) -> String {
 #[test]
 fn next_unseen_patch_visits_each_listed_patch_from_its_pose() {
     let (mut session, _) = tube_session();
+    // The flight to review: two key frames along the tube (the tube is no colon the preset
+    // could find a route in).
+    session.record_key_frame().unwrap();
+    for _ in 0..40 {
+        session.fly(crate::flight::forward(0.5));
+    }
+    session.record_key_frame().unwrap();
     let mut tools = ReviewTools::default();
     assert!(tools.next(&mut session).contains("no review yet"));
     tools.start(&session, Arc::new(|| {}));

@@ -6,6 +6,7 @@
 use super::settings::RayPassSettings;
 use crate::camera::Camera;
 use crate::render::{Frame, Renderer};
+use glam::DVec3;
 use rayon::prelude::*;
 
 /// The overlay's colour: a cool blue that no mucosa, mucus or light at the tip produces.
@@ -30,18 +31,25 @@ pub(super) fn clipped_pixels(
     let voxel_from_world = volume.geometry().voxel_from_world();
     let extent = volume.dims().map(|n| (n - 1) as f64);
     let sampler = renderer.sampler();
-    let [w, h] = camera.size();
-    let inside = |x: usize, y: usize| {
-        let Some(ray) = camera.pixel_ray(x, y) else {
-            return false;
-        };
-        let start = ray.at(camera.near_distance_along(ray.dir));
+    let in_tissue = |start: DVec3| {
         let p = voxel_from_world.transform_point3(start);
         let within = (0..3).all(|a| (0.0..=extent[a]).contains(&p[a]));
         within && {
             let value = sampler.value(p.as_vec3());
             (value >= tissue) == rising
         }
+    };
+    // Without a near plane every ray starts at the shared eye: one sample says for all.
+    let shared_start = camera.shared_origin().filter(|_| camera.near_mm() == 0.0);
+    if shared_start.is_some_and(|eye| !in_tissue(eye)) {
+        return Vec::new();
+    }
+    let [w, h] = camera.size();
+    let inside = |x: usize, y: usize| {
+        let Some(ray) = camera.pixel_ray(x, y) else {
+            return false;
+        };
+        in_tissue(ray.at(camera.near_distance_along(ray.dir)))
     };
     let clipped: Vec<bool> = (0..h)
         .into_par_iter()

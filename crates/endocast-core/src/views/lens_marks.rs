@@ -126,9 +126,9 @@ mod tests {
 
     #[test]
     fn the_cubes_empty_cells_become_transparent_and_its_faces_stay_opaque() {
-        let camera = camera(Projection::Cube, 90.0, [96, 72]);
+        let cube = camera(Projection::Cube, 90.0, [96, 72]);
         let mut rgba = vec![7; 96 * 72 * 4];
-        draw_rgba(&mut rgba, &camera);
+        draw_rgba(&mut rgba, &cube);
         let alpha = |x: usize, y: usize| rgba[4 * (x + 96 * y) + 3];
         // The cross's corners are empty; the front face (second row, second column) is not.
         for (x, y) in [(0, 0), (23, 23), (95, 0), (0, 71), (95, 71)] {
