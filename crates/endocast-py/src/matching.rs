@@ -32,32 +32,35 @@ pub fn match_scans<'py>(
     size: (usize, usize),
     fov: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let procedure = Preset::find(preset).ok_or_else(|| error(format!("unknown preset {preset:?}")))?;
+    let procedure =
+        Preset::find(preset).ok_or_else(|| error(format!("unknown preset {preset:?}")))?;
     let request = StudyRequest::preset(procedure);
     let (first, second) = (first.get(), second.get());
-    let (found, matched) = py.detach(|| {
-        let study_a = Study::resolve(first.volume(), &request);
-        let study_b = Study::resolve(second.volume(), &request);
-        let matched = Correspondence::of_studies(
-            (first.volume(), &study_a),
-            (second.volume(), &study_b),
-        )?;
-        let found = matched.counterpart(DVec3::from(at))?;
-        if let Some(path) = &output {
-            let scans = [
-                (first.renderer(), study_a.settings()),
-                (second.renderer(), study_b.settings()),
-            ];
-            let fov = fov.unwrap_or(procedure.fov_deg);
-            let image = side_by_side(scans, &found, fov, [size.0, size.1])
-                .map_err(|e| MatchFailure(error(format!("cannot render the views: {e}"))))?;
-            let (w, h) = (image.width() as u32, image.height() as u32);
-            endocast_io::image_out::write_png_rgb8(path, w, h, image.rgb())
-                .map_err(|e| MatchFailure(error(format!("cannot write {}: {e}", path.display()))))?;
-        }
-        Ok::<_, MatchFailure>((found, matched))
-    })
-    .map_err(|e| e.0)?;
+    let (found, matched) = py
+        .detach(|| {
+            let study_a = Study::resolve(first.volume(), &request);
+            let study_b = Study::resolve(second.volume(), &request);
+            let matched = Correspondence::of_studies(
+                (first.volume(), &study_a),
+                (second.volume(), &study_b),
+            )?;
+            let found = matched.counterpart(DVec3::from(at))?;
+            if let Some(path) = &output {
+                let scans = [
+                    (first.renderer(), study_a.settings()),
+                    (second.renderer(), study_b.settings()),
+                ];
+                let fov = fov.unwrap_or(procedure.fov_deg);
+                let image = side_by_side(scans, &found, fov, [size.0, size.1])
+                    .map_err(|e| MatchFailure(error(format!("cannot render the views: {e}"))))?;
+                let (w, h) = (image.width() as u32, image.height() as u32);
+                endocast_io::image_out::write_png_rgb8(path, w, h, image.rgb()).map_err(|e| {
+                    MatchFailure(error(format!("cannot write {}: {e}", path.display())))
+                })?;
+            }
+            Ok::<_, MatchFailure>((found, matched))
+        })
+        .map_err(|e| e.0)?;
     let v = |p: DVec3| [p.x, p.y, p.z];
     let (length_first, length_second) = matched.lengths_mm();
     let first_view = PyDict::new(py);

@@ -67,12 +67,16 @@ pub fn run(args: &MatchArgs) -> Result<()> {
     let found = matched.counterpart(DVec3::from(args.at))?;
     if let Some(output) = &args.output {
         let fov = args.fov.unwrap_or(preset.fov_deg);
-        let renderers = [Arc::new(Renderer::new(volume_a)), Arc::new(Renderer::new(volume_b))];
+        let renderers = [
+            Arc::new(Renderer::new(volume_a)),
+            Arc::new(Renderer::new(volume_b)),
+        ];
         let scans = [
             (&renderers[0], study_a.settings()),
             (&renderers[1], study_b.settings()),
         ];
-        let image = side_by_side(scans, &found, fov, args.size).context("cannot render the views")?;
+        let image =
+            side_by_side(scans, &found, fov, args.size).context("cannot render the views")?;
         endocast_io::image_out::write_png_rgb8(
             output,
             image.width() as u32,

@@ -52,7 +52,9 @@ pub enum MatchError {
         error: StudyPathError,
     },
     /// A path is too short to match.
-    #[error("the {which} path is {length_mm:.1} mm long: too short to match (at least {min_mm} mm)")]
+    #[error(
+        "the {which} path is {length_mm:.1} mm long: too short to match (at least {min_mm} mm)"
+    )]
     TooShort {
         /// "first" or "second".
         which: &'static str,

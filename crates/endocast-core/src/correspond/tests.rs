@@ -38,14 +38,28 @@ fn a_path_matches_itself_reversed_and_turned_over() {
     let b = path(&turned);
     let over = Correspondence::between(&a, &b).unwrap();
     assert!(over.reversed());
-    assert!((over.turn_deg().abs() - 180.0).abs() < 1.0, "{}", over.turn_deg());
+    assert!(
+        (over.turn_deg().abs() - 180.0).abs() < 1.0,
+        "{}",
+        over.turn_deg()
+    );
     let x = a.point_at(0.4 * length) + DVec3::new(0.0, 0.0, 5.0);
     let found = over.counterpart(x).unwrap();
-    assert!((found.arc_mm - (b.len_mm() - 0.4 * length)).abs() < 2.0, "{found:?}");
+    assert!(
+        (found.arc_mm - (b.len_mm() - 0.4 * length)).abs() < 2.0,
+        "{found:?}"
+    );
     let truth = DVec3::new(-x.x, -x.y, x.z);
     assert!(found.point_mm.distance(truth) < 1.5, "{found:?}");
     assert!(found.view.look_at_mm.distance(truth) < 1.5);
-    assert!(found.view.up.dot(found.view.look_at_mm - found.view.eye_mm).abs() < 1e-9);
+    assert!(
+        found
+            .view
+            .up
+            .dot(found.view.look_at_mm - found.view.eye_mm)
+            .abs()
+            < 1e-9
+    );
 }
 
 #[test]
@@ -54,7 +68,10 @@ fn bad_input_is_refused() {
     let short = path(&[DVec3::ZERO, DVec3::X * 4.0]);
     assert!(matches!(
         Correspondence::between(&a, &short),
-        Err(MatchError::TooShort { which: "second", .. })
+        Err(MatchError::TooShort {
+            which: "second",
+            ..
+        })
     ));
     let matched = Correspondence::between(&a, &a).unwrap();
     let error = matched.counterpart(DVec3::new(f64::NAN, 0.0, 0.0));
@@ -77,11 +94,17 @@ fn supine_points_find_their_prone_counterparts_within_10_mm() {
     let study_prone = Study::resolve(&prone, &request);
     let matched =
         Correspondence::of_studies((&supine, &study_supine), (&prone, &study_prone)).unwrap();
-    assert!((matched.turn_deg().abs() - 180.0).abs() < 10.0, "{}", matched.turn_deg());
+    assert!(
+        (matched.turn_deg().abs() - 180.0).abs() < 10.0,
+        "{}",
+        matched.turn_deg()
+    );
     let centre = |dims: [usize; 3]| DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
     let half = (centre(supine.dims()) - 1.0) / 2.0;
     let line = &pair.supine.centreline;
-    let mut arcs: Vec<f64> = (1..10).map(|n| 0.1 * n as f64 * line.length_vox()).collect();
+    let mut arcs: Vec<f64> = (1..10)
+        .map(|n| 0.1 * n as f64 * line.length_vox())
+        .collect();
     arcs.extend(flexures(line));
     let mut worst = 0.0f64;
     for (n, &s) in arcs.iter().enumerate() {

@@ -73,7 +73,11 @@ impl Track {
     /// The tangent at arc length `s_mm`, interpolated between samples and normalised.
     pub fn tangent_at(&self, s_mm: f64) -> DVec3 {
         let (n, t) = self.locate(s_mm);
-        let next = self.tangents.get(n + 1).copied().unwrap_or(self.tangents[n]);
+        let next = self
+            .tangents
+            .get(n + 1)
+            .copied()
+            .unwrap_or(self.tangents[n]);
         self.tangents[n].lerp(next, t).normalize_or_zero()
     }
 

@@ -34,9 +34,21 @@ pub(super) fn warp(a: &Track, b: &Track, turn: DQuat) -> (Vec<f64>, f64) {
                 0.0
             } else {
                 let at = |ii: usize, jj: usize| total[ii * nb + jj];
-                let diagonal = if i > 0 && j > 0 { at(i - 1, j - 1) } else { f64::INFINITY };
-                let up = if i > 0 { at(i - 1, j) + STALL_COST } else { f64::INFINITY };
-                let left = if j > 0 { at(i, j - 1) + STALL_COST } else { f64::INFINITY };
+                let diagonal = if i > 0 && j > 0 {
+                    at(i - 1, j - 1)
+                } else {
+                    f64::INFINITY
+                };
+                let up = if i > 0 {
+                    at(i - 1, j) + STALL_COST
+                } else {
+                    f64::INFINITY
+                };
+                let left = if j > 0 {
+                    at(i, j - 1) + STALL_COST
+                } else {
+                    f64::INFINITY
+                };
                 diagonal.min(up).min(left)
             };
             total[i * nb + j] = best + cost(i, j);
@@ -73,6 +85,10 @@ fn backtrack(total: &[f64], [na, nb]: [usize; 2], b: &Track) -> (Vec<f64>, f64) 
         };
         (i, j) = (pi, pj);
     }
-    let mapped = sum.iter().zip(&count).map(|(s, &c)| s / c.max(1) as f64).collect();
+    let mapped = sum
+        .iter()
+        .zip(&count)
+        .map(|(s, &c)| s / c.max(1) as f64)
+        .collect();
     (mapped, total[na * nb - 1] / pairs as f64)
 }

@@ -68,7 +68,10 @@ impl ColonPair {
     /// The prone arc length (voxels) of the point at supine arc length `s_vox`: vertices map to
     /// vertices, linearly in between.
     pub fn prone_arc_vox(&self, s_vox: f64) -> f64 {
-        let (from, to) = (self.supine.centreline.arc_vox(), self.prone.centreline.arc_vox());
+        let (from, to) = (
+            self.supine.centreline.arc_vox(),
+            self.prone.centreline.arc_vox(),
+        );
         let s = s_vox.clamp(0.0, self.supine.centreline.length_vox());
         let upper = from.partition_point(|&a| a <= s).clamp(1, from.len() - 1);
         let span = from[upper] - from[upper - 1];
@@ -156,7 +159,10 @@ mod tests {
         // The sigmoid (the first quarter) is 10–20 % longer.
         let (from, to) = (0.1 * supine.length_vox(), 0.25 * supine.length_vox());
         let stretch = (pair.prone_arc_vox(to) - pair.prone_arc_vox(from)) / (to - from);
-        assert!((1.10..=1.20).contains(&stretch), "sigmoid stretched {stretch}");
+        assert!(
+            (1.10..=1.20).contains(&stretch),
+            "sigmoid stretched {stretch}"
+        );
         // The transverse colon sags by up to 20 mm.
         let transverse = supine.points().iter().filter(|p| p.z > 0.6 * pair.last.z);
         let sag = |p: &DVec3| -pair.displacement(*p).y;
