@@ -195,7 +195,7 @@ impl Correspondence {
     /// The arc length along the second path (from its own start) matched with arc length
     /// `s_mm` along the first.
     pub fn arc_in_second(&self, s_mm: f64) -> f64 {
-        self.from_track(self.track_arc_in_second(s_mm))
+        self.own_arc(self.track_arc_in_second(s_mm))
     }
 
     /// The counterpart in the second scan of the point `x_mm` (world mm) of the first.
@@ -217,7 +217,7 @@ impl Correspondence {
         Ok(Counterpart {
             arc_first_mm: s_a,
             distance_mm,
-            arc_mm: self.from_track(s_b),
+            arc_mm: self.own_arc(s_b),
             point_mm,
             view_first,
             view: view(centre_b, point_mm, tangent_b, Some(up)),
@@ -233,7 +233,7 @@ impl Correspondence {
     }
 
     /// A track arc length of the second path as an arc length from its own start.
-    fn from_track(&self, s_mm: f64) -> f64 {
+    fn own_arc(&self, s_mm: f64) -> f64 {
         if self.reversed {
             self.b.length_mm - s_mm
         } else {
