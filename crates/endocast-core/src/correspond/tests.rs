@@ -103,7 +103,7 @@ fn supine_points_find_their_prone_counterparts_within_10_mm() {
     let half = (centre(supine.dims()) - 1.0) / 2.0;
     let line = &pair.supine.centreline;
     let mut arcs: Vec<f64> = (1..10)
-        .map(|n| 0.1 * n as f64 * line.length_vox())
+        .map(|n| 0.1 * f64::from(n) * line.length_vox())
         .collect();
     arcs.extend(flexures(line));
     let mut worst = 0.0f64;
