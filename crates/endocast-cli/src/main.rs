@@ -55,6 +55,9 @@ enum Command {
     /// The interactive workstation: fly through a scan with the slices, the controls, key
     /// frames, marks and cases (a window; `--screenshot` grabs it and quits).
     View(Box<commands::view::ViewArgs>),
+    /// Supine/prone correspondence: a finding in the first scan gives its counterpart and a
+    /// view of it in the second (JSON with --json), and the two views side by side (-o).
+    Match(Box<commands::match_scans::MatchArgs>),
 }
 
 fn main() -> ExitCode {
@@ -73,6 +76,7 @@ fn main() -> ExitCode {
         Command::Coverage(args) => commands::coverage::run(&args),
         Command::Mesh(args) => commands::mesh::run(&args),
         Command::Annotate(args) => commands::annotate::run(&args),
+        Command::Match(args) => commands::match_scans::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -14,6 +14,7 @@ mod fly;
 mod image;
 mod kwargs;
 mod look;
+mod matching;
 mod navigate;
 mod render;
 mod scene;
@@ -32,6 +33,7 @@ fn _endocast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(navigate::path, m)?)?;
     m.add_function(wrap_pyfunction!(fly::fly, m)?)?;
     m.add_function(wrap_pyfunction!(coverage::coverage, m)?)?;
+    m.add_function(wrap_pyfunction!(matching::match_scans, m)?)?;
     m.add_function(wrap_pyfunction!(look::preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(image::save_png, m)?)?;
     Ok(())

@@ -7,6 +7,7 @@ pub mod coverage;
 pub mod fly;
 mod fly_coverage;
 pub mod info;
+pub mod match_scans;
 pub mod mesh;
 pub mod path;
 pub mod phantom;

@@ -110,10 +110,20 @@ impl Colon {
 
     /// The layout for a grid of `dims` at `scale` voxels per paper millimetre.
     fn new(dims: [usize; 3], scale: f64) -> Self {
+        Self::around(Centreline::new(Self::axis_points(dims, scale)), scale)
+    }
+
+    /// The vertices of the centreline of the layout for a grid of `dims` at `scale`.
+    pub(super) fn axis_points(dims: [usize; 3], scale: f64) -> Vec<DVec3> {
         let last = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64) - 1.0;
         let control: Vec<DVec3> = CONTROL.iter().map(|c| DVec3::from(*c) * last).collect();
         let step_vox = (2.0 * scale).max(0.5);
-        let centreline = Centreline::new(resample(&b_spline(&control), step_vox));
+        resample(&b_spline(&control), step_vox)
+    }
+
+    /// The colon along `centreline` at `scale` voxels per paper millimetre: its radius, folds
+    /// and polyps placed by arc length along it.
+    pub(super) fn around(centreline: Centreline, scale: f64) -> Self {
         let mut colon = Self {
             centreline,
             folds: Vec::new(),
@@ -341,13 +351,21 @@ impl<'a> ColonField<'a> {
 
 /// A `size × size × (size · 478 / 512)` volume of tissue holding the colon's air lumen.
 pub fn colon(options: &PhantomOptions) -> (Volume, Colon) {
+    let (dims, scale) = grid(options);
+    let truth = Colon::new(dims, scale);
+    (raster(&truth, dims, options), truth)
+}
+
+/// The colon phantom's grid for `options` and the scale of its anatomy (voxels per paper mm).
+pub(super) fn grid(options: &PhantomOptions) -> ([usize; 3], f64) {
     let size = options.size_vox();
     let slices = (size * PAPER_SLICES / PAPER_SIZE).round() as usize;
-    let dims = [size as usize, size as usize, slices];
-    let truth = Colon::new(dims, size / PAPER_SIZE);
-    let field = ColonField::new(&truth, dims);
-    let volume = rasterize(dims, options, &field);
-    (volume, truth)
+    ([size as usize, size as usize, slices], size / PAPER_SIZE)
+}
+
+/// The volume of `truth` on a `dims` grid, with the noise of `options`.
+pub(super) fn raster(truth: &Colon, dims: [usize; 3], options: &PhantomOptions) -> Volume {
+    rasterize(dims, options, &ColonField::new(truth, dims))
 }
 
 /// The uniform cubic B-spline of the control polygon `control`, densely sampled. The curve does

@@ -30,6 +30,7 @@
 mod bins;
 mod centreline;
 mod colon;
+mod colon_prone;
 mod curved_tube;
 mod joint;
 mod layered;
@@ -44,6 +45,7 @@ mod vessel;
 
 pub use centreline::Centreline;
 pub use colon::{colon, Colon, Fold};
+pub use colon_prone::{colon_prone, ColonPair};
 pub use curved_tube::{curved_tube, CurvedTube};
 pub use joint::{joint, Joint};
 pub use layered::{layered, Layered, SECRETION_HU};
@@ -77,11 +79,14 @@ pub enum Phantom {
     Sinus,
     /// Air over a secretion layer of known, varying thickness over tissue ([`layered`]).
     Layered,
+    /// The colon of the same options scanned prone: deformed and turned over
+    /// ([`colon_prone`]).
+    ColonProne,
 }
 
 impl Phantom {
     /// Every phantom, in a fixed order.
-    pub const ALL: [Phantom; 8] = [
+    pub const ALL: [Phantom; 9] = [
         Self::SphereShell,
         Self::StraightTube,
         Self::CurvedTube,
@@ -90,9 +95,10 @@ impl Phantom {
         Self::Joint,
         Self::Sinus,
         Self::Layered,
+        Self::ColonProne,
     ];
 
-    /// The kebab-case name (`sphere-shell`, `straight-tube`, `curved-tube`, `colon`, `vessel`, `joint`, `sinus`, `layered`).
+    /// The kebab-case name (`sphere-shell`, `straight-tube`, `curved-tube`, `colon`, `vessel`, `joint`, `sinus`, `layered`, `colon-prone`).
     pub fn name(self) -> &'static str {
         match self {
             Self::SphereShell => "sphere-shell",
@@ -103,6 +109,7 @@ impl Phantom {
             Self::Joint => "joint",
             Self::Sinus => "sinus",
             Self::Layered => "layered",
+            Self::ColonProne => "colon-prone",
         }
     }
 
@@ -130,6 +137,9 @@ impl Phantom {
             Self::Layered => {
                 "air over a secretion layer of known, growing thickness over tissue: secretion"
             }
+            Self::ColonProne => {
+                "the colon of the same seed prone: sagged, stretched and turned over: supine/prone"
+            }
         }
     }
 
@@ -144,6 +154,7 @@ impl Phantom {
             Self::Joint => joint(options).0,
             Self::Sinus => sinus(options).0,
             Self::Layered => layered(options).0,
+            Self::ColonProne => colon_prone(options).0,
         }
     }
 }

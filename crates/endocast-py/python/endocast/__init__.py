@@ -22,6 +22,7 @@ default_view = accepting_images(_endocast.default_view)
 path = accepting_images(_endocast.path)
 fly = accepting_images(_endocast.fly)
 coverage = accepting_images(_endocast.coverage)
+match = _endocast.match
 
 __all__ = [
     "EndocastError",
@@ -30,6 +31,7 @@ __all__ = [
     "coverage",
     "default_view",
     "fly",
+    "match",
     "open",
     "path",
     "presets",

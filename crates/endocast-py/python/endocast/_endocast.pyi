@@ -258,6 +258,19 @@ def coverage(
     """Fly ``path`` (or the ``preset``'s automatic path) and review the wall it missed, as
     ``endocast coverage --json`` reports it: ``patches`` (largest first: ``area_mm2``,
     ``centroid``, ``eye``, ``look_at``, ...) and the coverage before and after the review."""
+def match(
+    first: Volume,
+    second: Volume,
+    at: Tuple[float, float, float],
+    preset: str = "colonoscopy",
+    output: Optional[_Path] = None,
+    size: Tuple[int, int] = (384, 384),
+    fov: Optional[float] = None,
+) -> dict[str, Any]:
+    """The counterpart in ``second`` (prone) of the point ``at`` (LPS mm) of ``first``
+    (supine), as ``endocast match --json`` reports it: ``point``, ``arc_mm``, ``eye``,
+    ``look_at`` and the match (``turn_deg``, ``reversed``, ...); with ``output``, the two views
+    side by side as a PNG."""
 def presets() -> list[str]:
     """The preset names."""
 def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:
