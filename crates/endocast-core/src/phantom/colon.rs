@@ -125,7 +125,8 @@ impl Colon {
         colon
     }
 
-    fn fold_spacing_vox(&self) -> f64 {
+    /// Distance between folds along the centreline, voxels.
+    pub(crate) fn fold_spacing_vox(&self) -> f64 {
         FOLD_SPACING_MM * self.scale
     }
 
@@ -196,7 +197,7 @@ impl Segment {
 
 /// The colon's value function: its truth, its segments and the bins that list, per bin of voxels,
 /// the segments that can be closest there and the folds and polyps that can reach it.
-struct ColonField<'a> {
+pub(crate) struct ColonField<'a> {
     colon: &'a Colon,
     segments: Vec<Segment>,
     bins: BinGrid,
@@ -248,7 +249,8 @@ impl Field for ColonField<'_> {
 }
 
 impl<'a> ColonField<'a> {
-    fn new(colon: &'a Colon, dims: [usize; 3]) -> Self {
+    /// The field of `colon` on a grid of `dims`.
+    pub(crate) fn new(colon: &'a Colon, dims: [usize; 3]) -> Self {
         let points = colon.centreline.points();
         let segments: Vec<Segment> = points
             .windows(2)
@@ -341,13 +343,18 @@ impl<'a> ColonField<'a> {
 
 /// A `size × size × (size · 478 / 512)` volume of tissue holding the colon's air lumen.
 pub fn colon(options: &PhantomOptions) -> (Volume, Colon) {
-    let size = options.size_vox();
-    let slices = (size * PAPER_SLICES / PAPER_SIZE).round() as usize;
-    let dims = [size as usize, size as usize, slices];
-    let truth = Colon::new(dims, size / PAPER_SIZE);
+    let (dims, truth) = layout(options);
     let field = ColonField::new(&truth, dims);
     let volume = rasterize(dims, options, &field);
     (volume, truth)
+}
+
+/// The grid and the colon's layout (with its five polyps) for `options`.
+pub(crate) fn layout(options: &PhantomOptions) -> ([usize; 3], Colon) {
+    let size = options.size_vox();
+    let slices = (size * PAPER_SLICES / PAPER_SIZE).round() as usize;
+    let dims = [size as usize, size as usize, slices];
+    (dims, Colon::new(dims, size / PAPER_SIZE))
 }
 
 /// The uniform cubic B-spline of the control polygon `control`, densely sampled. The curve does
