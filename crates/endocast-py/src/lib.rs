@@ -15,6 +15,7 @@ mod image;
 mod kwargs;
 mod look;
 mod navigate;
+mod polyps;
 mod render;
 mod scene;
 mod volume;
@@ -32,6 +33,7 @@ fn _endocast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(navigate::path, m)?)?;
     m.add_function(wrap_pyfunction!(fly::fly, m)?)?;
     m.add_function(wrap_pyfunction!(coverage::coverage, m)?)?;
+    m.add_function(wrap_pyfunction!(polyps::polyps, m)?)?;
     m.add_function(wrap_pyfunction!(look::preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(image::save_png, m)?)?;
     Ok(())

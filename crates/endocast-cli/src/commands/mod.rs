@@ -10,6 +10,7 @@ pub mod info;
 pub mod mesh;
 pub mod path;
 pub mod phantom;
+pub mod polyps;
 pub mod presets;
 pub mod render;
 pub mod view;

@@ -66,11 +66,8 @@ fn grow(
 fn neighbours(dims: [usize; 3], v: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
     (0..27).filter(|&n| n != 13).filter_map(move |n| {
         let offset = [n % 3, n / 3 % 3, n / 9];
-        let mut out = [0; 3];
-        for a in 0..3 {
-            out[a] = (v[a] + offset[a]).checked_sub(1).filter(|&c| c < dims[a])?;
-        }
-        Some(out)
+        let shifted = |a: usize| (v[a] + offset[a]).checked_sub(1).filter(|&c| c < dims[a]);
+        Some([shifted(0)?, shifted(1)?, shifted(2)?])
     })
 }
 

@@ -146,7 +146,7 @@ pub(crate) fn shape(
     };
     let (g, h) = (gradient * sign, hessian * sign);
     let g2 = g.length_squared();
-    if !(g2 > 0.0) || !g2.is_finite() {
+    if !(g2.is_finite() && g2 > 0.0) {
         return SurfaceShape {
             shape_index: 0.5,
             curvedness: 0.0,

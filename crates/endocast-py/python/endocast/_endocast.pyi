@@ -255,6 +255,22 @@ def coverage(
     """Fly ``path`` (or the ``preset``'s automatic path) and review the wall it missed, as
     ``endocast coverage --json`` reports it: ``patches`` (largest first: ``area_mm2``,
     ``centroid``, ``eye``, ``look_at``, ...) and the coverage before and after the review."""
+def polyps(
+    volume: _VolumeLike,
+    path: Optional[Union[_Path, npt.ArrayLike]] = None,
+    *,
+    preset: Optional[str] = None,
+    iso: Optional[float] = None,
+    sigma: float = 1.0,
+    min_size: float = 5.0,
+    lumen_threshold: Optional[float] = None,
+    bright_lumen: bool = False,
+    threads: Optional[int] = None,
+    **options: object,
+) -> dict[str, Any]:
+    """Polyp candidates on the wall of the lumen ``path`` starts in (or of the ``preset``'s
+    structure), as ``endocast polyps --json`` lists them: ``candidates`` (best first:
+    ``centre`` on the wall, LPS mm, ``size_mm``, ``score``)."""
 def presets() -> list[str]:
     """The preset names."""
 def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:
