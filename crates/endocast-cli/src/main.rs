@@ -43,6 +43,9 @@ enum Command {
     /// The wall a flight missed, as patches with their area, centroid and a camera that sees
     /// each (JSON with --json), their views (--views) and the coverage before and after them.
     Coverage(Box<commands::coverage::CoverageArgs>),
+    /// Polyp candidates on the wall of the colon (or the lumen a path starts in) by shape
+    /// index and curvedness: listed (JSON with --json), viewed (--thumbnails), added to a case.
+    Polyps(Box<commands::polyps::PolypsArgs>),
     /// List the procedure presets: mode, transfer function, isovalues, lumen, slice window, lens.
     Presets(commands::presets::PresetsArgs),
     /// The lumen's wall (an isosurface) as a triangle mesh: STL, OBJ or PLY in world mm.
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
         Command::Fly(args) => commands::fly::run(&args),
         Command::View(args) => commands::view::run(&args),
         Command::Coverage(args) => commands::coverage::run(&args),
+        Command::Polyps(args) => commands::polyps::run(&args),
         Command::Mesh(args) => commands::mesh::run(&args),
         Command::Annotate(args) => commands::annotate::run(&args),
         Command::Match(args) => commands::match_scans::run(&args),

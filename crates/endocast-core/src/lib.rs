@@ -24,6 +24,7 @@ pub mod look;
 pub mod navigate;
 pub mod path;
 pub mod phantom;
+pub mod polyps;
 pub mod pose;
 pub mod presets;
 pub mod render;

@@ -16,6 +16,7 @@ mod kwargs;
 mod look;
 mod matching;
 mod navigate;
+mod polyps;
 mod render;
 mod scene;
 mod volume;
@@ -34,6 +35,7 @@ fn _endocast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fly::fly, m)?)?;
     m.add_function(wrap_pyfunction!(coverage::coverage, m)?)?;
     m.add_function(wrap_pyfunction!(matching::match_scans, m)?)?;
+    m.add_function(wrap_pyfunction!(polyps::polyps, m)?)?;
     m.add_function(wrap_pyfunction!(look::preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(image::save_png, m)?)?;
     Ok(())

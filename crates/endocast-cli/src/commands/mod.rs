@@ -11,6 +11,7 @@ pub mod match_scans;
 pub mod mesh;
 pub mod path;
 pub mod phantom;
+pub mod polyps;
 pub mod presets;
 pub mod render;
 pub mod view;

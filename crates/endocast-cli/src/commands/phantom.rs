@@ -19,9 +19,14 @@ pub struct PhantomArgs {
     /// Gaussian noise, standard deviation in HU.
     #[arg(long, default_value_t = 0.0)]
     noise: f64,
-    /// Seed of the noise.
+    /// Seed of the noise (and of the polyps' draw with --polyps).
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// colon only: N polyps of 4–10 mm (sessile, pedunculated and flat in turn) drawn with
+    /// --seed at random places on and between the folds, instead of the five fixed ones;
+    /// 0 gives a colon of folds only.
+    #[arg(long, value_name = "N")]
+    polyps: Option<usize>,
 }
 
 /// The largest phantom we agree to build (2048³ would be 16 GiB).
@@ -50,7 +55,11 @@ pub fn run(args: &PhantomArgs) -> Result<()> {
         size: args.size,
         noise_hu: args.noise,
         seed: args.seed,
+        polyps: args.polyps,
     };
+    if args.polyps.is_some() && phantom != Phantom::Colon {
+        bail!("--polyps applies to the colon phantom only");
+    }
     let volume = phantom.build(&options);
     endocast_io::write(&args.output, &volume).context("cannot write the phantom")?;
     let [nx, ny, nz] = volume.dims();

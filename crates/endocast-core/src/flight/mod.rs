@@ -10,6 +10,7 @@ mod frames;
 mod looks;
 mod overview;
 mod review;
+pub(crate) use review::up_for;
 mod wall;
 
 pub use error::FlightError;

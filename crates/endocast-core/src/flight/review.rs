@@ -196,7 +196,7 @@ impl<'a> ReviewSite<'a> {
 }
 
 /// Superior (+z, LPS) made perpendicular to `view`, else anterior when looking up or down.
-fn up_for(view: DVec3) -> DVec3 {
+pub(crate) fn up_for(view: DVec3) -> DVec3 {
     let view = view.normalize_or(DVec3::Y);
     let up = DVec3::Z - view * view.z;
     if up.length() > 0.1 {

@@ -135,7 +135,8 @@ impl Colon {
         colon
     }
 
-    fn fold_spacing_vox(&self) -> f64 {
+    /// Distance between folds along the centreline, voxels.
+    pub(crate) fn fold_spacing_vox(&self) -> f64 {
         FOLD_SPACING_MM * self.scale
     }
 
@@ -206,7 +207,7 @@ impl Segment {
 
 /// The colon's value function: its truth, its segments and the bins that list, per bin of voxels,
 /// the segments that can be closest there and the folds and polyps that can reach it.
-struct ColonField<'a> {
+pub(crate) struct ColonField<'a> {
     colon: &'a Colon,
     segments: Vec<Segment>,
     bins: BinGrid,
@@ -258,7 +259,8 @@ impl Field for ColonField<'_> {
 }
 
 impl<'a> ColonField<'a> {
-    fn new(colon: &'a Colon, dims: [usize; 3]) -> Self {
+    /// The field of `colon` on a grid of `dims`.
+    pub(crate) fn new(colon: &'a Colon, dims: [usize; 3]) -> Self {
         let points = colon.centreline.points();
         let segments: Vec<Segment> = points
             .windows(2)
@@ -351,8 +353,7 @@ impl<'a> ColonField<'a> {
 
 /// A `size × size × (size · 478 / 512)` volume of tissue holding the colon's air lumen.
 pub fn colon(options: &PhantomOptions) -> (Volume, Colon) {
-    let (dims, scale) = grid(options);
-    let truth = Colon::new(dims, scale);
+    let (dims, truth) = layout(options);
     (raster(&truth, dims, options), truth)
 }
 
@@ -366,6 +367,12 @@ pub(super) fn grid(options: &PhantomOptions) -> ([usize; 3], f64) {
 /// The volume of `truth` on a `dims` grid, with the noise of `options`.
 pub(super) fn raster(truth: &Colon, dims: [usize; 3], options: &PhantomOptions) -> Volume {
     rasterize(dims, options, &ColonField::new(truth, dims))
+}
+
+/// The grid and the colon's layout (with its five polyps) for `options`.
+pub(crate) fn layout(options: &PhantomOptions) -> ([usize; 3], Colon) {
+    let (dims, scale) = grid(options);
+    (dims, Colon::new(dims, scale))
 }
 
 /// The uniform cubic B-spline of the control polygon `control`, densely sampled. The curve does

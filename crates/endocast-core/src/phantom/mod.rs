@@ -31,10 +31,12 @@ mod bins;
 mod centreline;
 mod colon;
 mod colon_prone;
+mod colon_polyps;
 mod curved_tube;
 mod joint;
 mod layered;
 mod noise;
+mod polyp;
 pub mod profile;
 mod raster;
 mod shape;
@@ -46,9 +48,11 @@ mod vessel;
 pub use centreline::Centreline;
 pub use colon::{colon, Colon, Fold};
 pub use colon_prone::{colon_prone, ColonPair};
+pub use colon_polyps::{colon_polyps, PolypColon, POLYP_DIAMETER_MM};
 pub use curved_tube::{curved_tube, CurvedTube};
 pub use joint::{joint, Joint};
 pub use layered::{layered, Layered, SECRETION_HU};
+pub use polyp::{Polyp, PolypShape};
 pub use shape::Ball;
 pub use sinus::{sinus, Cavity, Septum, Sinus};
 pub use sphere_shell::{sphere_shell, SphereShell};
@@ -128,7 +132,9 @@ impl Phantom {
             Self::CurvedTube => {
                 "air tube bent through 270 degrees along an arc: paths around a bend"
             }
-            Self::Colon => "winding air tube with haustral folds and polyps: fly-through",
+            Self::Colon => {
+                "winding air tube with haustral folds and polyps (or N drawn ones): fly-through"
+            }
             Self::Vessel => "contrast-filled vessel with a metal stent and calcifications",
             Self::Joint => {
                 "three bones around two thin contrast layers: two isosurfaces, depth peeling"
@@ -149,7 +155,10 @@ impl Phantom {
             Self::SphereShell => sphere_shell(options).0,
             Self::StraightTube => straight_tube(options).0,
             Self::CurvedTube => curved_tube(options).0,
-            Self::Colon => colon(options).0,
+            Self::Colon => match options.polyps {
+                Some(count) => colon_polyps(options, count).0,
+                None => colon(options).0,
+            },
             Self::Vessel => vessel(options).0,
             Self::Joint => joint(options).0,
             Self::Sinus => sinus(options).0,
@@ -175,6 +184,10 @@ pub struct PhantomOptions {
     /// Seed of the noise; the same seed gives the same voxels on any machine and thread count.
     /// Default 1.
     pub seed: u64,
+    /// The colon only: this many polyps of drawn sizes, shapes and places (drawn with `seed`,
+    /// see [`colon_polyps`]) instead of its five fixed ones; `Some(0)` gives folds only.
+    /// Default `None`.
+    pub polyps: Option<usize>,
 }
 
 impl Default for PhantomOptions {
@@ -183,6 +196,7 @@ impl Default for PhantomOptions {
             size: 128,
             noise_hu: 0.0,
             seed: 1,
+            polyps: None,
         }
     }
 }

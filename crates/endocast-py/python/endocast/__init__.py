@@ -3,7 +3,7 @@
 Read a scan (``open``), wrap a numpy array (``Volume.from_array``) or pass a nibabel or
 SimpleITK image as it is (``as_volume`` converts it), render the endoscope's
 view (``render``), plan a centred path through a lumen (``path``), fly along it (``fly``) and review the
-wall a flight missed (``coverage``).
+wall a flight missed (``coverage``), find polyp candidates on a colon's wall (``polyps``).
 The options are those of the ``endocast`` command (``--look-at`` is ``look_at=``), with the
 same defaults and presets; positions are in the patient frame, LPS millimetres, as DICOM has
 them (``Volume.affine_ras`` converts to nibabel's RAS).
@@ -23,6 +23,7 @@ path = accepting_images(_endocast.path)
 fly = accepting_images(_endocast.fly)
 coverage = accepting_images(_endocast.coverage)
 match = _endocast.match
+polyps = accepting_images(_endocast.polyps)
 
 __all__ = [
     "EndocastError",
@@ -34,6 +35,7 @@ __all__ = [
     "match",
     "open",
     "path",
+    "polyps",
     "presets",
     "render",
     "save_png",

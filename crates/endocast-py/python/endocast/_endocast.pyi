@@ -271,6 +271,22 @@ def match(
     (supine), as ``endocast match --json`` reports it: ``point``, ``arc_mm``, ``eye``,
     ``look_at`` and the match (``turn_deg``, ``reversed``, ...); with ``output``, the two views
     side by side as a PNG."""
+def polyps(
+    volume: _VolumeLike,
+    path: Optional[Union[_Path, npt.ArrayLike]] = None,
+    *,
+    preset: Optional[str] = None,
+    iso: Optional[float] = None,
+    sigma: float = 1.0,
+    min_size: float = 5.0,
+    lumen_threshold: Optional[float] = None,
+    bright_lumen: bool = False,
+    threads: Optional[int] = None,
+    **options: object,
+) -> dict[str, Any]:
+    """Polyp candidates on the wall of the lumen ``path`` starts in (or of the ``preset``'s
+    structure), as ``endocast polyps --json`` lists them: ``candidates`` (best first:
+    ``centre`` on the wall, LPS mm, ``size_mm``, ``score``)."""
 def presets() -> list[str]:
     """The preset names."""
 def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:
