@@ -22,6 +22,7 @@ use std::path::PathBuf;
 #[pyfunction]
 #[pyo3(name = "match", signature = (first, second, at, preset = "colonoscopy", output = None, size = (384, 384), fov = None))]
 #[allow(clippy::too_many_arguments)]
+#[allow(clippy::needless_pass_by_value)] // PyO3 hands arguments over by value.
 pub fn match_scans<'py>(
     py: Python<'py>,
     first: &Bound<'py, Volume>,

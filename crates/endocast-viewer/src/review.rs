@@ -33,12 +33,15 @@ struct Found {
     patches_total: usize,
 }
 
+/// The review running off the UI thread.
+type ReviewJob = Job<Result<Found, String>>;
+
 /// The review tools' state.
 #[derive(Debug, Default)]
 pub struct ReviewTools {
     /// Fly the route back too before listing (default: forward only, as flown).
     pub both_ways: bool,
-    job: Option<(Job<Result<Found, String>>, Arc<AtomicUsize>)>,
+    job: Option<(ReviewJob, Arc<AtomicUsize>)>,
     found: Option<Found>,
     /// Which listed patches the endoscope has been taken to.
     visited: Vec<bool>,

@@ -5,7 +5,7 @@ use super::Counterpart;
 use crate::camera::CameraError;
 use crate::look::{still_view, LookError};
 use crate::pose::Pose;
-use crate::render::{Camera, RenderSettings, Renderer, SettingsError};
+use crate::render::{Camera, Filter, RenderSettings, Renderer, SettingsError};
 use crate::views::{Image, ViewError, CAMERA_COLOR};
 use std::sync::Arc;
 use thiserror::Error;
@@ -61,7 +61,7 @@ fn view(
 ) -> Result<Image, PairError> {
     let camera = Camera::look_at(pose.eye_mm, pose.look_at_mm, pose.up, fov_deg, size)?;
     let prepared = renderer.prepare(settings)?;
-    let frame = still_view(&prepared, None, &camera, 1)?;
+    let frame = still_view(&prepared, None, &camera, 1, Filter::Trilinear)?;
     let mut image = Image::from_frame(&frame, settings.background)?;
     let (x, y) = (0.5 * size[0] as f64, 0.5 * size[1] as f64);
     image.line((x - MARK_PX, y), (x + MARK_PX, y), CAMERA_COLOR);

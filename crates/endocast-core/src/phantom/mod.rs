@@ -30,8 +30,8 @@
 mod bins;
 mod centreline;
 mod colon;
-mod colon_prone;
 mod colon_polyps;
+mod colon_prone;
 mod curved_tube;
 mod joint;
 mod layered;
@@ -47,8 +47,8 @@ mod vessel;
 
 pub use centreline::Centreline;
 pub use colon::{colon, Colon, Fold};
-pub use colon_prone::{colon_prone, ColonPair};
 pub use colon_polyps::{colon_polyps, PolypColon, POLYP_DIAMETER_MM};
+pub use colon_prone::{colon_prone, ColonPair};
 pub use curved_tube::{curved_tube, CurvedTube};
 pub use joint::{joint, Joint};
 pub use layered::{layered, Layered, SECRETION_HU};

@@ -37,7 +37,8 @@ fn gaussian_pair(seed: u64, pair: u64) -> (f64, f64) {
 /// A uniform sample in [0, 1) for draw `index` under `seed` (53 bits of the hash), for
 /// placements drawn with a seed.
 pub(crate) fn uniform(seed: u64, index: u64) -> f64 {
-    (splitmix64(splitmix64(seed ^ 0x5EED_0F_A11_D4A3) ^ index) >> 11) as f64 / (1u64 << 53) as f64
+    (splitmix64(splitmix64(seed ^ 0x0005_EED0_FA11_D4A3) ^ index) >> 11) as f64
+        / (1u64 << 53) as f64
 }
 
 /// The standard normal sample of voxel `index` under `seed`.

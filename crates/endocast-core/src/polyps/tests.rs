@@ -97,7 +97,7 @@ fn finds_sessile_and_pedunculated_polyps_of_6_mm_and_more_at_their_size() {
         "only {expected} polyps of 6 mm or more drawn"
     );
     assert!(
-        hit as f64 >= 0.9 * expected as f64,
+        f64::from(hit) >= 0.9 * f64::from(expected),
         "found {hit} of {expected}"
     );
     assert!(worst_size <= 1.5, "worst size error {worst_size} mm");
