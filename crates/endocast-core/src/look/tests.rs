@@ -226,6 +226,7 @@ fn fold_and_wall(noise_hu: f64) -> Volume {
         size: 48,
         noise_hu,
         seed: 3,
+        ..Default::default()
     };
     rasterize([48, 48, 48], &options, &|p: DVec3| {
         let wall = ramp(40.0 - p.z, TISSUE_HU, AIR_HU);

@@ -10,6 +10,7 @@ use super::centreline::Centreline;
 use super::profile::{paint, ramp, AIR_HU, REACH_VOX, TISSUE_HU};
 use super::raster::{rasterize, Field};
 use super::shape::{torus, Ball};
+use super::tagged_pool::{self, Pool};
 use super::PhantomOptions;
 use crate::Volume;
 use glam::DVec3;
@@ -91,6 +92,8 @@ pub struct Colon {
     pub folds: Vec<Fold>,
     /// Polyps: tissue balls centred just outside the wall, bulging into the lumen.
     pub polyps: Vec<Ball>,
+    /// Pools of tagged fluid under the air (none unless [`PhantomOptions::tagged_fluid`]).
+    pub pools: Vec<Pool>,
     /// Voxels per millimetre of the paper-size anatomy (`size / 512`).
     scale: f64,
 }
@@ -118,6 +121,7 @@ impl Colon {
             centreline,
             folds: Vec::new(),
             polyps: Vec::new(),
+            pools: Vec::new(),
             scale,
         };
         colon.folds = colon.place_folds();
@@ -222,7 +226,8 @@ impl Field for ColonField<'_> {
         }
         let mut hu = if best_d2.is_finite() {
             let d = best_d2.sqrt() - self.colon.radius_vox_at(best_s);
-            ramp(d, AIR_HU, TISSUE_HU)
+            let lumen = Pool::lumen_hu(&self.colon.pools, AIR_HU, p.y, best_s);
+            ramp(d, lumen, TISSUE_HU)
         } else {
             TISSUE_HU
         };
@@ -339,12 +344,16 @@ impl<'a> ColonField<'a> {
     }
 }
 
-/// A `size × size × (size · 478 / 512)` volume of tissue holding the colon's air lumen.
+/// A `size × size × (size · 478 / 512)` volume of tissue holding the colon's air lumen, with
+/// pools of tagged fluid when the options ask for them.
 pub fn colon(options: &PhantomOptions) -> (Volume, Colon) {
     let size = options.size_vox();
     let slices = (size * PAPER_SLICES / PAPER_SIZE).round() as usize;
     let dims = [size as usize, size as usize, slices];
-    let truth = Colon::new(dims, size / PAPER_SIZE);
+    let mut truth = Colon::new(dims, size / PAPER_SIZE);
+    if options.tagged_fluid {
+        truth.pools = tagged_pool::place(&truth);
+    }
     let field = ColonField::new(&truth, dims);
     let volume = rasterize(dims, options, &field);
     (volume, truth)

@@ -40,6 +40,7 @@ mod shape;
 mod sinus;
 mod sphere_shell;
 mod straight_tube;
+mod tagged_pool;
 mod vessel;
 
 pub use centreline::Centreline;
@@ -51,6 +52,7 @@ pub use shape::Ball;
 pub use sinus::{sinus, Cavity, Septum, Sinus};
 pub use sphere_shell::{sphere_shell, SphereShell};
 pub use straight_tube::{straight_tube, Tube};
+pub use tagged_pool::{Pool, TAGGED_FLUID_HU};
 pub use vessel::{vessel, Stent, Vessel};
 
 #[cfg(test)]
@@ -164,6 +166,9 @@ pub struct PhantomOptions {
     /// Seed of the noise; the same seed gives the same voxels on any machine and thread count.
     /// Default 1.
     pub seed: u64,
+    /// The colon: pools of tagged fluid (oral contrast) under the air in its sumps, for
+    /// electronic cleansing. Other phantoms ignore it. Default false.
+    pub tagged_fluid: bool,
 }
 
 impl Default for PhantomOptions {
@@ -172,6 +177,7 @@ impl Default for PhantomOptions {
             size: 128,
             noise_hu: 0.0,
             seed: 1,
+            tagged_fluid: false,
         }
     }
 }

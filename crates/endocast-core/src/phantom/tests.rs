@@ -91,6 +91,7 @@ fn same_seed_same_voxels_other_seed_other_noise() {
         size: 24,
         noise_hu: 20.0,
         seed,
+        ..Default::default()
     };
     for phantom in Phantom::ALL {
         let a = phantom.build(&noisy(5));
@@ -107,6 +108,7 @@ fn noise_has_the_requested_spread() {
         size: 40,
         noise_hu: 25.0,
         seed: 3,
+        ..Default::default()
     };
     let volume = Phantom::StraightTube.build(&options);
     let corner: Vec<f64> = (0..8)
@@ -135,6 +137,7 @@ fn voxels_do_not_depend_on_the_thread_count() {
         size: 40,
         noise_hu: 15.0,
         seed: 11,
+        ..Default::default()
     };
     let one_thread = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
