@@ -22,6 +22,10 @@ pub struct PhantomArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// The colon: pools of tagged fluid (600 HU oral contrast) under the air in its sumps, with
+    /// the blurred rims of a CT, for `--cleanse on`.
+    #[arg(long)]
+    tagged_fluid: bool,
 }
 
 /// The largest phantom we agree to build (2048³ would be 16 GiB).
@@ -37,6 +41,12 @@ pub fn run(args: &PhantomArgs) -> Result<()> {
             names.join(", ")
         );
     };
+    if args.tagged_fluid && phantom != Phantom::Colon {
+        bail!(
+            "--tagged-fluid is for the colon phantom, not {}",
+            phantom.name()
+        );
+    }
     if !(8..=MAX_SIZE).contains(&args.size) {
         bail!("--size must be between 8 and {MAX_SIZE}, not {}", args.size);
     }
@@ -50,6 +60,7 @@ pub fn run(args: &PhantomArgs) -> Result<()> {
         size: args.size,
         noise_hu: args.noise,
         seed: args.seed,
+        tagged_fluid: args.tagged_fluid,
     };
     let volume = phantom.build(&options);
     endocast_io::write(&args.output, &volume).context("cannot write the phantom")?;

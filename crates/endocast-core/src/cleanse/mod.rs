@@ -91,6 +91,20 @@ impl Cleanse {
             _ => None,
         }
     }
+
+    /// `volume` as this switch asks, with the line to tell the user: the scan itself when
+    /// [`Cleanse::Off`], its cleansed copy ([`cleanse`]) when [`Cleanse::On`]. Every front end
+    /// loads its study's scan through this.
+    pub fn apply(self, volume: Volume) -> Result<(Volume, Option<String>), CleanseError> {
+        match self {
+            Self::Off => Ok((volume, None)),
+            Self::On => {
+                let cleansed = cleanse(&volume)?;
+                let summary = cleansed.summary();
+                Ok((cleansed.volume, Some(summary)))
+            }
+        }
+    }
 }
 
 /// A scan with its tagged fluid removed.
