@@ -90,9 +90,7 @@ pub fn open(
         .detach(|| endocast_io::open(&path, &options))
         .map_err(to_py)?;
     let switch = if cleanse { Cleanse::On } else { Cleanse::Off };
-    let (volume, summary) = py
-        .detach(|| switch.apply(loaded.volume))
-        .map_err(to_py)?;
+    let (volume, summary) = py.detach(|| switch.apply(loaded.volume)).map_err(to_py)?;
     loaded.warnings.extend(summary);
     let source = loaded.source.format.name().to_owned();
     Ok(Volume::new(volume, loaded.warnings, source))
