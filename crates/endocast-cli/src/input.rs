@@ -1,5 +1,6 @@
 //! The options every command that reads a scan shares: series choice, limits, raw layout.
 
+use crate::cleanse_args::CleanseArgs;
 use crate::parse::{parse_dims, parse_spacing};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -45,6 +46,8 @@ pub struct InputArgs {
     /// Raw input: bytes to skip before the first sample.
     #[arg(long, value_name = "BYTES", default_value_t = 0)]
     pub raw_header_bytes: u64,
+    #[command(flatten)]
+    pub cleanse: CleanseArgs,
 }
 
 impl InputArgs {
@@ -69,8 +72,14 @@ impl InputArgs {
         Ok(())
     }
 
-    /// Reads the scan these options name.
+    /// Reads the scan these options name, cleansed when `--cleanse on` asks for it.
     pub fn open(&self) -> Result<Loaded> {
+        let mut loaded = self.open_as_stored()?;
+        loaded.volume = self.cleanse.apply(loaded.volume)?;
+        Ok(loaded)
+    }
+
+    fn open_as_stored(&self) -> Result<Loaded> {
         let mut options = OpenOptions::default();
         options.series.clone_from(&self.series);
         options.limits = self.limits();

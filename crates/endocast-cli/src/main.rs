@@ -1,6 +1,7 @@
 //! The `endocast` command-line tool: every command is a thin front end over the libraries.
 
 mod case_args;
+mod cleanse_args;
 mod commands;
 mod input;
 mod look;

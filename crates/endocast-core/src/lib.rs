@@ -15,6 +15,7 @@
 pub mod animation;
 pub mod annotate;
 pub mod camera;
+pub mod cleanse;
 pub mod correspond;
 pub mod coverage;
 pub mod flight;

@@ -2,6 +2,7 @@
 //! numpy array and its affine, held by the renderer that every call shares.
 
 use crate::errors::{error, to_py};
+use endocast_core::cleanse::Cleanse;
 use endocast_core::render::Renderer;
 use endocast_core::{Geometry, Modality};
 use endocast_io::{ElementType, Endian, Limits, OpenOptions, Rescale};
@@ -53,7 +54,8 @@ impl Volume {
 /// `orientation` (for a file that declares none, e.g. "LPI"; a head CT is otherwise turned
 /// upright from its anatomy), `fill_missing_slices` (accept a DICOM series with missing slices,
 /// interpolated and warned), `allow_outside_data` (a detached NRRD/MetaImage data file outside
-/// the header's folder).
+/// the header's folder), `cleanse` (CT colonography: remove pools of tagged fluid under air and
+/// their rims, as `--cleanse on`; what was removed is added to `warnings`).
 #[pyfunction]
 #[pyo3(signature = (
     path,
@@ -63,6 +65,7 @@ impl Volume {
     orientation = None,
     fill_missing_slices = false,
     allow_outside_data = false,
+    cleanse = false,
 ))]
 #[allow(clippy::needless_pass_by_value)] // PyO3 hands arguments over by value.
 pub fn open(
@@ -73,6 +76,7 @@ pub fn open(
     orientation: Option<String>,
     fill_missing_slices: bool,
     allow_outside_data: bool,
+    cleanse: bool,
 ) -> PyResult<Volume> {
     let mut options = OpenOptions::default();
     options.series = series;
@@ -82,11 +86,14 @@ pub fn open(
     options.orientation = orientation;
     options.fill_missing_slices = fill_missing_slices;
     options.allow_outside_data = allow_outside_data;
-    let loaded = py
+    let mut loaded = py
         .detach(|| endocast_io::open(&path, &options))
         .map_err(to_py)?;
+    let switch = if cleanse { Cleanse::On } else { Cleanse::Off };
+    let (volume, summary) = py.detach(|| switch.apply(loaded.volume)).map_err(to_py)?;
+    loaded.warnings.extend(summary);
     let source = loaded.source.format.name().to_owned();
-    Ok(Volume::new(loaded.volume, loaded.warnings, source))
+    Ok(Volume::new(volume, loaded.warnings, source))
 }
 
 #[pymethods]

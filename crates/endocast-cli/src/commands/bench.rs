@@ -4,6 +4,7 @@
 //! ramp and a complex transfer function, then depth peeling; with a scan and `--path` it measures
 //! one setting.
 
+use crate::cleanse_args::CleanseArgs;
 use crate::look::{find_preset, in_pool, LookArgs, ScanLook};
 use crate::lumen::LumenArgs;
 use crate::optics::{LensArgs, StereoArgs};
@@ -46,6 +47,8 @@ pub struct BenchArgs {
     /// DICOM: fill missing slices by interpolation (warned) instead of refusing the series.
     #[arg(long)]
     fill_missing_slices: bool,
+    #[command(flatten)]
+    cleanse: CleanseArgs,
     /// Size of the colon phantom (512 gives the paper's 512×512×478).
     #[arg(long, value_name = "N", default_value_t = 512)]
     phantom_size: usize,
@@ -587,7 +590,8 @@ fn one_setting(args: &BenchArgs, volume: &Path) -> Result<(Renderer, Vec<Pose>, 
     let mut options = OpenOptions::default();
     options.orientation.clone_from(&args.orientation);
     options.fill_missing_slices = args.fill_missing_slices;
-    let loaded = endocast_io::open(volume, &options).context("cannot read the scan")?;
+    let mut loaded = endocast_io::open(volume, &options).context("cannot read the scan")?;
+    loaded.volume = args.cleanse.apply(loaded.volume)?;
     let ScanLook { settings, look, .. } = on_path(args, &loaded.volume, &poses)?;
     let what = match look {
         Some(_) => format!("{} look", args.look.look_name()),

@@ -27,6 +27,10 @@ pub struct PhantomArgs {
     /// 0 gives a colon of folds only.
     #[arg(long, value_name = "N")]
     polyps: Option<usize>,
+    /// The colon: pools of tagged fluid (600 HU oral contrast) under the air in its sumps, with
+    /// the blurred rims of a CT, for `--cleanse on`.
+    #[arg(long)]
+    tagged_fluid: bool,
 }
 
 /// The largest phantom we agree to build (2048³ would be 16 GiB).
@@ -42,6 +46,12 @@ pub fn run(args: &PhantomArgs) -> Result<()> {
             names.join(", ")
         );
     };
+    if args.tagged_fluid && phantom != Phantom::Colon {
+        bail!(
+            "--tagged-fluid is for the colon phantom, not {}",
+            phantom.name()
+        );
+    }
     if !(8..=MAX_SIZE).contains(&args.size) {
         bail!("--size must be between 8 and {MAX_SIZE}, not {}", args.size);
     }
@@ -56,6 +66,7 @@ pub fn run(args: &PhantomArgs) -> Result<()> {
         noise_hu: args.noise,
         seed: args.seed,
         polyps: args.polyps,
+        tagged_fluid: args.tagged_fluid,
     };
     if args.polyps.is_some() && phantom != Phantom::Colon {
         bail!("--polyps applies to the colon phantom only");

@@ -10,6 +10,7 @@ use super::centreline::Centreline;
 use super::profile::{paint, ramp, AIR_HU, REACH_VOX, TISSUE_HU};
 use super::raster::{rasterize, Field};
 use super::shape::{torus, Ball};
+use super::tagged_pool::{self, Pool};
 use super::PhantomOptions;
 use crate::Volume;
 use glam::DVec3;
@@ -91,6 +92,8 @@ pub struct Colon {
     pub folds: Vec<Fold>,
     /// Polyps: tissue balls centred just outside the wall, bulging into the lumen.
     pub polyps: Vec<Ball>,
+    /// Pools of tagged fluid under the air (none unless [`PhantomOptions::tagged_fluid`]).
+    pub pools: Vec<Pool>,
     /// Voxels per millimetre of the paper-size anatomy (`size / 512`).
     scale: f64,
 }
@@ -128,6 +131,7 @@ impl Colon {
             centreline,
             folds: Vec::new(),
             polyps: Vec::new(),
+            pools: Vec::new(),
             scale,
         };
         colon.folds = colon.place_folds();
@@ -233,7 +237,8 @@ impl Field for ColonField<'_> {
         }
         let mut hu = if best_d2.is_finite() {
             let d = best_d2.sqrt() - self.colon.radius_vox_at(best_s);
-            ramp(d, AIR_HU, TISSUE_HU)
+            let lumen = Pool::lumen_hu(&self.colon.pools, AIR_HU, p.y, best_s);
+            ramp(d, lumen, TISSUE_HU)
         } else {
             TISSUE_HU
         };
@@ -351,7 +356,8 @@ impl<'a> ColonField<'a> {
     }
 }
 
-/// A `size × size × (size · 478 / 512)` volume of tissue holding the colon's air lumen.
+/// A `size × size × (size · 478 / 512)` volume of tissue holding the colon's air lumen, with
+/// pools of tagged fluid when the options ask for them.
 pub fn colon(options: &PhantomOptions) -> (Volume, Colon) {
     let (dims, truth) = layout(options);
     (raster(&truth, dims, options), truth)
@@ -369,10 +375,15 @@ pub(super) fn raster(truth: &Colon, dims: [usize; 3], options: &PhantomOptions) 
     rasterize(dims, options, &ColonField::new(truth, dims))
 }
 
-/// The grid and the colon's layout (with its five polyps) for `options`.
+/// The grid and the colon's layout (with its five polyps, and its pools of tagged fluid when
+/// `options` ask for them) for `options`.
 pub(crate) fn layout(options: &PhantomOptions) -> ([usize; 3], Colon) {
     let (dims, scale) = grid(options);
-    (dims, Colon::new(dims, scale))
+    let mut truth = Colon::new(dims, scale);
+    if options.tagged_fluid {
+        truth.pools = tagged_pool::place(&truth);
+    }
+    (dims, truth)
 }
 
 /// The uniform cubic B-spline of the control polygon `control`, densely sampled. The curve does

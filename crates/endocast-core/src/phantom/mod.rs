@@ -43,6 +43,7 @@ mod shape;
 mod sinus;
 mod sphere_shell;
 mod straight_tube;
+mod tagged_pool;
 mod vessel;
 
 pub use centreline::Centreline;
@@ -57,6 +58,7 @@ pub use shape::Ball;
 pub use sinus::{sinus, Cavity, Septum, Sinus};
 pub use sphere_shell::{sphere_shell, SphereShell};
 pub use straight_tube::{straight_tube, Tube};
+pub use tagged_pool::{Pool, TAGGED_FLUID_HU};
 pub use vessel::{vessel, Stent, Vessel};
 
 #[cfg(test)]
@@ -188,6 +190,9 @@ pub struct PhantomOptions {
     /// see [`colon_polyps`]) instead of its five fixed ones; `Some(0)` gives folds only.
     /// Default `None`.
     pub polyps: Option<usize>,
+    /// The colon: pools of tagged fluid (oral contrast) under the air in its sumps, for
+    /// electronic cleansing. Other phantoms ignore it. Default false.
+    pub tagged_fluid: bool,
 }
 
 impl Default for PhantomOptions {
@@ -197,6 +202,7 @@ impl Default for PhantomOptions {
             noise_hu: 0.0,
             seed: 1,
             polyps: None,
+            tagged_fluid: false,
         }
     }
 }
