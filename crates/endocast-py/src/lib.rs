@@ -16,6 +16,7 @@ mod kwargs;
 mod look;
 mod navigate;
 mod render;
+mod route;
 mod scene;
 mod volume;
 

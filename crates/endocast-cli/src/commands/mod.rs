@@ -9,6 +9,7 @@ mod fly_coverage;
 pub mod info;
 pub mod mesh;
 pub mod path;
+mod path_target;
 pub mod phantom;
 pub mod presets;
 pub mod render;
