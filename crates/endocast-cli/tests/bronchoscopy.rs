@@ -7,7 +7,8 @@
 //! (DICOM patient coordinates) of that component's voxels in one axial slice and one region:
 //! the trachea's section at z = 39.5; the right and left main bronchi's sections at z = −8.5
 //! and −16.5; the two thin branches that leave them upwards (x < −45 mm on the right, x > 33 mm
-//! on the left, in the slices above z = −14 and −26): the upper lobe bronchi; and the two
+//! on the left, in the slices above z = −14 and −26), at their widest sections (z = −10.5 and
+//! −22.5): the upper lobe bronchi; and the two
 //! branches that run on down (z < −38 mm): the lower lobe bronchi. A coronal projection of the
 //! component shows the same tree.
 
@@ -19,8 +20,8 @@ const MEASURED: [(&str, [f64; 3]); 7] = [
     ("trachea", [-12.6, 70.0, 39.5]),
     ("right main bronchus", [-32.3, 69.5, -8.5]),
     ("left main bronchus", [4.9, 73.6, -16.5]),
-    ("right upper lobe bronchus", [-56.6, 63.5, -0.5]),
-    ("left upper lobe bronchus", [45.9, 69.4, -0.5]),
+    ("right upper lobe bronchus", [-52.5, 65.7, -10.5]),
+    ("left upper lobe bronchus", [36.9, 71.0, -22.5]),
     ("right lower lobe bronchus", [-52.3, 71.4, -52.5]),
     ("left lower lobe bronchus", [48.0, 84.6, -44.5]),
 ];
@@ -83,7 +84,7 @@ fn the_chest_ct_tree_is_labelled_and_routes_reach_targets_beside_it() {
     // A target in the lung (−410 HU) 8 mm anterior to the left lower lobe bronchus's last
     // section (52.0, 87.2, −50.5): a thinner scope ends as near or nearer.
     let nodule = [52.0, 79.2, -50.5];
-    let reports: Vec<Value> = [2.0, 4.9, 7.0].map(|d| route(chest, nodule, d)).into();
+    let reports: Vec<Value> = [1.0, 4.9, 7.0].map(|d| route(chest, nodule, d)).into();
     let remaining: Vec<f64> = reports
         .iter()
         .map(|r| r["remaining_mm"].as_f64().unwrap())

@@ -71,10 +71,11 @@ pub struct AirwayTree {
 }
 
 impl AirwayTree {
-    /// The tree of `lumen` (the airways found in `volume`, with their distance `field`) from its
-    /// seed, which lies at the trachea's top (see [`super::find_trachea`]).
+    /// The tree of `lumen` (the airways found in `volume`, with their distance `field`) from the
+    /// widest voxel near its seed, which lies at the trachea's top (see [`super::find_trachea`]).
     pub fn new(volume: &Volume, lumen: &Lumen, field: &DistanceField) -> Self {
-        let nodes = skeleton::skeletonise(volume, lumen, field, lumen.seed());
+        let root = skeleton::root_near(lumen, field, lumen.seed());
+        let nodes = skeleton::skeletonise(volume, lumen, field, root);
         let runs = branches::runs(&nodes);
         let labels = label::label(&nodes, &runs);
         let diameter = |node: &Node| diameter_mm(volume, field, node);
