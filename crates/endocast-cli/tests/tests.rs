@@ -4,6 +4,7 @@
 
 mod annotate;
 mod bad_input;
+mod bronchoscopy;
 mod common;
 mod default_views;
 mod info_shared_data;

@@ -18,6 +18,7 @@ mod matching;
 mod navigate;
 mod polyps;
 mod render;
+mod route;
 mod scene;
 mod volume;
 

@@ -4,20 +4,18 @@
 use crate::errors::{error, to_py};
 use crate::kwargs::Kwargs;
 use crate::look::{find_preset, LookOptions};
+use crate::route::{RouteSummary, TargetOptions};
 use crate::volume::Volume;
 use endocast_core::path::SmoothOptions;
-use endocast_core::study::{Study, StudyPathError, StudyRequest};
+use endocast_core::study::{Study, StudyPath, StudyPathError, StudyRequest};
 use glam::DVec3;
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 
 /// A point in LPS mm, as (x, y, z).
 type Point = (f64, f64, f64);
-
-/// A path's points (N, 3) and radii (N,).
-type PathArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// The centred path through the lumen from `start` (LPS mm; or `start_voxel`, an index) to
 /// `end` (or `end_voxel`), as `endocast path` plans it and writes it. Without a start, the
@@ -28,6 +26,14 @@ type PathArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 /// `preset`, `iso` (the wall, in the scan's units: the lumen threshold follows it),
 /// `lumen_threshold`, `bright_lumen`, `smoothing` (control point spacing, mm, default 5) and
 /// `step`.
+///
+/// With `target` (LPS mm, a nodule) and the bronchoscopy preset, the path is the bronchoscope's
+/// route from the trachea through airways at least `scope_diameter` wide (mm, default 4.9) to
+/// the reachable centreline point nearest the target, as `endocast path --target` plans it, and
+/// a third element is returned: a dict with `target`, `scope_diameter_mm`, `end`,
+/// `remaining_mm` (from the end to the target), `narrowest_diameter_mm` (None where only the
+/// scan's border limits it) and `branches` (the branches passed, each a dict of `name` and
+/// `generation`).
 #[pyfunction]
 #[pyo3(signature = (volume, start = None, end = None, **options))]
 pub fn path<'py>(
@@ -36,7 +42,7 @@ pub fn path<'py>(
     start: Option<[f64; 3]>,
     end: Option<[f64; 3]>,
     options: Option<&Bound<'py, PyDict>>,
-) -> PyResult<PathArrays<'py>> {
+) -> PyResult<Bound<'py, PyTuple>> {
     let kw = Kwargs::new(py, "path", options)?;
     let volume = volume.get().volume();
     let start_voxel = kw.take::<[f64; 3]>("start_voxel")?;
@@ -53,7 +59,11 @@ pub fn path<'py>(
     };
     let smoothing = kw.take::<f64>("smoothing")?.unwrap_or(5.0);
     let step = kw.take::<f64>("step")?.unwrap_or(2.0);
+    let target = TargetOptions::take(&kw)?;
     kw.finish()?;
+    if target.is_some() && (start.is_some() || end.is_some()) {
+        return Err(error("give target, or start and end, not both"));
+    }
     let world = |p: Option<[f64; 3]>, v: Option<[f64; 3]>, name: &str| match (p, v) {
         (Some(_), Some(_)) => Err(error(format!("give {name} or {name}_voxel, not both"))),
         (Some(p), None) => Ok(Some(DVec3::from(p))),
@@ -67,8 +77,13 @@ pub fn path<'py>(
         step_mm: 0.5,
         ..SmoothOptions::default()
     };
-    let (points, radii) = py.detach(|| -> PyResult<_> {
+    let (points, radii, route) = py.detach(|| -> PyResult<_> {
         let study = Study::resolve(volume, &request);
+        if let Some(target) = &target {
+            let routed = target.plan(volume, &study, &options)?;
+            let (points, radii) = sampled(&routed.path, step)?;
+            return Ok((points, radii, Some(RouteSummary::of(&routed))));
+        }
         let planned = study
             .plan(volume, start, end, &options)
             .map_err(|e| match e {
@@ -78,16 +93,33 @@ pub fn path<'py>(
                 )),
                 e => error(e.to_string()),
             })?;
-        let points = planned.planned.path.points_every(step).map_err(to_py)?;
-        let radii: Vec<f64> = points
-            .iter()
-            .map(|&p| planned.field.distance_mm(p))
-            .collect();
-        Ok((points, radii))
+        let (points, radii) = sampled(&planned, step)?;
+        Ok((points, radii, None))
     })?;
     let flat: Vec<f64> = points.iter().flat_map(|p| p.to_array()).collect();
     let points = Array2::from_shape_vec((points.len(), 3), flat).map_err(to_py)?;
-    Ok((points.into_pyarray(py), PyArray1::from_vec(py, radii)))
+    let (points, radii) = (points.into_pyarray(py), PyArray1::from_vec(py, radii));
+    match route {
+        Some(route) => PyTuple::new(
+            py,
+            [
+                points.into_any(),
+                radii.into_any(),
+                route.to_dict(py)?.into_any(),
+            ],
+        ),
+        None => PyTuple::new(py, [points.into_any(), radii.into_any()]),
+    }
+}
+
+/// A planned path's points every `step` mm and their distances to the wall.
+fn sampled(planned: &StudyPath, step: f64) -> PyResult<(Vec<DVec3>, Vec<f64>)> {
+    let points = planned.planned.path.points_every(step).map_err(to_py)?;
+    let radii = points
+        .iter()
+        .map(|&p| planned.field.distance_mm(p))
+        .collect();
+    Ok((points, radii))
 }
 
 /// The camera `render` takes when given no `eye`, the same as `endocast render`'s: for an

@@ -10,6 +10,7 @@ pub mod info;
 pub mod match_scans;
 pub mod mesh;
 pub mod path;
+mod path_target;
 pub mod phantom;
 pub mod polyps;
 pub mod presets;

@@ -1,6 +1,7 @@
 //! `endocast path`: the centred flight path through a lumen between two points (or to the
 //! farthest point), written as our path JSON or as 3D Slicer Markups (`.mrk.json`).
 
+use super::path_target;
 use crate::input::InputArgs;
 use crate::look::find_preset;
 use crate::lumen::LumenArgs;
@@ -9,7 +10,7 @@ use crate::structure;
 use crate::study_report;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
-use endocast_core::navigate::LumenChoiceError;
+use endocast_core::navigate::{LumenChoiceError, DEFAULT_SCOPE_DIAMETER_MM};
 use endocast_core::path::SmoothOptions;
 use endocast_core::study::{Study, StudyPath, StudyPathError, StudyRequest};
 use endocast_core::Volume;
@@ -58,6 +59,18 @@ pub struct PathArgs {
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
+    /// A target (a nodule), world mm: with the bronchoscopy preset, the path runs from the
+    /// trachea through the labelled airway tree, in airways at least --scope-diameter wide, to
+    /// the reachable centreline point nearest the target; --json then also lists the branches
+    /// passed (trachea, main, lobar, segmental), the distance left to the target and the
+    /// labelled tree.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          conflicts_with_all = ["from", "from_voxel", "to", "to_voxel"])]
+    target: Option<[f64; 3]>,
+    /// The bronchoscope's outer diameter for --target, mm (default 4.9: a standard adult
+    /// diagnostic bronchoscope; thin scopes are about 4, ultrathin about 3).
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_SCOPE_DIAMETER_MM, requires = "target")]
+    scope_diameter: f64,
     /// Also write the structure the preset found (tinted on the slices through the start) as
     /// a PNG; needs --preset and no --from.
     #[arg(long, value_name = "FILE.png")]
@@ -91,18 +104,26 @@ pub fn run(args: &PathArgs) -> Result<()> {
         step_mm: 0.5,
         ..SmoothOptions::default()
     };
+    let (study_path, target) = match args.target {
+        Some(t) => {
+            let routed = path_target::plan(volume, &study, t, args.scope_diameter, &options)?;
+            let target = (path_target::to_json(&routed), path_target::say(&routed));
+            (routed.path, Some(target))
+        }
+        None => (plan(volume, &study, from, to, &options)?, None),
+    };
     let StudyPath {
         lumen_voxels,
         field,
         planned,
-    } = plan(volume, &study, from, to, &options)?;
+    } = study_path;
     let seconds = clock.elapsed().as_secs_f64();
     let points = planned
         .path
         .points_every(args.step)
         .with_context(|| format!("--step {}", args.step))?;
     write(&args.output, &points)?;
-    let summary = json!({
+    let mut summary = json!({
         "output": args.output,
         "points": points.len(),
         "length_mm": planned.path.len_mm(),
@@ -113,6 +134,15 @@ pub fn run(args: &PathArgs) -> Result<()> {
         "seconds": seconds,
         "study": study_report::to_json(&study),
     });
+    if let (Some((route, _)), Some(fields)) = (&target, summary.as_object_mut()) {
+        fields.extend(
+            route
+                .as_object()
+                .into_iter()
+                .flatten()
+                .map(|(k, v)| (k.clone(), v.clone())),
+        );
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
@@ -125,6 +155,9 @@ pub fn run(args: &PathArgs) -> Result<()> {
             planned.mean_radius_mm,
             seconds
         );
+        if let Some((_, line)) = &target {
+            println!("{line}");
+        }
     }
     Ok(())
 }

@@ -114,6 +114,49 @@ pub fn centreline(
         .map(|voxels| summarise(field, &voxels))
 }
 
+/// The centred paths from one lumen voxel to every other (one Dijkstra search over the whole
+/// lumen): the shortest-path tree the airway tree is skeletonised from.
+pub(crate) struct CentredPaths<'a> {
+    graph: Graph<'a>,
+    search: Search,
+}
+
+impl<'a> CentredPaths<'a> {
+    /// The centred paths through `lumen` (with its distance `field`) from voxel `start`.
+    pub(crate) fn new(
+        volume: &Volume,
+        lumen: &'a Lumen,
+        field: &'a DistanceField,
+        start: [usize; 3],
+    ) -> Self {
+        let graph = Graph::new(volume, lumen, field);
+        let search = graph.search(start, None);
+        Self { graph, search }
+    }
+
+    /// The length (mm) of the centred path to voxel number `n` (in the lumen's numbering), or
+    /// `None` when it was not reached.
+    pub(crate) fn length_mm(&self, n: usize) -> Option<f64> {
+        self.search.cost[n]
+            .is_finite()
+            .then(|| f64::from(self.search.length_mm[n]))
+    }
+
+    /// The voxel before `v` on its centred path, or `None` for the start and voxels not
+    /// reached.
+    pub(crate) fn parent(&self, v: [usize; 3]) -> Option<[usize; 3]> {
+        let n = self.graph.numbering.number(v)?;
+        let by = *self.search.came_by.get(n).filter(|&&b| b != NONE)?;
+        let o = self.graph.steps[usize::from(by)].0;
+        Some([0, 1, 2].map(|a| v[a].wrapping_add_signed(-o[a])))
+    }
+
+    /// The lumen's numbering.
+    pub(crate) fn numbering(&self) -> &LumenNumbering<'a> {
+        &self.graph.numbering
+    }
+}
+
 /// Why a point could not be placed in the lumen.
 enum Snap {
     NotFinite(f64),
@@ -341,13 +384,27 @@ impl Search {
 /// World points, length and distances to the wall of a voxel path.
 fn summarise(field: &DistanceField, voxels: &[[usize; 3]]) -> CentrelinePath {
     let points_mm: Vec<DVec3> = voxels.iter().map(|&v| field.world_of_voxel(v)).collect();
-    let length_mm = points_mm.windows(2).map(|p| p[0].distance(p[1])).sum();
-    let distances: Vec<f64> = voxels.iter().map(|&v| field.distance_at_voxel(v)).collect();
-    CentrelinePath {
-        points_mm,
-        length_mm,
-        min_distance_mm: distances.iter().copied().fold(f64::INFINITY, f64::min),
-        mean_distance_mm: distances.iter().sum::<f64>() / distances.len().max(1) as f64,
+    CentrelinePath::through(field, points_mm)
+}
+
+impl CentrelinePath {
+    /// The raw path through `points_mm`, voxel centres of `field`'s lumen in order (each
+    /// point's distance is its nearest voxel's).
+    pub fn through(field: &DistanceField, points_mm: Vec<DVec3>) -> Self {
+        let length_mm = points_mm.windows(2).map(|p| p[0].distance(p[1])).sum();
+        let distances: Vec<f64> = points_mm
+            .iter()
+            .map(|&p| {
+                let v = field.voxel_of_world(p).round().max(DVec3::ZERO);
+                field.distance_at_voxel([v.x as usize, v.y as usize, v.z as usize])
+            })
+            .collect();
+        CentrelinePath {
+            points_mm,
+            length_mm,
+            min_distance_mm: distances.iter().copied().fold(f64::INFINITY, f64::min),
+            mean_distance_mm: distances.iter().sum::<f64>() / distances.len().max(1) as f64,
+        }
     }
 }
 

@@ -18,6 +18,7 @@
 //! Units: points are world millimetres (LPS) unless a name says `voxel`; voxel indices are
 //! `[usize; 3]` of the volume, `i` first.
 
+mod airway;
 mod aorta;
 mod axial;
 mod bit_grid;
@@ -42,6 +43,7 @@ mod trachea;
 mod upright;
 mod viewpoint;
 
+pub use airway::{AirwayBranch, AirwayRoute, AirwayTree, RouteError, DEFAULT_SCOPE_DIAMETER_MM};
 pub use aorta::{find_aorta, Aorta};
 pub use central::{CENTRAL_DEPTH_MM, CENTRAL_ML};
 pub use centreline::{
@@ -58,7 +60,7 @@ pub use nasal::{
     find_nasal_cavity, NasalCavity, FRONT_SHARE, MIN_ROUTE_MM, PASSAGE_HALF_WIDTH_MM,
     SCOPE_RADIUS_MM,
 };
-pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, PlannedPath};
+pub use plan::{plan_in, plan_path, seed_voxel, smooth_centreline, smooth_raw, PlannedPath};
 pub use preset::{preset_lumen, Central, LumenChoice, LumenChoiceError};
 pub use snap::nearest_lumen_point;
 pub use trachea::find_trachea;

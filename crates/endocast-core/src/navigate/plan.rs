@@ -72,6 +72,16 @@ pub fn smooth_centreline(
     options: &SmoothOptions,
 ) -> Result<PlannedPath, NavError> {
     let raw = centreline(volume, lumen, field, start_mm, end)?;
+    smooth_raw(field, raw, options)
+}
+
+/// A raw centreline (voxel centres of `field`'s lumen) smoothed with `options` until every
+/// sample stays a quarter voxel inside the lumen (see [`smooth_centreline`]).
+pub fn smooth_raw(
+    field: &DistanceField,
+    raw: CentrelinePath,
+    options: &SmoothOptions,
+) -> Result<PlannedPath, NavError> {
     let clearance = 0.25 * field.min_spacing_mm().min(raw.min_distance_mm);
     let inside = |path: &Path| {
         path.samples()

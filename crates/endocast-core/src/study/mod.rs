@@ -28,12 +28,14 @@
 //! assert!(study.structure().unwrap().contains(eye));
 //! ```
 
+mod airway;
 mod framing;
 mod lens;
 mod options;
 mod route;
 mod start;
 
+pub use airway::{TargetPath, TargetPathError};
 pub use framing::{object_bounds, object_framing};
 pub use lens::LensOptions;
 pub use options::{named, LookOptions, OptionError, PeelOptions, ViewOptions};

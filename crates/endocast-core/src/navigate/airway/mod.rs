@@ -1,0 +1,118 @@
+//! The airway tree skeletonised and labelled by generation (trachea, main, lobar and segmental
+//! bronchi: see [`label`]), and routes through it to a target for a bronchoscope of a given
+//! diameter ([`AirwayTree::route`]).
+//!
+//! The centrelines come from the centred paths of [`super::centreline`] from the trachea's top
+//! ([`skeleton`]); a lumen diameter along them is twice the distance to the nearest wall voxel
+//! centre less half a voxel (the wall's surface lies on average half a voxel inside that centre,
+//! see [`DistanceField`]).
+
+mod body;
+mod branches;
+mod label;
+mod route;
+mod skeleton;
+#[cfg(test)]
+mod tests;
+
+pub use route::{AirwayRoute, RouteError, DEFAULT_SCOPE_DIAMETER_MM};
+
+use super::distance::DistanceField;
+use super::lumen::Lumen;
+use crate::Volume;
+use glam::DVec3;
+use skeleton::Node;
+
+/// One branch of the airway tree: the centreline from the branch point it leaves (the root, for
+/// the trachea) to the next branch point or its tip.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AirwayBranch {
+    /// Its anatomical name: "trachea", "right main bronchus", "left upper lobe bronchus",
+    /// "right lower lobe segmental bronchus", ...
+    pub name: String,
+    /// Trachea 0, main bronchi (and the bronchus intermedius) 1, lobar 2, segmental 3, ...
+    pub generation: u32,
+    /// The branch it leaves (`None` for the trachea).
+    pub parent: Option<usize>,
+    /// Centreline voxel centres, world mm (LPS), from the branch point it leaves.
+    pub points_mm: Vec<DVec3>,
+    /// The lumen's diameter at each point, mm.
+    pub diameters_mm: Vec<f64>,
+}
+
+impl AirwayBranch {
+    /// Length of its centreline, mm.
+    pub fn length_mm(&self) -> f64 {
+        self.points_mm.windows(2).map(|w| w[0].distance(w[1])).sum()
+    }
+}
+
+/// The lumen's diameter at a centreline node, mm: twice its distance to the nearest wall voxel
+/// centre less half a voxel; infinite where the scan's border is as near as the wall (the lumen
+/// runs on out of the scan, as the trachea does at its top).
+fn diameter_mm(volume: &Volume, field: &DistanceField, node: &Node) -> f64 {
+    let spacing = volume.geometry().spacing_mm().to_array();
+    let dims = volume.dims();
+    let border_mm = (0..3)
+        .map(|a| ((node.voxel[a] + 1).min(dims[a] - node.voxel[a]) as f64) * spacing[a])
+        .fold(f64::INFINITY, f64::min);
+    if node.distance_mm >= border_mm - 1e-6 {
+        return f64::INFINITY;
+    }
+    2.0 * (node.distance_mm - 0.5 * field.min_spacing_mm()).max(0.0)
+}
+
+/// An airway tree: its branches, the trachea first, every branch after the one it leaves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AirwayTree {
+    branches: Vec<AirwayBranch>,
+    /// The lumen's threshold and side, for telling a target outside the body.
+    threshold: f64,
+}
+
+impl AirwayTree {
+    /// The tree of `lumen` (the airways found in `volume`, with their distance `field`) from the
+    /// widest voxel near its seed, which lies at the trachea's top (see [`super::find_trachea`]).
+    pub fn new(volume: &Volume, lumen: &Lumen, field: &DistanceField) -> Self {
+        let root = skeleton::root_near(lumen, field, lumen.seed());
+        let nodes = skeleton::skeletonise(volume, lumen, field, root);
+        let runs = branches::runs(&nodes);
+        let labels = label::label(&nodes, &runs);
+        let diameter = |node: &Node| diameter_mm(volume, field, node);
+        let branches = runs
+            .into_iter()
+            .zip(labels)
+            .map(|(run, (name, generation))| AirwayBranch {
+                name,
+                generation,
+                parent: run.parent,
+                points_mm: run.nodes.iter().map(|&n| nodes[n].point_mm).collect(),
+                diameters_mm: run.nodes.iter().map(|&n| diameter(&nodes[n])).collect(),
+            })
+            .collect();
+        Self {
+            branches,
+            threshold: lumen.threshold(),
+        }
+    }
+
+    /// The branches, the trachea first, every branch after the one it leaves.
+    pub fn branches(&self) -> &[AirwayBranch] {
+        &self.branches
+    }
+
+    /// The branches from the trachea down to branch `b`, in order.
+    pub fn lineage(&self, b: usize) -> Vec<usize> {
+        let mut line = vec![b];
+        while let Some(p) = self.branches[line[line.len() - 1]].parent {
+            line.push(p);
+        }
+        line.reverse();
+        line
+    }
+
+    /// The first branch named `name`.
+    pub fn find(&self, name: &str) -> Option<&AirwayBranch> {
+        self.branches.iter().find(|b| b.name == name)
+    }
+}
