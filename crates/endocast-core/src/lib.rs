@@ -16,6 +16,7 @@ pub mod animation;
 pub mod annotate;
 pub mod camera;
 pub mod coverage;
+pub mod dissect;
 pub mod flight;
 pub mod geometry;
 pub mod isosurface;
