@@ -43,6 +43,9 @@ enum Command {
     /// The wall a flight missed, as patches with their area, centroid and a camera that sees
     /// each (JSON with --json), their views (--views) and the coverage before and after them.
     Coverage(Box<commands::coverage::CoverageArgs>),
+    /// Virtual dissection: the lumen cut open along its path and laid flat (length × angle)
+    /// to a PNG with a mm scale, and NAME.map.npy, each pixel's 3D wall point (LPS mm).
+    Dissect(Box<commands::dissect::DissectArgs>),
     /// List the procedure presets: mode, transfer function, isovalues, lumen, slice window, lens.
     Presets(commands::presets::PresetsArgs),
     /// The lumen's wall (an isosurface) as a triangle mesh: STL, OBJ or PLY in world mm.
@@ -71,6 +74,7 @@ fn main() -> ExitCode {
         Command::Fly(args) => commands::fly::run(&args),
         Command::View(args) => commands::view::run(&args),
         Command::Coverage(args) => commands::coverage::run(&args),
+        Command::Dissect(args) => commands::dissect::run(&args),
         Command::Mesh(args) => commands::mesh::run(&args),
         Command::Annotate(args) => commands::annotate::run(&args),
     };

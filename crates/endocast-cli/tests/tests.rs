@@ -6,6 +6,7 @@ mod annotate;
 mod bad_input;
 mod common;
 mod default_views;
+mod dissect;
 mod info_shared_data;
 mod integrity;
 mod look;
