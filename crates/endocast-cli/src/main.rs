@@ -47,6 +47,9 @@ enum Command {
     /// Polyp candidates on the wall of the colon (or the lumen a path starts in) by shape
     /// index and curvedness: listed (JSON with --json), viewed (--thumbnails), added to a case.
     Polyps(Box<commands::polyps::PolypsArgs>),
+    /// Virtual dissection: the lumen cut open along its path and laid flat (length × angle)
+    /// to a PNG with a mm scale, and NAME.map.npy, each pixel's 3D wall point (LPS mm).
+    Dissect(Box<commands::dissect::DissectArgs>),
     /// List the procedure presets: mode, transfer function, isovalues, lumen, slice window, lens.
     Presets(commands::presets::PresetsArgs),
     /// The lumen's wall (an isosurface) as a triangle mesh: STL, OBJ or PLY in world mm.
@@ -79,6 +82,7 @@ fn main() -> ExitCode {
         Command::View(args) => commands::view::run(&args),
         Command::Coverage(args) => commands::coverage::run(&args),
         Command::Polyps(args) => commands::polyps::run(&args),
+        Command::Dissect(args) => commands::dissect::run(&args),
         Command::Mesh(args) => commands::mesh::run(&args),
         Command::Annotate(args) => commands::annotate::run(&args),
         Command::Match(args) => commands::match_scans::run(&args),

@@ -7,6 +7,7 @@ mod bad_input;
 mod bronchoscopy;
 mod common;
 mod default_views;
+mod dissect;
 mod info_shared_data;
 mod integrity;
 mod look;

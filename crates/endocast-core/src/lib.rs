@@ -18,6 +18,7 @@ pub mod camera;
 pub mod cleanse;
 pub mod correspond;
 pub mod coverage;
+pub mod dissect;
 pub mod flight;
 pub mod geometry;
 pub mod isosurface;

@@ -95,7 +95,26 @@ pub fn write_png_rgba8(path: &Path, width: u32, height: u32, pixels: &[u8]) -> R
 /// `width·height` samples; NaN and infinities are stored as they are.
 pub fn write_npy_f32(path: &Path, width: u32, height: u32, values: &[f32]) -> Result<()> {
     check_len(path, width, height, 1, values.len())?;
-    let header = npy_header(width, height);
+    write_npy(path, &format!("({height}, {width})"), values)
+}
+
+/// Writes a `height × width × channels` float32 array as a NumPy `.npy` file, as
+/// [`write_npy_f32`] does (e.g. a wall point in mm per pixel: `numpy.load(path)[row, column]`
+/// is its `channels` values). `values` holds `width·height·channels` samples.
+pub fn write_npy_f32_channels(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: u32,
+    values: &[f32],
+) -> Result<()> {
+    check_len(path, width, height, channels as usize, values.len())?;
+    write_npy(path, &format!("({height}, {width}, {channels})"), values)
+}
+
+/// Writes `values` under the `.npy` header of an array of `shape` (a Python tuple literal).
+fn write_npy(path: &Path, shape: &str, values: &[f32]) -> Result<()> {
+    let header = npy_header(shape);
     write_file(path, |w| {
         w.write_all(&header)?;
         // Converted in rows so a large image does not need a second full-size byte buffer.
@@ -112,19 +131,19 @@ pub fn write_npy_f32(path: &Path, width: u32, height: u32, values: &[f32]) -> Re
 /// The 8 bytes every `.npy` file starts with: the magic string and format version 1.0.
 const NPY_MAGIC: &[u8; 8] = b"\x93NUMPY\x01\x00";
 
-/// The `.npy` 1.0 preamble for a little-endian float32 `(height, width)` array: magic, header
-/// length (u16 LE), then the Python dict literal padded with spaces and ended by a newline so
-/// that the data starts at a multiple of 64 bytes, as the format asks for aligned reads.
-fn npy_header(width: u32, height: u32) -> Vec<u8> {
-    let dict =
-        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({height}, {width}), }}");
+/// The `.npy` 1.0 preamble for a little-endian float32 array of `shape` (a tuple literal such
+/// as `(480, 640)`): magic, header length (u16 LE), then the Python dict literal padded with
+/// spaces and ended by a newline so that the data starts at a multiple of 64 bytes, as the
+/// format asks for aligned reads.
+fn npy_header(shape: &str) -> Vec<u8> {
+    let dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape}, }}");
     // magic (8) + length field (2) + dict + at least the newline, rounded up to 64.
     let unpadded = NPY_MAGIC.len() + 2 + dict.len() + 1;
     let total = unpadded.div_ceil(64) * 64;
     let header_len = total - NPY_MAGIC.len() - 2;
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(NPY_MAGIC);
-    // Two u32 dimensions print in at most ~70 characters, so the length fits a u16 easily.
+    // Three u32 dimensions print in at most ~70 characters, so the length fits a u16 easily.
     out.extend_from_slice(&(header_len as u16).to_le_bytes());
     out.extend_from_slice(dict.as_bytes());
     out.resize(total - 1, b' ');
@@ -219,7 +238,7 @@ mod tests {
 
     #[test]
     fn npy_header_is_exact_and_aligned() {
-        let h = npy_header(640, 480);
+        let h = npy_header("(480, 640)");
         let dict = b"{'descr': '<f4', 'fortran_order': False, 'shape': (480, 640), }";
         assert_eq!(h.len(), 128);
         assert_eq!(&h[..8], NPY_MAGIC);
@@ -228,7 +247,8 @@ mod tests {
         assert!(h[10 + dict.len()..127].iter().all(|&b| b == b' '));
         assert_eq!(h[127], b'\n');
         // NumPy's own writer also pads the smallest shape to 128 bytes.
-        assert_eq!(npy_header(1, 1).len(), 128);
+        assert_eq!(npy_header("(1, 1)").len(), 128);
+        assert_eq!(npy_header("(4096, 4096, 3)").len() % 64, 0);
     }
 
     #[test]

@@ -4,6 +4,7 @@ pub mod annotate;
 pub mod bench;
 pub mod convert;
 pub mod coverage;
+pub mod dissect;
 pub mod fly;
 mod fly_coverage;
 pub mod info;

@@ -301,7 +301,7 @@ impl Path {
 
     /// Tangent and up at arc `s` (within the path), interpolated between the two samples around
     /// it: consecutive frames differ by a small rotation, so a normalised blend is accurate.
-    fn frame_at(&self, s: f64) -> PathSample {
+    pub fn frame_at(&self, s: f64) -> PathSample {
         let step = self.options.step_mm;
         let k = ((s / step).floor() as usize).min(self.samples.len() - 1);
         let a = self.samples[k];
