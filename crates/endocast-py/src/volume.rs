@@ -68,6 +68,7 @@ impl Volume {
     cleanse = false,
 ))]
 #[allow(clippy::needless_pass_by_value)] // PyO3 hands arguments over by value.
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, each optional.
 pub fn open(
     py: Python<'_>,
     path: PathBuf,

@@ -44,7 +44,7 @@ fn rays_into_pools(colon: &Colon) -> Vec<(DVec3, DVec3)> {
     for pool in &colon.pools {
         let (a, b) = pool.arc_vox;
         for n in 0..12 {
-            let s = a + (b - a) * (1.0 + n as f64) / 13.0 * 0.33 + (b - a) / 3.0;
+            let s = a + (b - a) * (1.0 + f64::from(n)) / 13.0 * 0.33 + (b - a) / 3.0;
             let tangent = line.tangent_at(s);
             let down = (DVec3::Y - tangent * tangent.y).normalize();
             let side = tangent.cross(down);
@@ -153,7 +153,7 @@ fn a_prone_scan_has_its_pools_on_the_other_side_and_an_mr_is_refused() {
         *wet.geometry(),
         wet.voxels().to_vec(),
         wet.value_map(),
-        crate::Modality::from_code("MR"),
+        Modality::from_code("MR"),
     )
     .unwrap();
     assert_eq!(cleanse(&mr).unwrap_err(), CleanseError::NotHounsfield);

@@ -119,7 +119,7 @@ fn along_axis(image: &mut Image, plot: &Plot, mm_per_px: f64) {
 /// Ticks and degree labels left of the plot: 0° is the frames' up vector, 90° their right.
 fn around_axis(image: &mut Image, plot: &Plot) {
     for degrees in [0, 90, 180, 270, 360] {
-        let y = plot.y as i64 + (degrees as f64 / 360.0 * plot.rows as f64).round() as i64;
+        let y = plot.y as i64 + (f64::from(degrees) / 360.0 * plot.rows as f64).round() as i64;
         let left = plot.x as i64;
         image.line(
             ((left - TICK) as f64, y as f64),

@@ -90,7 +90,7 @@ fn rings_of_a_straight_tube_lie_on_columns_and_the_map_on_its_wall() {
     let rings = [10.0, 24.0, 37.5];
     let volume = phantom(64, &tube, &rings);
     let axis: Vec<DVec3> = (0..=8)
-        .map(|n| DVec3::new(0.0, 0.0, -24.0 + 6.0 * n as f64))
+        .map(|n| DVec3::new(0.0, 0.0, -24.0 + 6.0 * f64::from(n)))
         .collect();
     let path = Path::from_points_exact(&axis, 0.5).unwrap();
     check(&volume, &path, &tube, &rings, 0.0);
@@ -109,7 +109,7 @@ fn rings_of_a_curved_tube_lie_on_columns_and_the_map_on_its_wall() {
     let volume = phantom(72, &tube, &rings);
     let (first, last) = (0.5, 4.5);
     let axis: Vec<DVec3> = (0..=80)
-        .map(|n| first + (last - first) * n as f64 / 80.0)
+        .map(|n| first + (last - first) * f64::from(n) / 80.0)
         .map(|a: f64| AXIS_MM * DVec3::new(a.cos(), 0.0, a.sin()))
         .collect();
     let path = Path::from_points_exact(&axis, 0.5).unwrap();
@@ -120,7 +120,7 @@ fn rings_of_a_curved_tube_lie_on_columns_and_the_map_on_its_wall() {
 fn rays_inside_a_tight_bend_stop_where_the_next_column_cuts_them() {
     // A circle of radius 5 mm: every cutting plane holds the circle's axis, 5 mm from the path.
     let points: Vec<DVec3> = (0..=40)
-        .map(|n| 5.0 * DVec3::new((n as f64 * 0.1).cos(), 0.0, (n as f64 * 0.1).sin()))
+        .map(|n| 5.0 * DVec3::new((f64::from(n) * 0.1).cos(), 0.0, (f64::from(n) * 0.1).sin()))
         .collect();
     let path = Path::from_points_exact(&points, 0.5).unwrap();
     let columns = rays::columns(&path, 20, 0.5);
