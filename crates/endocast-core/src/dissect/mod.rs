@@ -156,19 +156,36 @@ pub fn dissect(
     let columns = rays::columns(path, columns, step_mm);
     let caster = Caster::new(volume, wall.iso, wall.color);
     let rows = options.rows;
-    let hits: Vec<Vec<Option<cast::Hit>>> = (0..columns.len())
-        .into_par_iter()
-        .map(|i| {
-            let reaches = rays::reaches(&columns, i, rows, options.reach_mm);
-            let column = &columns[i];
+    // Every ray to the wall first, then each hit kept where no neighbouring fan is crossed
+    // on the way (the clamp of `rays::reaches`, which needs the fans' walls).
+    let mut hits: Vec<Vec<Option<cast::Hit>>> = columns
+        .par_iter()
+        .map(|column| {
             (0..rows)
                 .map(|row| {
                     let dir = rays::direction(column, rays::angle(row, rows));
-                    caster.cast(column.origin, dir, reaches[row])
+                    caster.cast(column.origin, dir, options.reach_mm)
                 })
                 .collect()
         })
         .collect();
+    let walls: Vec<Vec<f64>> = columns
+        .iter()
+        .zip(&hits)
+        .map(|(c, column)| {
+            let distance =
+                |h: &Option<cast::Hit>| h.map_or(f64::INFINITY, |h| h.point.distance(c.origin));
+            column.iter().map(distance).collect()
+        })
+        .collect();
+    hits.par_iter_mut().enumerate().for_each(|(i, column)| {
+        let reaches = rays::reaches(&columns, i, options.reach_mm, &walls);
+        for ((hit, wall), reach) in column.iter_mut().zip(&walls[i]).zip(reaches) {
+            if *wall > reach {
+                *hit = None;
+            }
+        }
+    });
     lay_flat(&columns, &hits, step_mm, wall.iso)
 }
 

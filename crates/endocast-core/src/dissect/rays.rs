@@ -65,23 +65,38 @@ pub(super) fn direction(column: &Column, angle: f64) -> DVec3 {
 /// reaches it at `r = offset / (d · tangent)`.
 #[derive(Debug, Clone, Copy)]
 struct Crossing {
+    /// The other column's index.
+    column: usize,
     /// `(other origin − origin) · other tangent`, mm.
     offset: f64,
     /// The other tangent, which a ray's direction is dotted with.
     tangent: DVec3,
 }
 
+/// Whether `point` (on `column`'s cutting plane) lies inside `column`'s fan: nearer its origin
+/// than the wall along the fan's ray toward it (`walls`: each row's distance to the wall, mm,
+/// infinite where its ray met none).
+fn in_fan(column: &Column, walls: &[f64], point: DVec3) -> bool {
+    let v = point - column.origin;
+    let turn = v.dot(column.right).atan2(v.dot(column.up)).rem_euclid(TAU);
+    let row = ((turn / TAU * walls.len() as f64) as usize).min(walls.len() - 1);
+    v.length() < walls[row]
+}
+
 /// The reach of each of the `rows` rays of column `i`, mm: `reach_mm`, or less where the ray
-/// first meets the cutting plane of a column within `2 · reach_mm` of arc (see the module
-/// documentation). Columns further apart along the path meet within the reach only where the
-/// path comes back on itself, and the lumen's wall lies between the two passes.
-pub(super) fn reaches(columns: &[Column], i: usize, rows: usize, reach_mm: f64) -> Vec<f64> {
+/// first meets the cutting plane of a column within `2 · reach_mm` of arc inside that column's
+/// fan (see the module documentation). `walls[j][row]` is the distance from column `j` to the
+/// wall along its ray `row` (infinite where none): a plane crossed beyond the other column's
+/// wall (a far column of a path that comes back on itself, with tissue between the passes) does
+/// not clamp.
+pub(super) fn reaches(columns: &[Column], i: usize, reach_mm: f64, walls: &[Vec<f64>]) -> Vec<f64> {
     let own = columns[i];
     let crossings: Vec<Crossing> = columns
         .iter()
         .enumerate()
         .filter(|&(j, c)| j != i && (c.arc_mm - own.arc_mm).abs() <= 2.0 * reach_mm)
-        .map(|(_, c)| Crossing {
+        .map(|(column, c)| Crossing {
+            column,
             offset: (c.origin - own.origin).dot(c.tangent),
             tangent: c.tangent,
         })
@@ -91,12 +106,14 @@ pub(super) fn reaches(columns: &[Column], i: usize, rows: usize, reach_mm: f64) 
             c.offset.abs() < reach_mm * in_plane
         })
         .collect();
+    let rows = walls[i].len();
     (0..rows)
         .map(|row| {
             let d = direction(&own, angle(row, rows));
             crossings.iter().fold(reach_mm, |reach, c| {
                 let r = c.offset / d.dot(c.tangent);
-                if r > 0.0 && r < reach {
+                let at = own.origin + d * r;
+                if r > 0.0 && r < reach && in_fan(&columns[c.column], &walls[c.column], at) {
                     r
                 } else {
                     reach

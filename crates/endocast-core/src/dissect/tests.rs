@@ -124,7 +124,9 @@ fn rays_inside_a_tight_bend_stop_where_the_next_column_cuts_them() {
         .collect();
     let path = Path::from_points_exact(&points, 0.5).unwrap();
     let columns = rays::columns(&path, 20, 0.5);
-    let reaches = rays::reaches(&columns, 10, 36, 20.0);
+    // In open space every fan reaches everywhere: every plane crossed clamps.
+    let walls = vec![vec![f64::INFINITY; 36]; columns.len()];
+    let reaches = rays::reaches(&columns, 10, 20.0, &walls);
     let column = &columns[10];
     for (row, reach) in reaches.iter().enumerate() {
         let d = rays::direction(column, rays::angle(row, 36));
