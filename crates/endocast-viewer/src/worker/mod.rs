@@ -228,9 +228,12 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
     let mut scene = SceneRef::default();
     let mut planner = PreviewPlanner::default();
     let mut look_pass = LookPass::default();
+    // Read once: the memory limit comes from /proc and the cgroup files.
+    let limits = Limits::default();
     let mut warned = false;
     while let Some(request) = next_request(shared) {
-        let still_filter = still_filter(renderer, request.view.still_filter, &mut warned);
+        let requested = request.view.still_filter;
+        let still_filter = still_filter(&limits, renderer, requested, &mut warned);
         if let Some(look) = &request.view.look {
             let superseded = || shared.generation.load(Ordering::Acquire) != request.generation;
             let deliver = deliverer(shared, &request);
@@ -269,10 +272,15 @@ fn run(shared: &Shared, renderer: &Arc<Renderer>) {
 }
 
 /// The filter of the stills of a standing view: `requested`, or trilinear (and a warning, the
-/// first time, `warned` after it) where the B-spline's coefficients would not fit the memory.
-fn still_filter(renderer: &Renderer, requested: Filter, warned: &mut bool) -> Filter {
+/// first time, `warned` after it) where the B-spline's coefficients would not fit `limits`.
+fn still_filter(
+    limits: &Limits,
+    renderer: &Renderer,
+    requested: Filter,
+    warned: &mut bool,
+) -> Filter {
     let voxels = renderer.volume().voxels().len();
-    let (filter, warning) = Limits::default().still_filter(requested, voxels);
+    let (filter, warning) = limits.still_filter(requested, voxels);
     if let Some(warning) = warning.filter(|_| !*warned) {
         eprintln!("warning: {warning}");
         *warned = true;
