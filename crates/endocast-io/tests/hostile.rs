@@ -84,6 +84,25 @@ fn an_element_longer_than_the_file_is_refused_before_any_allocation() {
     assert!(start.elapsed() < Duration::from_secs(1));
 }
 
+/// A data set in implicit VR under a meta group that says explicit VR (found by the fuzzer):
+/// dicom-rs's explicit decoder would take the first element's VR bytes "S\x01" as UN, and a
+/// later element's bytes as a 3 758 161 918-byte length, and reserve it. Such a file is read
+/// by the adaptive decoder only, which finds the sequence's first item corrupt.
+#[test]
+fn an_implicit_data_set_under_an_explicit_meta_group_is_never_read_as_explicit() {
+    let mut bytes = meta(EXPLICIT_LE);
+    // (0008,1140) SQ, implicit length 339; as explicit VR: "S\x01" (UN), length 0, then
+    // (5104,0000) with VR FF FF and length 0xE000FFFE.
+    bytes.extend_from_slice(&[0x08, 0x00, 0x40, 0x11, 0x53, 0x01, 0x00, 0x00]);
+    bytes.extend_from_slice(&[0, 0, 0, 0, 0x04, 0x51, 0, 0, 0xFF, 0xFF, 0xFF, 0xFF]);
+    bytes.extend_from_slice(&[0xFE, 0xFF, 0x00, 0xE0]);
+    bytes.resize(bytes.len() + 339 - 16, 0);
+    let (_dir, path) = file_with("implicit-under-explicit.dcm", &bytes);
+    let start = Instant::now();
+    refused(read_dicom(&path), &path, &["read as implicit VR", "item header"]);
+    assert!(start.elapsed() < Duration::from_secs(1));
+}
+
 /// An RLE header of `segments` segments for fragments of 2-byte samples.
 fn rle_fragment(segments: &[Vec<u8>]) -> Vec<u8> {
     let mut data = vec![0u8; 64];

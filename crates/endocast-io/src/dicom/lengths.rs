@@ -14,6 +14,7 @@
 //! of padding (raw deflate has no checksum, so its end and length are what can be checked), and
 //! the inflated elements are then walked like those of any other file.
 
+use super::open::Body;
 use crate::compressed;
 use crate::error::{ReadError, Result};
 use flate2::bufread::DeflateDecoder;
@@ -62,16 +63,18 @@ struct Walker<R> {
 
 /// Where a walk stopped.
 enum Walked {
-    /// At the end of the file: every length fits.
-    End,
+    /// At the end of the file: every length fits, in a data set encoded as given.
+    End(Body),
     /// At the start of a deflated data set (byte offset), after the file meta group.
     Deflated(u64),
 }
 
 /// Checks that every defined element, item and fragment length in the file at `path` fits in the
 /// bytes that follow it; a deflated data set is inflated (at most `max_inflated` bytes), its
-/// stream checked to its end, and its lengths checked against the inflated bytes.
-pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()> {
+/// stream checked to its end, and its lengths checked against the inflated bytes. Returns how
+/// the data set is encoded: [`Body::Implicit`] when its meta group says explicit VR little
+/// endian but its first element has no valid VR (then only the adaptive decoder may read it).
+pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<Body> {
     let file = File::open(path).map_err(|e| ReadError::io(path, e))?;
     let len = file.metadata().map_err(|e| ReadError::io(path, e))?.len();
     let mut w = Walker {
@@ -96,8 +99,11 @@ pub(super) fn check_element_lengths(path: &Path, max_inflated: u64) -> Result<()
         .walk()
         .map_err(|message| ReadError::format(path, message))?
     {
-        Walked::End => Ok(()),
-        Walked::Deflated(start) => check_deflated(path, w.reader.into_inner(), start, max_inflated),
+        Walked::End(body) => Ok(body),
+        Walked::Deflated(start) => {
+            check_deflated(path, w.reader.into_inner(), start, max_inflated)?;
+            Ok(Body::AsDeclared)
+        }
     }
 }
 
@@ -140,9 +146,19 @@ fn check_deflated(path: &Path, mut file: File, start: u64, max_inflated: u64) ->
         open: Vec::new(),
         implicit_from: None,
     };
-    w.walk()
-        .map(|_| ())
-        .map_err(|message| ReadError::format(path, format!("in the inflated data set: {message}")))
+    match w.walk() {
+        Ok(Walked::End(Body::AsDeclared)) => Ok(()),
+        // dicom-rs's deflate reader has no adaptive decoder: it would take the first element's
+        // missing VR as UN and the next bytes as a length of any size.
+        Ok(_) => Err(ReadError::format(
+            path,
+            "the inflated data set's first element has no valid VR: the file is corrupt",
+        )),
+        Err(message) => Err(ReadError::format(
+            path,
+            format!("in the inflated data set: {message}"),
+        )),
+    }
 }
 
 /// The data set's encoding from its first element's VR bytes `vr`: a meta group saying
@@ -207,6 +223,7 @@ impl<R: Read + Seek> Walker<R> {
         let mut in_fragments = false;
         // Whether the first element of the data set is still to come.
         let mut first_of_body = true;
+        let mut body = Body::AsDeclared;
         while self.pos + 8 <= self.len {
             self.close_ended();
             let start = self.pos;
@@ -221,7 +238,11 @@ impl<R: Read + Seek> Walker<R> {
                 start < meta_end
             };
             if !in_meta && std::mem::take(&mut first_of_body) {
-                encoding = body_encoding(encoding, [head[4], head[5]]);
+                let found = body_encoding(encoding, [head[4], head[5]]);
+                if found != encoding {
+                    body = Body::Implicit;
+                }
+                encoding = found;
             }
             let current = match (in_meta, encoding) {
                 (true, _) => Encoding::ExplicitLittle,
@@ -263,7 +284,7 @@ impl<R: Read + Seek> Walker<R> {
             }
         }
         Ok(match encoding {
-            Some(_) => Walked::End,
+            Some(_) => Walked::End(body),
             // A deflated data set that is empty (or a meta group cut short): inflating it fails.
             None => Walked::Deflated(self.pos),
         })

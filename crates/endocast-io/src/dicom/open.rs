@@ -1,8 +1,11 @@
 //! Opening a DICOM file through dicom-rs, with pydicom's fallback for a data set encoded in
 //! implicit VR under a meta group that says explicit VR little endian (some converters write
-//! that): when dicom-rs's reader fails on such a file, it is read again with dicom-rs's
-//! adaptive decoder, which looks at the first element of the data set to decide, as pydicom
-//! does ("Expected explicit VR, but found implicit VR").
+//! that): the pre-flight walk ([`super::lengths`]) sees that the data set's first element has
+//! no valid VR, and such a file is read with dicom-rs's adaptive decoder only, which looks at
+//! that first element to decide, as pydicom does ("Expected explicit VR, but found implicit
+//! VR"). Its explicit decoder is never tried on it: that decoder takes the missing VR as UN and
+//! the next bytes as a 4-byte length, and reserves whatever they say (gigabytes, found by the
+//! fuzzer) before finding the file short.
 
 use crate::error::{ReadError, Result};
 use crate::guard;
@@ -20,7 +23,8 @@ use dicom_transfer_syntax_registry::TransferSyntaxRegistry;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
-/// How a file was read.
+/// How a file's data set is encoded, as the pre-flight walk found it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Body {
     /// As its transfer syntax says.
     AsDeclared,
@@ -28,8 +32,24 @@ pub(super) enum Body {
     Implicit,
 }
 
-/// The DICOM object in `path`: up to its pixel data when `header_only`, else whole.
-pub(super) fn open(path: &Path, header_only: bool) -> Result<(DefaultDicomObject, Body)> {
+/// The DICOM object in `path`, whose data set the pre-flight walk found encoded as `body`: up
+/// to its pixel data when `header_only`, else whole.
+pub(super) fn open(path: &Path, header_only: bool, body: Body) -> Result<DefaultDicomObject> {
+    if body == Body::Implicit {
+        return match guard::quietly(|| read_adaptive(path)) {
+            Ok(Ok(Some(object))) => Ok(object),
+            Ok(Ok(None)) => Err(ReadError::format(
+                path,
+                "not a readable DICOM file: its data set has no valid VR, and its transfer \
+                 syntax is not explicit VR little endian",
+            )),
+            Ok(Err(message)) => Err(ReadError::format(
+                path,
+                format!("not a readable DICOM file (read as implicit VR): {message}"),
+            )),
+            Err(panicked) => Err(ReadError::format(path, panicked.to_string())),
+        };
+    }
     let opened = guard::quietly(|| {
         let options = OpenFileOptions::new();
         let options = if header_only {
@@ -40,19 +60,11 @@ pub(super) fn open(path: &Path, header_only: bool) -> Result<(DefaultDicomObject
         options.open_file(path)
     })
     .map_err(|panicked| ReadError::format(path, panicked.to_string()))?;
-    let error = match opened {
-        Ok(object) => return Ok((object, Body::AsDeclared)),
-        Err(error) => error,
-    };
-    match guard::quietly(|| read_adaptive(path)) {
-        Ok(Ok(Some(object))) => Ok((object, Body::Implicit)),
-        _ => Err(open_error(path, &error)),
-    }
+    opened.map_err(|error| open_error(path, &error))
 }
 
 /// The whole file read with the adaptive decoder, when its transfer syntax is explicit VR
-/// little endian (native or encapsulated) and its data set turns out to be implicit VR;
-/// `None` when it is not such a file.
+/// little endian (native or encapsulated); `None` when it is not.
 fn read_adaptive(path: &Path) -> std::result::Result<Option<DefaultDicomObject>, String> {
     let mut file = BufReader::new(std::fs::File::open(path).map_err(|e| e.to_string())?);
     let mut head = [0u8; 132];
@@ -65,7 +77,7 @@ fn read_adaptive(path: &Path) -> std::result::Result<Option<DefaultDicomObject>,
         && TransferSyntaxRegistry
             .get(meta.transfer_syntax())
             .is_some_and(|ts| ts.endianness() == Endianness::Little);
-    if !explicit_le || !body_is_implicit(&mut file)? {
+    if !explicit_le {
         return Ok(None);
     }
     let decoder = StatefulDecoder::new(
@@ -76,17 +88,6 @@ fn read_adaptive(path: &Path) -> std::result::Result<Option<DefaultDicomObject>,
     );
     let object = InMemDicomObject::read_dataset(decoder).map_err(|e| chain(&e))?;
     Ok(Some(object.with_exact_meta(meta)))
-}
-
-/// Whether the first data set element at the reader's position has no valid explicit VR
-/// (the reader is left where it was).
-fn body_is_implicit(file: &mut BufReader<std::fs::File>) -> std::result::Result<bool, String> {
-    let start = file.stream_position().map_err(|e| e.to_string())?;
-    let mut head = [0u8; 6];
-    let read = file.read_exact(&mut head).is_ok();
-    file.seek(SeekFrom::Start(start))
-        .map_err(|e| e.to_string())?;
-    Ok(read && !head[4..].iter().all(u8::is_ascii_uppercase))
 }
 
 /// Turns a dicom-object open error into ours: an unknown or undecodable transfer syntax is

@@ -67,8 +67,8 @@ const PALETTE: [[f32; 3]; 6] = [
 /// a SEG or RTDOSE, a compressed transfer syntax, frames off one regular stack, pixel data
 /// shorter than the frames declared, a grid beyond `limits`.
 pub fn read_overlay(path: &Path, limits: &Limits) -> Result<Overlay> {
-    check_element_lengths(path, limits.max_voxels.saturating_mul(4))?;
-    let (object, _) = open(path, false)?;
+    let body = check_element_lengths(path, limits.max_voxels.saturating_mul(4))?;
+    let object = open(path, false, body)?;
     let syntax = object.meta().transfer_syntax.trim_end_matches('\0');
     if ![
         uids::EXPLICIT_VR_LITTLE_ENDIAN,
@@ -100,10 +100,10 @@ pub fn read_overlay(path: &Path, limits: &Limits) -> Result<Overlay> {
 /// Refuses a segmentation or dose grid given as a scan, saying how to use it; any other file
 /// (readable or not) passes, for the scan reader to judge.
 pub(super) fn refuse_as_scan(path: &Path, limits: &Limits) -> Result<()> {
-    if check_element_lengths(path, limits.max_voxels.saturating_mul(4)).is_err() {
+    let Ok(body) = check_element_lengths(path, limits.max_voxels.saturating_mul(4)) else {
         return Ok(());
-    }
-    let Ok((object, _)) = open(path, true) else {
+    };
+    let Ok(object) = open(path, true, body) else {
         return Ok(());
     };
     let what = match text(&object, tags::MODALITY).as_str() {

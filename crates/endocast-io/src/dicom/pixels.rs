@@ -303,7 +303,7 @@ pub(super) fn decode_file(
     map: &SampleMap,
 ) -> Result<(Vec<FrameStats>, Option<String>)> {
     let path = file.path.as_path();
-    let (object, _) = open::open(path, false)?;
+    let object = open::open(path, false, file.body)?;
     let pixel_data = object
         .get(tags::PIXEL_DATA)
         .ok_or_else(|| ReadError::format(path, "expected a PixelData element, found none"))?;

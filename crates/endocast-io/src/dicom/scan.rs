@@ -87,6 +87,8 @@ pub(super) struct ImageFile {
     /// For a Siemens mosaic, how its slices are tiled in the stored image (`layout` and
     /// `frames` then describe the slices, one frame per tile).
     pub mosaic: Option<Mosaic>,
+    /// How its data set is encoded (the pre-flight walk's finding, for reading it whole).
+    pub body: Body,
 }
 
 /// How samples are stored; must be the same for every file of a series.
@@ -164,15 +166,17 @@ pub(super) fn scan(path: &Path, limits: &Limits) -> Scanned {
     }
     // A deflated data set holds at most the largest volume's 16-bit samples and its header.
     let max_inflated = limits.max_voxels.saturating_mul(2).saturating_add(1 << 26);
-    if let Err(e) = lengths::check_element_lengths(path, max_inflated) {
-        return Scanned::Unreadable(e);
-    }
-    let (object, body) = match open::open(path, true) {
+    let body = match lengths::check_element_lengths(path, max_inflated) {
+        Ok(body) => body,
+        Err(e) => return Scanned::Unreadable(e),
+    };
+    let object = match open::open(path, true, body) {
         Ok(opened) => opened,
         Err(e) => return Scanned::Unreadable(e),
     };
     match image_file(path, &object, &object.meta().transfer_syntax, limits) {
         Ok(Some(mut image)) => {
+            image.body = body;
             if let Body::Implicit = body {
                 image.notes.push(format!(
                     "{}: the meta group says explicit VR, but the data set is implicit VR; \
@@ -263,6 +267,7 @@ fn image_file(
         frames,
         notes,
         mosaic,
+        body: Body::AsDeclared,
     }))
 }
 
