@@ -9,6 +9,7 @@
 //! rendering and planning, so Python threads run those in parallel.
 
 mod coverage;
+mod dissect;
 mod errors;
 mod fly;
 mod image;
@@ -36,6 +37,7 @@ fn _endocast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fly::fly, m)?)?;
     m.add_function(wrap_pyfunction!(coverage::coverage, m)?)?;
     m.add_function(wrap_pyfunction!(matching::match_scans, m)?)?;
+    m.add_function(wrap_pyfunction!(dissect::dissect, m)?)?;
     m.add_function(wrap_pyfunction!(polyps::polyps, m)?)?;
     m.add_function(wrap_pyfunction!(look::preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(image::save_png, m)?)?;

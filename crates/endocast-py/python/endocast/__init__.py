@@ -3,7 +3,8 @@
 Read a scan (``open``), wrap a numpy array (``Volume.from_array``) or pass a nibabel or
 SimpleITK image as it is (``as_volume`` converts it), render the endoscope's
 view (``render``), plan a centred path through a lumen (``path``), fly along it (``fly``) and review the
-wall a flight missed (``coverage``), find polyp candidates on a colon's wall (``polyps``).
+wall a flight missed (``coverage``), find polyp candidates on a colon's wall (``polyps``),
+lay the wall open along the path (``dissect``).
 The options are those of the ``endocast`` command (``--look-at`` is ``look_at=``), with the
 same defaults and presets; positions are in the patient frame, LPS millimetres, as DICOM has
 them (``Volume.affine_ras`` converts to nibabel's RAS).
@@ -24,6 +25,7 @@ fly = accepting_images(_endocast.fly)
 coverage = accepting_images(_endocast.coverage)
 match = _endocast.match
 polyps = accepting_images(_endocast.polyps)
+dissect = accepting_images(_endocast.dissect)
 
 __all__ = [
     "EndocastError",
@@ -31,6 +33,7 @@ __all__ = [
     "as_volume",
     "coverage",
     "default_view",
+    "dissect",
     "fly",
     "match",
     "open",

@@ -287,6 +287,24 @@ def polyps(
     """Polyp candidates on the wall of the lumen ``path`` starts in (or of the ``preset``'s
     structure), as ``endocast polyps --json`` lists them: ``candidates`` (best first:
     ``centre`` on the wall, LPS mm, ``size_mm``, ``score``)."""
+def dissect(
+    volume: _VolumeLike,
+    path: Optional[Union[_Path, npt.ArrayLike]] = None,
+    *,
+    preset: Optional[str] = None,
+    iso: Optional[float] = None,
+    along_step: float = 0.5,
+    rows: int = 360,
+    reach: float = 60.0,
+    lumen_threshold: Optional[float] = None,
+    bright_lumen: bool = False,
+    threads: Optional[int] = None,
+    **options: object,
+) -> dict[str, Any]:
+    """The wall along ``path`` (or the ``preset``'s automatic path) cut open and laid flat, as
+    ``endocast dissect`` writes it: ``image`` (height, width, 3 uint8), ``map`` (height, width,
+    3 float32: the LPS mm wall point of each pixel, NaN where none), ``plot`` (where the wall
+    pixels lie), ``along_mm_per_px``, ``around_deg_per_px``, ``wall_fraction``, ..."""
 def presets() -> list[str]:
     """The preset names."""
 def save_png(path: _Path, image: npt.NDArray[np.uint8]) -> None:
