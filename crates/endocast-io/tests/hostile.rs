@@ -86,8 +86,9 @@ fn an_element_longer_than_the_file_is_refused_before_any_allocation() {
 
 /// A data set in implicit VR under a meta group that says explicit VR (found by the fuzzer):
 /// dicom-rs's explicit decoder would take the first element's VR bytes "S\x01" as UN, and a
-/// later element's bytes as a 3 758 161 918-byte length, and reserve it. Such a file is read
-/// by the adaptive decoder only, which finds the sequence's first item corrupt.
+/// later element's bytes as a 3 758 161 918-byte length, and reserve it. Such a file is walked
+/// as implicit VR (and read by the adaptive decoder only): the walk enters the sequence, as the
+/// dictionary says (0008,1140) is one, and finds its first "item" corrupt.
 #[test]
 fn an_implicit_data_set_under_an_explicit_meta_group_is_never_read_as_explicit() {
     let mut bytes = meta(EXPLICIT_LE);
@@ -99,7 +100,26 @@ fn an_implicit_data_set_under_an_explicit_meta_group_is_never_read_as_explicit()
     bytes.resize(bytes.len() + 339 - 16, 0);
     let (_dir, path) = file_with("implicit-under-explicit.dcm", &bytes);
     let start = Instant::now();
-    refused(read_dicom(&path), &path, &["read as implicit VR", "item header"]);
+    refused(read_dicom(&path), &path, &["(0000,0000)", "20740 bytes"]);
+    assert!(start.elapsed() < Duration::from_secs(1));
+}
+
+/// dicom-rs reads a binary value by whole numbers: a 7-byte UL (the implicit-VR group length
+/// (0008,0000)) is read as one number, and the next header starts 3 bytes before where its
+/// length says (found by the fuzzer). The walk splits the file there too, and so sees the
+/// 2 147 483 647-byte length dicom-rs would reserve.
+#[test]
+fn a_binary_value_of_an_odd_length_is_split_where_dicom_rs_splits_it() {
+    let mut bytes = meta(IMPLICIT_LE);
+    bytes.extend(implicit((0x0008, 0x0000), &[1, 0, 0, 0, 0x08, 0x00, 0x05]));
+    bytes.extend_from_slice(&[0x00, 0xFF, 0xFF, 0xFF, 0x7F, 0, 0, 0, 0, 0, 0, 0, 0]);
+    let (_dir, path) = file_with("odd-ul.dcm", &bytes);
+    let start = Instant::now();
+    refused(
+        read_dicom(&path),
+        &path,
+        &["(0008,0005)", "2147483647 bytes"],
+    );
     assert!(start.elapsed() < Duration::from_secs(1));
 }
 

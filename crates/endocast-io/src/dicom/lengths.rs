@@ -7,7 +7,10 @@
 //! (iteratively, seeking over values, descending into sequences and items) costs a few hundred
 //! small reads per file and keeps every allocation bounded by the file's real size. The walk
 //! splits the file where dicom-rs does: the file meta group ends where its group length
-//! (0002,0000) says, not at the first element of another group.
+//! (0002,0000) says, not at the first element of another group; an implicit-VR element has the
+//! standard dictionary's VR; and a binary value whose length is not a multiple of its number's
+//! size is read by whole numbers, the next header starting right after them (the fuzzer found
+//! each of these: a walk that splits the file anywhere else checks lengths dicom-rs never reads).
 //!
 //! A deflated data set (transfer syntax 1.2.840.10008.1.2.1.99) is inflated here first: its
 //! deflate stream must reach its final block at the end of the file, give or take a few bytes
@@ -17,6 +20,9 @@
 use super::open::Body;
 use crate::compressed;
 use crate::error::{ReadError, Result};
+use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry};
+use dicom_core::Tag;
+use dicom_dictionary_std::StandardDataDictionary;
 use flate2::bufread::DeflateDecoder;
 use std::fs::File;
 use std::io::{self, BufReader, Cursor, Read, Seek, SeekFrom};
@@ -173,6 +179,33 @@ fn body_encoding(declared: Option<Encoding>, vr: [u8; 2]) -> Option<Encoding> {
     }
 }
 
+/// The VR dicom-rs reads an element as: its explicit VR, else (implicit VR) the standard
+/// dictionary's, with Pixel Data and Overlay Data as OW (PS3.5 A.1), as dicom-rs resolves it.
+fn read_as(tag: (u16, u16), explicit: Option<[u8; 2]>) -> Option<[u8; 2]> {
+    if explicit.is_some() {
+        return explicit;
+    }
+    if tag == (0x7FE0, 0x0010) || (tag.0 >> 8 == 0x60 && tag.1 == 0x3000) {
+        return Some(*b"OW");
+    }
+    StandardDataDictionary
+        .by_tag(Tag(tag.0, tag.1))
+        .map(|entry| entry.vr().relaxed().to_bytes())
+}
+
+/// The bytes dicom-rs consumes of a defined `length` read as `vr`: whole numbers only, so a
+/// binary value whose length is not a multiple of its number's size leaves the rest unread (and
+/// the next element header starts there, as dicom-rs reads it).
+fn bytes_read(length: u32, vr: Option<[u8; 2]>) -> u64 {
+    let size: u32 = match vr.as_ref().map(|v| &v[..]) {
+        Some(b"US" | b"SS" | b"OW") => 2,
+        Some(b"AT" | b"FL" | b"OF" | b"SL" | b"UL" | b"OL") => 4,
+        Some(b"FD" | b"OD" | b"SV" | b"UV" | b"OV") => 8,
+        _ => 1,
+    };
+    u64::from(length - length % size)
+}
+
 impl<R: Read + Seek> Walker<R> {
     fn seek_to(&mut self, pos: u64) -> io::Result<()> {
         self.reader.seek(SeekFrom::Start(pos))?;
@@ -277,10 +310,10 @@ impl<R: Read + Seek> Walker<R> {
                     .map_or(u64::MAX, |n| self.pos + n);
             } else if tag == (0x0002, 0x0010) && in_meta {
                 encoding = self.transfer_syntax(length)?;
-            } else if vr == Some(*b"SQ") || self.starts_with_item(length, inner)? {
+            } else if read_as(tag, vr) == Some(*b"SQ") || self.starts_with_item(length, inner)? {
                 self.open_sequence(Some(end), vr == Some(*b"UN"))?;
             } else {
-                self.skip(u64::from(length))?;
+                self.skip(bytes_read(length, read_as(tag, vr)))?;
             }
         }
         Ok(match encoding {
