@@ -15,7 +15,7 @@ mod scene_args;
 mod structure;
 mod study_report;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Virtual endoscopy of CT and MRI scans.
@@ -65,6 +65,10 @@ enum Command {
     /// Supine/prone correspondence: a finding in the first scan gives its counterpart and a
     /// view of it in the second (JSON with --json), and the two views side by side (-o).
     Match(Box<commands::match_scans::MatchArgs>),
+    /// Every study of a manifest (CSV or JSON lines) through the pipeline: path, flight with
+    /// coverage and film, a key view, and for colonoscopy the dissection and polyp candidates;
+    /// resumable, each study isolated, summarised in summary.csv and summary.json.
+    Batch(Box<commands::batch::BatchArgs>),
 }
 
 fn main() -> ExitCode {
@@ -86,6 +90,7 @@ fn main() -> ExitCode {
         Command::Mesh(args) => commands::mesh::run(&args),
         Command::Annotate(args) => commands::annotate::run(&args),
         Command::Match(args) => commands::match_scans::run(&args),
+        Command::Batch(args) => commands::batch::run(&args, &Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,6 +4,7 @@
 
 mod annotate;
 mod bad_input;
+mod batch;
 mod bronchoscopy;
 mod common;
 mod default_views;

@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod annotate;
+pub mod batch;
 pub mod bench;
 pub mod convert;
 pub mod coverage;

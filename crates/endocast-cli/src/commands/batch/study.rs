@@ -1,0 +1,314 @@
+//! One study of a batch: its steps, each this program run as a child process (`path`, `fly`
+//! with coverage, `render`, and for colonoscopy `dissect` and `polyps`), so that a study that
+//! fails, panics or runs out of memory takes nothing else down; its report, `report.json`; and
+//! the fingerprint of its inputs and settings that lets a later run skip it.
+
+use super::manifest::Entry;
+use anyhow::{bail, Context, Result};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Instant, UNIX_EPOCH};
+
+/// The report of each study, in its output folder.
+pub const REPORT: &str = "report.json";
+
+/// What every study of a batch shares.
+pub struct Setup<'a> {
+    /// This program.
+    pub program: PathBuf,
+    /// Its command line, to tell which options each step takes.
+    pub cli: &'a clap::Command,
+    /// Worker threads per study.
+    pub threads: usize,
+    /// The largest volume a study may read (its share of the memory).
+    pub max_voxels: u64,
+}
+
+/// How a study ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Every step ran.
+    Ok,
+    /// A step failed; its message says why.
+    Failed,
+    /// A finished report with the same inputs and settings was already there.
+    Skipped,
+}
+
+/// One study's line of the run summary.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Record {
+    /// The scan, as the manifest resolved it.
+    pub scan: String,
+    /// How it ended.
+    pub status: Status,
+    /// Why it failed (empty otherwise).
+    pub message: String,
+    /// Its time, seconds (of the run that made the report, when skipped).
+    pub seconds: f64,
+    /// Its output folder.
+    pub output: String,
+    /// What it wrote: name → file.
+    pub outputs: serde_json::Map<String, Value>,
+}
+
+/// Runs the study `entry` into `folder`, or skips it when `folder` already holds a finished
+/// report of the same inputs and settings.
+pub fn run(entry: &Entry, folder: &Path, setup: &Setup) -> Record {
+    let clock = Instant::now();
+    let record = |status, message: String, outputs| Record {
+        scan: entry.scan.display().to_string(),
+        status,
+        message,
+        seconds: clock.elapsed().as_secs_f64(),
+        output: folder.display().to_string(),
+        outputs,
+    };
+    let inputs = match fingerprint(entry) {
+        Ok(inputs) => inputs,
+        Err(e) => return record(Status::Failed, format!("{e:#}"), Default::default()),
+    };
+    if let Some(done) = finished(folder, &inputs) {
+        return Record {
+            status: Status::Skipped,
+            ..done
+        };
+    }
+    let mut steps = serde_json::Map::new();
+    let ran = run_steps(entry, folder, setup, &mut steps);
+    let outputs = outputs(folder, &steps);
+    let done = match ran {
+        Ok(()) => record(Status::Ok, String::new(), outputs),
+        Err(e) => record(Status::Failed, format!("{e:#}"), outputs),
+    };
+    let report = json!({"record": &done, "inputs": inputs, "steps": steps});
+    if let Err(e) = write_report(folder, &report) {
+        return record(Status::Failed, format!("{e:#}"), done.outputs);
+    }
+    done
+}
+
+/// The steps of a study, each adding its JSON (or `null`) to `steps`; stops at the first
+/// that fails.
+fn run_steps(
+    entry: &Entry,
+    folder: &Path,
+    setup: &Setup,
+    steps: &mut serde_json::Map<String, Value>,
+) -> Result<()> {
+    std::fs::create_dir_all(folder)
+        .with_context(|| format!("cannot create {}", folder.display()))?;
+    let path_file = folder.join("path.json");
+    let path_arg = path_file.display().to_string();
+    let mut plan = vec![
+        ("path", vec!["-o", "path.json", "--json"]),
+        (
+            "fly",
+            vec![
+                "--path",
+                &path_arg,
+                "-o",
+                "film.mp4",
+                "--coverage",
+                "--json",
+            ],
+        ),
+        ("render", vec!["-o", "start.png"]),
+    ];
+    if entry.preset.as_deref() == Some("colonoscopy") {
+        plan.push((
+            "dissect",
+            vec!["--path", &path_arg, "-o", "flat.png", "--json"],
+        ));
+        plan.push(("polyps", vec!["--path", &path_arg, "--json"]));
+    }
+    for (command, own) in plan {
+        let args = step_args(command, &own, entry, folder, setup);
+        steps.insert(command.into(), run_step(&setup.program, command, &args)?);
+    }
+    Ok(())
+}
+
+/// The arguments of step `command`: the scan, the preset, the options of the manifest it
+/// takes, the step's own (outputs in `folder`), and the batch's threads and memory share.
+fn step_args(
+    command: &str,
+    own: &[&str],
+    entry: &Entry,
+    folder: &Path,
+    setup: &Setup,
+) -> Vec<String> {
+    let takes = |name: &str| takes_option(setup.cli, command, name);
+    let mut args = vec![command.to_owned(), entry.scan.display().to_string()];
+    if let Some(preset) = &entry.preset {
+        args.extend(["--preset".to_owned(), preset.clone()]);
+    }
+    for (name, value) in entry.options.iter().filter(|(name, _)| takes(name)) {
+        match value.as_str() {
+            "true" => args.push(format!("--{name}")),
+            "false" => {}
+            _ => args.extend([format!("--{name}"), value.clone()]),
+        }
+    }
+    let mut own = own.iter();
+    while let Some(arg) = own.next() {
+        args.push(arg.to_string());
+        if *arg == "-o" {
+            let file = own.next().expect("-o has its file");
+            args.push(folder.join(file).display().to_string());
+        }
+    }
+    if takes("threads") {
+        args.extend(["--threads".to_owned(), setup.threads.to_string()]);
+    }
+    args.extend(["--max-voxels".to_owned(), setup.max_voxels.to_string()]);
+    args
+}
+
+/// Whether subcommand `command` of `cli` has the option `--name`.
+pub fn takes_option(cli: &clap::Command, command: &str, name: &str) -> bool {
+    cli.find_subcommand(command)
+        .is_some_and(|sub| sub.get_arguments().any(|arg| arg.get_long() == Some(name)))
+}
+
+/// Runs one step; its JSON output (or `null` when it prints none), or its error message.
+fn run_step(program: &Path, command: &str, args: &[String]) -> Result<Value> {
+    let output = Command::new(program)
+        .args(args)
+        .output()
+        .with_context(|| format!("cannot run {}", program.display()))?;
+    if !output.status.success() {
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let said = stderr
+            .lines()
+            .rev()
+            .find_map(|line| line.strip_prefix("error: "))
+            .map_or_else(|| last_lines(&stderr), str::to_owned);
+        bail!("{command}: {said} ({})", output.status);
+    }
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    Ok(serde_json::from_str(&stdout).unwrap_or(Value::Null))
+}
+
+/// The last lines of a step's standard error (a panic's message and where), for a failure
+/// that printed no `error:` line.
+fn last_lines(stderr: &str) -> String {
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    let tail = &lines[lines.len().saturating_sub(3)..];
+    if tail.is_empty() {
+        "no message".to_owned()
+    } else {
+        tail.join(" / ")
+    }
+}
+
+/// The files the steps wrote that exist, by name.
+fn outputs(
+    folder: &Path,
+    steps: &serde_json::Map<String, Value>,
+) -> serde_json::Map<String, Value> {
+    let files = [
+        ("path", "path.json"),
+        ("film", "film.mp4"),
+        ("coverage", "film.coverage.json"),
+        ("start", "start.png"),
+        ("dissection", "flat.png"),
+        ("dissection_map", "flat.map.npy"),
+    ];
+    let mut found: serde_json::Map<String, Value> = files
+        .iter()
+        .map(|(name, file)| (*name, folder.join(file)))
+        .filter(|(_, file)| file.is_file())
+        .map(|(name, file)| (name.to_owned(), json!(file.display().to_string())))
+        .collect();
+    if let Some(candidates) = steps.get("polyps").and_then(|p| p.get("candidates")) {
+        found.insert(
+            "polyp_candidates".into(),
+            json!(candidates.as_array().map_or(0, Vec::len)),
+        );
+    }
+    found
+}
+
+/// What decides a study's results: the scan's files (name, size, time of change), its preset
+/// and options, and this program's version. A report with the same fingerprint is current.
+fn fingerprint(entry: &Entry) -> Result<Value> {
+    let scan = &entry.scan;
+    let meta = std::fs::metadata(scan)
+        .with_context(|| format!("cannot read the scan {}", scan.display()))?;
+    let mut files = vec![scan.clone()];
+    if meta.is_dir() {
+        files = list_files(scan)?;
+    }
+    let files: Vec<Value> = files
+        .iter()
+        .map(|file| {
+            let meta = std::fs::metadata(file)
+                .with_context(|| format!("cannot read {}", file.display()))?;
+            let changed = meta
+                .modified()
+                .ok()
+                .and_then(|t| t.duration_since(UNIX_EPOCH).ok())
+                .map_or(0, |d| d.as_nanos());
+            Ok(json!([
+                file.display().to_string(),
+                meta.len(),
+                changed.to_string()
+            ]))
+        })
+        .collect::<Result<_>>()?;
+    Ok(json!({
+        "files": files,
+        "preset": entry.preset,
+        "options": entry.options,
+        "version": env!("CARGO_PKG_VERSION"),
+    }))
+}
+
+/// Every file under `folder`, sorted (a DICOM series' folder).
+fn list_files(folder: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    let mut pending = vec![folder.to_path_buf()];
+    while let Some(dir) = pending.pop() {
+        let read =
+            std::fs::read_dir(&dir).with_context(|| format!("cannot list {}", dir.display()))?;
+        for item in read {
+            let path = item?.path();
+            if path.is_dir() {
+                pending.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// The record of a finished (ok) report in `folder` made from `inputs`, if there is one.
+fn finished(folder: &Path, inputs: &Value) -> Option<Record> {
+    let text = std::fs::read_to_string(folder.join(REPORT)).ok()?;
+    let report: Value = serde_json::from_str(&text).ok()?;
+    let record = report.get("record")?;
+    if report.get("inputs")? != inputs || record.get("status")? != "ok" {
+        return None;
+    }
+    Some(Record {
+        scan: record.get("scan")?.as_str()?.to_owned(),
+        status: Status::Ok,
+        message: String::new(),
+        seconds: record.get("seconds")?.as_f64()?,
+        output: record.get("output")?.as_str()?.to_owned(),
+        outputs: record.get("outputs")?.as_object()?.clone(),
+    })
+}
+
+/// Writes `report` into `folder` atomically (a study killed while writing leaves the old one).
+fn write_report(folder: &Path, report: &Value) -> Result<()> {
+    let file = folder.join(REPORT);
+    let text = serde_json::to_string_pretty(report)?;
+    endocast_io::atomic::write_file(&file, |out| out.write_all(text.as_bytes()))
+        .with_context(|| format!("cannot write {}", file.display()))
+}
