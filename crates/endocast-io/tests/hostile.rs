@@ -123,6 +123,25 @@ fn a_binary_value_of_an_odd_length_is_split_where_dicom_rs_splits_it() {
     assert!(start.elapsed() < Duration::from_secs(1));
 }
 
+/// Among a data set's elements (not in a sequence), dicom-rs reads a sequence delimiter
+/// (FFFE,E0DD) with a length as an element with a value of that length (found by the fuzzer).
+/// The walk does too, and so reaches the 2 147 483 647-byte length dicom-rs would reserve next.
+#[test]
+fn a_delimiter_among_elements_is_an_element_with_its_value() {
+    let mut bytes = meta(IMPLICIT_LE);
+    bytes.extend(implicit((0xFFFE, 0xE0DD), &[0x10, 0x00, 0x10, 0x00]));
+    bytes.extend_from_slice(&[0, 0, 0, 0, 0xFF, 0xFF, 0xFF, 0x7F]);
+    bytes.extend_from_slice(&[0; 12]);
+    let (_dir, path) = file_with("delimiter-element.dcm", &bytes);
+    let start = Instant::now();
+    refused(
+        read_dicom(&path),
+        &path,
+        &["(0000,0000)", "2147483647 bytes"],
+    );
+    assert!(start.elapsed() < Duration::from_secs(1));
+}
+
 /// An RLE header of `segments` segments for fragments of 2-byte samples.
 fn rle_fragment(segments: &[Vec<u8>]) -> Vec<u8> {
     let mut data = vec![0u8; 64];

@@ -9,8 +9,10 @@
 //! splits the file where dicom-rs does: the file meta group ends where its group length
 //! (0002,0000) says, not at the first element of another group; an implicit-VR element has the
 //! standard dictionary's VR; and a binary value whose length is not a multiple of its number's
-//! size is read by whole numbers, the next header starting right after them (the fuzzer found
-//! each of these: a walk that splits the file anywhere else checks lengths dicom-rs never reads).
+//! size is read by whole numbers, the next header starting right after them; and an item tag
+//! other than an item delimiter among a data set's elements (not among a sequence's items) is
+//! an element with a value (the fuzzer found each of these: a walk that splits the file anywhere
+//! else checks lengths dicom-rs never reads).
 //!
 //! A deflated data set (transfer syntax 1.2.840.10008.1.2.1.99) is inflated here first: its
 //! deflate stream must reach its final block at the end of the file, give or take a few bytes
@@ -59,12 +61,20 @@ struct Walker<R> {
     reader: BufReader<R>,
     pos: u64,
     len: u64,
-    /// The sequences and items open at `pos`: where each ends, `None` for an undefined length
-    /// (closed by its delimiter).
-    open: Vec<Option<u64>>,
+    /// The sequences and items open at `pos`, innermost last.
+    open: Vec<Level>,
     /// The nesting depth from which elements are implicit VR little endian whatever the
     /// transfer syntax: inside a sequence stored as UN (PS3.5 6.2.2), until it closes.
     implicit_from: Option<usize>,
+}
+
+/// A sequence or an item open during the walk.
+#[derive(Clone, Copy)]
+struct Level {
+    /// Where it ends, `None` for an undefined length (closed by its delimiter).
+    end: Option<u64>,
+    /// Whether it is a sequence, holding items (else an item, holding elements).
+    sequence: bool,
 }
 
 /// Where a walk stopped.
@@ -290,8 +300,14 @@ impl<R: Read + Seek> Walker<R> {
             } else {
                 current
             };
-            if tag.0 == 0xFFFE {
+            if tag.0 == 0xFFFE && (in_fragments || self.among_items()) {
                 in_fragments = self.item(tag, length, in_fragments)?;
+                continue;
+            }
+            if tag == (0xFFFE, 0xE00D) {
+                // Among elements, an item delimiter ends the item (and is ignored outside any,
+                // as dicom-rs does); any other (FFFE,xxxx) there is an element like any other.
+                self.close_item();
                 continue;
             }
             if length == UNDEFINED {
@@ -323,9 +339,9 @@ impl<R: Read + Seek> Walker<R> {
         })
     }
 
-    /// Opens a sequence or item ending at `end` (`None`: at its delimiter); refuses one nested
-    /// deeper than [`MAX_NESTING`].
-    fn open(&mut self, end: Option<u64>) -> Result<(), String> {
+    /// Opens a sequence (`sequence`) or an item ending at `end` (`None`: at its delimiter);
+    /// refuses one nested deeper than [`MAX_NESTING`].
+    fn open(&mut self, end: Option<u64>, sequence: bool) -> Result<(), String> {
         if self.open.len() >= MAX_NESTING {
             return Err(format!(
                 "sequences are nested more than {} levels deep (at byte {}); real files nest a \
@@ -334,13 +350,13 @@ impl<R: Read + Seek> Walker<R> {
                 self.pos
             ));
         }
-        self.open.push(end);
+        self.open.push(Level { end, sequence });
         Ok(())
     }
 
     /// Opens a sequence ending at `end`; one stored as UN (`un`) holds implicit VR items.
     fn open_sequence(&mut self, end: Option<u64>, un: bool) -> Result<(), String> {
-        self.open(end)?;
+        self.open(end, true)?;
         if un && self.implicit_from.is_none() {
             self.implicit_from = Some(self.open.len());
         }
@@ -360,7 +376,7 @@ impl<R: Read + Seek> Walker<R> {
 
     /// Closes the defined-length sequences and items that end at or before `pos`.
     fn close_ended(&mut self) {
-        while let Some(Some(end)) = self.open.last() {
+        while let Some(Level { end: Some(end), .. }) = self.open.last() {
             if *end > self.pos {
                 break;
             }
@@ -370,9 +386,22 @@ impl<R: Read + Seek> Walker<R> {
 
     /// Closes the innermost sequence or item of undefined length, at its delimiter.
     fn close_delimited(&mut self) {
-        if let Some(None) = self.open.last() {
+        if let Some(Level { end: None, .. }) = self.open.last() {
             self.open.pop();
         }
+    }
+
+    /// Closes the innermost item, at an item delimiter among its elements.
+    fn close_item(&mut self) {
+        if self.open.last().is_some_and(|level| !level.sequence) {
+            self.open.pop();
+        }
+    }
+
+    /// Whether the walk is among a sequence's items (else among a data set's elements, at the
+    /// top or in an item).
+    fn among_items(&self) -> bool {
+        self.open.last().is_some_and(|level| level.sequence)
     }
 
     /// Tag, length and (explicit VR only) the VR of the element whose first 8 bytes are `head`.
@@ -433,12 +462,12 @@ impl<R: Read + Seek> Walker<R> {
                 Ok(true)
             }
             0xE000 if length == UNDEFINED => {
-                self.open(None)?;
+                self.open(None, false)?;
                 Ok(false) // the item's elements follow inline
             }
             0xE000 => {
                 self.check(tag, length)?;
-                self.open(Some(self.pos + u64::from(length)))?;
+                self.open(Some(self.pos + u64::from(length)), false)?;
                 Ok(false)
             }
             0xE00D => {
