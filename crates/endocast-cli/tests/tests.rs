@@ -5,6 +5,7 @@
 mod annotate;
 mod bad_input;
 mod bronchoscopy;
+mod cleanse;
 mod common;
 mod default_views;
 mod dissect;

@@ -99,7 +99,11 @@ fn an_implicit_data_set_under_an_explicit_meta_group_is_never_read_as_explicit()
     bytes.resize(bytes.len() + 339 - 16, 0);
     let (_dir, path) = file_with("implicit-under-explicit.dcm", &bytes);
     let start = Instant::now();
-    refused(read_dicom(&path), &path, &["read as implicit VR", "item header"]);
+    refused(
+        read_dicom(&path),
+        &path,
+        &["read as implicit VR", "item header"],
+    );
     assert!(start.elapsed() < Duration::from_secs(1));
 }
 
