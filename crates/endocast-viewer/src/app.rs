@@ -159,7 +159,8 @@ impl ViewerApp {
         if let Some(ready) = &mut self.ready {
             let mut action = None;
             // Along the bottom, under the side panels too: the flat wall is long.
-            let flat_said = crate::dissection_ui::flat_view_ui(ctx, ready);
+            let flat_said =
+                crate::dissection_ui::flat_view_ui(ctx, &mut ready.dissection, &mut ready.session);
             egui::SidePanel::left("controls")
                 .resizable(false)
                 .exact_width(290.0)

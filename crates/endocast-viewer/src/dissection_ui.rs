@@ -6,7 +6,6 @@
 
 use crate::dissection::{DissectionTools, Flat};
 use crate::session::Session;
-use crate::state::Ready;
 use egui::{Color32, Pos2, Rect, Sense, Stroke, TextureOptions, Vec2};
 use std::sync::Arc;
 
@@ -67,8 +66,11 @@ pub(crate) fn dissection_ui(view: &mut DissectionView, ui: &mut egui::Ui, sessio
 
 /// The flat view along the bottom of the window, while there is one to show; returns a line
 /// for the status bar when a pixel was clicked.
-pub(crate) fn flat_view_ui(ctx: &egui::Context, ready: &mut Ready) -> Option<String> {
-    let view = &mut ready.dissection;
+pub(crate) fn flat_view_ui(
+    ctx: &egui::Context,
+    view: &mut DissectionView,
+    session: &mut Session,
+) -> Option<String> {
     if !view.shown {
         return None;
     }
@@ -89,12 +91,12 @@ pub(crate) fn flat_view_ui(ctx: &egui::Context, ready: &mut Ready) -> Option<Str
             egui::ScrollArea::horizontal()
                 .id_salt("flat view")
                 .show(ui, |ui| {
-                    let column = view.tools.endoscope_column(&ready.session);
+                    let column = view.tools.endoscope_column(session);
                     clicked = strip_ui(ui, flat, texture, column);
                 });
         });
     let (x, y) = clicked?;
-    Some(view.tools.visit(&mut ready.session, x, y))
+    Some(view.tools.visit(session, x, y))
 }
 
 /// The flat image scaled to [`STRIP_HEIGHT`], the endoscope's `column` marked; returns the

@@ -139,16 +139,22 @@ fn rays_inside_a_tight_bend_stop_where_the_next_column_cuts_them() {
     }
 }
 
-#[test]
-fn bad_options_and_a_path_outside_the_lumen_are_refused_by_name() {
+/// A `size³` phantom of a straight tube without rings along z through the origin, the path
+/// along its axis from `z = −half_mm` to `half_mm`, and its wall.
+fn straight_tube(size: usize, half_mm: f64) -> (Volume, Path, Wall) {
     let tube = |p: DVec3| (p.z, p.truncate().length());
-    let volume = phantom(24, &tube, &[]);
-    let axis = [DVec3::new(0.0, 0.0, -5.0), DVec3::new(0.0, 0.0, 5.0)];
-    let path = Path::from_points_exact(&axis, 0.5).unwrap();
+    let axis = [-half_mm, half_mm].map(|z| DVec3::new(0.0, 0.0, z));
     let wall = Wall {
         iso: ISO,
         color: [1.0; 3],
     };
+    let path = Path::from_points_exact(&axis, 0.5).unwrap();
+    (phantom(size, &tube, &[]), path, wall)
+}
+
+#[test]
+fn bad_options_and_a_path_outside_the_lumen_are_refused_by_name() {
+    let (volume, path, wall) = straight_tube(24, 5.0);
     let error = |wall: &Wall, options: DissectOptions| {
         dissect(&volume, &path, wall, &options)
             .unwrap_err()
@@ -192,14 +198,7 @@ fn bad_options_and_a_path_outside_the_lumen_are_refused_by_name() {
 
 #[test]
 fn a_flat_pixel_gives_the_camera_on_its_column_looking_at_its_wall_point() {
-    let tube = |p: DVec3| (p.z + 10.0, p.truncate().length());
-    let volume = phantom(32, &tube, &[]);
-    let axis = [DVec3::new(0.0, 0.0, -10.0), DVec3::new(0.0, 0.0, 10.0)];
-    let path = Path::from_points_exact(&axis, 0.5).unwrap();
-    let wall = Wall {
-        iso: ISO,
-        color: [1.0; 3],
-    };
+    let (volume, path, wall) = straight_tube(32, 10.0);
     let flat = dissect(&volume, &path, &wall, &DissectOptions::default()).unwrap();
     let plot = flat.plot;
     let (x, y) = (plot.x + 12, plot.y + 200);
@@ -232,14 +231,7 @@ fn a_flat_pixel_gives_the_camera_on_its_column_looking_at_its_wall_point() {
 
 #[test]
 fn a_flat_pixel_whose_ray_met_no_wall_gives_no_camera() {
-    let tube = |p: DVec3| (p.z, p.truncate().length());
-    let volume = phantom(24, &tube, &[]);
-    let axis = [DVec3::new(0.0, 0.0, -5.0), DVec3::new(0.0, 0.0, 5.0)];
-    let path = Path::from_points_exact(&axis, 0.5).unwrap();
-    let wall = Wall {
-        iso: ISO,
-        color: [1.0; 3],
-    };
+    let (volume, path, wall) = straight_tube(24, 5.0);
     // A reach shorter than the 8 mm radius: no ray meets the wall…
     let short = DissectOptions {
         reach_mm: 2.0,
