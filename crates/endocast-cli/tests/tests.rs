@@ -6,6 +6,7 @@ mod annotate;
 mod bad_input;
 mod batch;
 mod bronchoscopy;
+mod cleanse;
 mod common;
 mod default_views;
 mod dissect;

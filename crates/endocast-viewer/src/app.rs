@@ -135,6 +135,18 @@ impl ViewerApp {
         &self.message
     }
 
+    /// The virtual dissection (its flat image once made), once a scan is open.
+    pub fn dissection(&self) -> Option<&crate::dissection::DissectionTools> {
+        self.ready.as_ref().map(|r| &r.dissection.tools)
+    }
+
+    /// Whether the scan shown is cleansed of tagged fluid, and whether a switch is being made.
+    pub fn cleansing(&self) -> Option<(bool, bool)> {
+        self.ready
+            .as_ref()
+            .map(|r| (r.cleanse.is_on(), r.cleanse.running()))
+    }
+
     /// Where the case is (auto)saved.
     pub fn case_path(&self) -> Option<PathBuf> {
         self.ready.as_ref().map(|r| r.autosave.path().to_owned())
@@ -146,6 +158,9 @@ impl ViewerApp {
         egui::TopBottomPanel::bottom("status").show(ctx, |ui| self.status_ui(ui));
         if let Some(ready) = &mut self.ready {
             let mut action = None;
+            // Along the bottom, under the side panels too: the flat wall is long.
+            let flat_said =
+                crate::dissection_ui::flat_view_ui(ctx, &mut ready.dissection, &mut ready.session);
             egui::SidePanel::left("controls")
                 .resizable(false)
                 .exact_width(290.0)
@@ -173,6 +188,9 @@ impl ViewerApp {
                 .show(ctx, |ui| view_ui(ui, ready));
             if let Some(action) = action {
                 self.act(action);
+            }
+            if let Some(said) = flat_said {
+                self.message = said;
             }
             self.poll_tasks();
             self.autosave(false);
@@ -237,6 +255,8 @@ impl ViewerApp {
                     marks: MarkTool::default(),
                     last_input: None,
                     review: ReviewTools::default(),
+                    dissection: Default::default(),
+                    cleanse: Default::default(),
                 });
                 self.loading = None;
             }
@@ -252,9 +272,16 @@ impl ViewerApp {
             ready.tools.poll(&mut ready.session),
             ready.meshes.poll(&mut ready.session),
             ready.review.poll(),
+            ready.dissection.tools.poll(),
         ];
         if let Some(message) = finished.into_iter().flatten().last() {
             self.message = message;
+        }
+        if let Some((said, changed)) = ready.cleanse.poll(&mut ready.session) {
+            if changed {
+                ready.scene_changed();
+            }
+            self.message = said;
         }
         ready.tasks.retain(|job| match job.poll() {
             Polled::Running => true,

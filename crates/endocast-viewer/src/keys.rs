@@ -32,6 +32,10 @@ pub const HELP: &[(&str, &str)] = &[
     ("C", "collision on / off"),
     ("Z", "centre in the lumen (across the view)"),
     ("N", "next unseen patch (after \"Review unseen\")"),
+    (
+        "click in the flat view",
+        "look at that wall point from the path (after \"Dissect\")",
+    ),
     ("H", "back to the start"),
     ("+ / -", "faster / slower"),
 ];

@@ -13,6 +13,8 @@
 //!   without a window;
 //! - [`case`]: case files, written atomically and autosaved;
 //! - [`case_choice`]: which case a session reopens and saves to (never one it would replace);
+//! - [`review`], [`dissection`], [`cleansing`]: the reading tools of CT colonography (the
+//!   wall a flight missed, the wall laid flat, the tagged fluid removed);
 //! - [`planner`]: the centred path between two points (or to the farthest) as key frames;
 //! - [`export`]: the flight filmed (GIF, MP4, PNGs) and its path files (ours, Slicer Markups);
 //! - [`geometry`]: the grid, the endoscope's instrument, marker spheres and meshes drawn;
@@ -43,7 +45,13 @@
 pub mod app;
 pub mod case;
 pub mod case_choice;
+pub mod cleansing;
+#[cfg(feature = "window")]
+mod cleansing_ui;
 pub mod controller;
+pub mod dissection;
+#[cfg(feature = "window")]
+mod dissection_ui;
 pub mod export;
 #[cfg(feature = "window")]
 mod flight_ui;

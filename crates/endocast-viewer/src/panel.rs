@@ -43,6 +43,7 @@ pub(crate) fn controls_ui(
         action = Some(Action::Reorient(code));
     }
     warnings_ui(ui, &ready.session.scene().warnings);
+    crate::cleansing_ui::cleanse_ui(ui, &mut ready.cleanse, &ready.session);
     ui.separator();
     view_controls_ui(ui, &mut ready.session);
     ui.separator();
@@ -75,6 +76,11 @@ pub(crate) fn controls_ui(
             {
                 action = Some(Action::Message(m));
             }
+        });
+    egui::CollapsingHeader::new("Virtual dissection")
+        .default_open(false)
+        .show(ui, |ui| {
+            crate::dissection_ui::dissection_ui(&mut ready.dissection, ui, &ready.session);
         });
     egui::CollapsingHeader::new("Export the flight")
         .default_open(false)

@@ -83,6 +83,14 @@ pub fn plan_flight(
     })
 }
 
+/// The study's automatic path through the structure its preset found, as `endocast path` plans
+/// it without a start or an end: the route of the review and the dissection when there are
+/// fewer than two key frames.
+pub fn automatic_path(study: &Study, volume: &Volume) -> Result<Path, String> {
+    let planned = study.plan(volume, None, None, &SmoothOptions::default());
+    Ok(planned.map_err(|e| e.to_string())?.planned.path)
+}
+
 /// Key frames every [`KEY_STEP_MM`] along `path`, each looking [`LOOK_AHEAD_MM`] ahead on it,
 /// with `look`.
 fn key_frames_along(path: &Path, look: KeyLook) -> Result<Vec<KeyFrame>, String> {

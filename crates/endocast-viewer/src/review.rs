@@ -6,6 +6,7 @@
 
 use crate::controller::FlyCamera;
 use crate::jobs::{Job, Notify, Polled};
+use crate::planner::automatic_path;
 use crate::session::Session;
 use endocast_core::animation::KeyFrame;
 use endocast_core::camera::Projection;
@@ -13,7 +14,6 @@ use endocast_core::flight::{
     review, FlightError, FlightOptions, Layout, PatchView, ReviewRequest, Route,
     DEFAULT_MIN_AREA_MM2, REVIEW_FRAME_PX, REVIEW_STEP_MM,
 };
-use endocast_core::path::SmoothOptions;
 use endocast_core::study::Study;
 use endocast_core::study::LOOK_AHEAD_MM;
 use endocast_core::views::Image;
@@ -211,8 +211,6 @@ fn route(keys: Vec<KeyFrame>, study: &Study, volume: &Volume) -> Result<Route, S
     if keys.len() >= 2 {
         return Route::from_key_frames(keys).map_err(|e| e.to_string());
     }
-    let planned = study
-        .plan(volume, None, None, &SmoothOptions::default())
-        .map_err(|e| format!("no route to review: {e}"))?;
-    Ok(Route::Path(planned.planned.path))
+    let path = automatic_path(study, volume).map_err(|e| format!("no route to review: {e}"))?;
+    Ok(Route::Path(path))
 }

@@ -74,6 +74,11 @@ impl SliceViewer {
     pub(crate) fn plane(&self) -> Plane {
         self.plane
     }
+
+    /// Reformats the slice again (the scan shown changed), keeping the page, zoom and pan.
+    pub(crate) fn forget_image(&mut self) {
+        self.image = Derived::default();
+    }
 }
 
 /// Draws the large slice in `ui`'s space and acts on its input (a click goes to `tools`, as a

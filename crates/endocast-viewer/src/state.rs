@@ -1,6 +1,8 @@
 //! What the window keeps beside the session, shared by the window's parts.
 
 use crate::case::Autosave;
+use crate::cleansing::CleanseSwitch;
+use crate::dissection_ui::DissectionView;
 use crate::flight_ui::FlightTools;
 use crate::geometry_ui::MeshLoader;
 use crate::jobs::Job;
@@ -35,6 +37,25 @@ pub(crate) struct Ready {
     pub last_input: Option<Instant>,
     /// The review of the wall a flight missed.
     pub review: ReviewTools,
+    /// The virtual dissection and its flat view.
+    pub dissection: DissectionView,
+    /// The scan cleansed of tagged fluid, or as acquired.
+    pub cleanse: CleanseSwitch,
+}
+
+impl Ready {
+    /// Forgets what was derived from the scan shown before it changed (cleansed or restored):
+    /// the slices, the overview, the review and the dissection are made again on the new one.
+    pub fn scene_changed(&mut self) {
+        self.slices = SlicesView::default();
+        self.overview = OverviewView::default();
+        if let Some(viewer) = &mut self.large_slice {
+            viewer.forget_image();
+        }
+        self.shown = None;
+        self.review = ReviewTools::default();
+        self.dissection.tools.clear();
+    }
 }
 
 /// What the control panel asks of the application.

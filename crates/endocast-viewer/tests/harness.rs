@@ -149,6 +149,25 @@ impl Window {
         found.into_iter().min_by(|a, b| a.min.y.total_cmp(&b.min.y))
     }
 
+    /// Where the last frame painted the texture named `name` (its whole picture, clipped or
+    /// not), and the part of it left visible by its clip.
+    pub fn image_rect(&self, name: &str) -> Option<(Rect, Rect)> {
+        let id = self
+            .ctx
+            .tex_manager()
+            .read()
+            .allocated()
+            .find(|(_, meta)| meta.name == name)
+            .map(|(id, _)| *id)?;
+        self.shapes.iter().find_map(|clipped| match &clipped.shape {
+            Shape::Mesh(mesh) if mesh.texture_id == id => {
+                let rect = mesh.calc_bounds();
+                Some((rect, rect.intersect(clipped.clip_rect)))
+            }
+            _ => None,
+        })
+    }
+
     /// Every text the last frame painted and where, clipped or not.
     pub fn painted_text_rects(&self) -> Vec<(String, Rect)> {
         let mut all = Vec::new();

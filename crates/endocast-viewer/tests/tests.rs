@@ -12,4 +12,6 @@ mod review;
 mod series;
 mod ui;
 mod ui_case;
+mod ui_cleansing;
+mod ui_dissection;
 mod ui_tools;

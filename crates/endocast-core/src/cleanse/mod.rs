@@ -160,13 +160,7 @@ impl std::error::Error for CleanseError {}
 /// `volume` with its tagged fluid and the fluid's partial volumes replaced by air (see the
 /// module documentation). The original is not changed.
 pub fn cleanse(volume: &Volume) -> Result<Cleansed, CleanseError> {
-    let not_ct = matches!(volume.modality(), Modality::Mr | Modality::Other(_));
-    let ValueKind::Hounsfield { offset } = ScanValues::measure(volume).kind else {
-        return Err(CleanseError::NotHounsfield);
-    };
-    if not_ct {
-        return Err(CleanseError::NotHounsfield);
-    }
+    let offset = hounsfield_offset(volume.modality(), &ScanValues::measure(volume))?;
     let scan = pools::HuScan::new(volume, offset);
     let gravity = Gravity::supine_or_prone(volume.geometry());
     let found = pools::find(&scan, &gravity);
@@ -184,4 +178,15 @@ pub fn cleanse(volume: &Volume) -> Result<Cleansed, CleanseError> {
         pools: found.into_iter().map(|p| p.pool).collect(),
         changed_voxels,
     })
+}
+
+/// Whether a scan of `modality` whose values measure as `values` can be cleansed: a CT (or a
+/// scan that does not say what it is) in Hounsfield units; the offset of its values from HU.
+/// [`cleanse`] refuses every other scan, and the viewer offers its switch only where this holds.
+pub fn hounsfield_offset(modality: &Modality, values: &ScanValues) -> Result<f64, CleanseError> {
+    match (modality, values.kind) {
+        (Modality::Mr | Modality::Other(_), _) => Err(CleanseError::NotHounsfield),
+        (_, ValueKind::Hounsfield { offset }) => Ok(offset),
+        _ => Err(CleanseError::NotHounsfield),
+    }
 }

@@ -28,12 +28,14 @@
 mod cast;
 mod image;
 mod map;
+mod pick;
 mod rays;
 #[cfg(test)]
 mod tests;
 
 pub use image::{Plot, Scale};
 pub use map::WallMap;
+pub use pick::PickError;
 
 use crate::path::Path;
 use crate::render::{RenderSettings, MAX_IMAGE_EDGE};

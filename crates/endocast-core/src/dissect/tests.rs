@@ -139,16 +139,22 @@ fn rays_inside_a_tight_bend_stop_where_the_next_column_cuts_them() {
     }
 }
 
-#[test]
-fn bad_options_and_a_path_outside_the_lumen_are_refused_by_name() {
+/// A `size³` phantom of a straight tube without rings along z through the origin, the path
+/// along its axis from `z = −half_mm` to `half_mm`, and its wall.
+fn straight_tube(size: usize, half_mm: f64) -> (Volume, Path, Wall) {
     let tube = |p: DVec3| (p.z, p.truncate().length());
-    let volume = phantom(24, &tube, &[]);
-    let axis = [DVec3::new(0.0, 0.0, -5.0), DVec3::new(0.0, 0.0, 5.0)];
-    let path = Path::from_points_exact(&axis, 0.5).unwrap();
+    let axis = [-half_mm, half_mm].map(|z| DVec3::new(0.0, 0.0, z));
     let wall = Wall {
         iso: ISO,
         color: [1.0; 3],
     };
+    let path = Path::from_points_exact(&axis, 0.5).unwrap();
+    (phantom(size, &tube, &[]), path, wall)
+}
+
+#[test]
+fn bad_options_and_a_path_outside_the_lumen_are_refused_by_name() {
+    let (volume, path, wall) = straight_tube(24, 5.0);
     let error = |wall: &Wall, options: DissectOptions| {
         dissect(&volume, &path, wall, &options)
             .unwrap_err()
@@ -187,5 +193,66 @@ fn bad_options_and_a_path_outside_the_lumen_are_refused_by_name() {
     assert!(
         message.contains("no ray from the path met the wall"),
         "{message}"
+    );
+}
+
+#[test]
+fn a_flat_pixel_gives_the_camera_on_its_column_looking_at_its_wall_point() {
+    let (volume, path, wall) = straight_tube(32, 10.0);
+    let flat = dissect(&volume, &path, &wall, &DissectOptions::default()).unwrap();
+    let plot = flat.plot;
+    let (x, y) = (plot.x + 12, plot.y + 200);
+    let pose = flat.pose_of_pixel(&path, x, y).unwrap();
+    // Column 12 is 6 mm along the axis from z = −10; the eye looks at the mapped wall point.
+    assert!(
+        pose.eye_mm.distance(DVec3::new(0.0, 0.0, -4.0)) < 1e-6,
+        "{pose:?}"
+    );
+    assert_eq!(Some(pose.look_at_mm), flat.map.at(x, y));
+    assert!((pose.look_at_mm.z + 4.0).abs() < 1e-3, "{pose:?}");
+    assert!(pose.up.dot(pose.look_at_mm - pose.eye_mm).abs() < 1e-9);
+    assert_eq!(flat.arc_mm_of_column(x, &path), Some(6.0));
+    assert_eq!(flat.column_of_arc(6.0), Some(x));
+    // The last column is clamped to the path's end; beyond it and in the margins, nothing.
+    let last = plot.x + plot.columns - 1;
+    let end = flat.arc_mm_of_column(last, &path).unwrap();
+    assert!((end - path.len_mm()).abs() < 1e-9, "{end}");
+    assert_eq!(flat.column_of_arc(path.len_mm() + 1.0), None);
+    assert_eq!(flat.column_of_arc(f64::NAN), None);
+    assert_eq!(
+        flat.pose_of_pixel(&path, 2, 2),
+        Err(PickError::OutsidePlot(2, 2))
+    );
+    assert_eq!(
+        flat.pose_of_pixel(&path, x, plot.y + plot.rows),
+        Err(PickError::OutsidePlot(x, plot.y + plot.rows))
+    );
+}
+
+#[test]
+fn a_flat_pixel_whose_ray_met_no_wall_gives_no_camera() {
+    let (volume, path, wall) = straight_tube(24, 5.0);
+    // A reach shorter than the 8 mm radius: no ray meets the wall…
+    let short = DissectOptions {
+        reach_mm: 2.0,
+        ..Default::default()
+    };
+    assert!(dissect(&volume, &path, &wall, &short).is_err());
+    // …and with the reach to the wall for some rows only, the others are NaN.
+    let tilted: Vec<DVec3> = [-5.0, 5.0].map(|z| DVec3::new(3.0, 0.0, z)).to_vec();
+    let off_axis = Path::from_points_exact(&tilted, 0.5).unwrap();
+    let near = DissectOptions {
+        reach_mm: 6.0,
+        ..Default::default()
+    };
+    let flat = dissect(&volume, &off_axis, &wall, &near).unwrap();
+    let plot = flat.plot;
+    let x = plot.x + 4;
+    let empty = (plot.y..plot.y + plot.rows)
+        .find(|&y| flat.map.at(x, y).is_none())
+        .unwrap();
+    assert_eq!(
+        flat.pose_of_pixel(&off_axis, x, empty),
+        Err(PickError::NoWall(x, empty))
     );
 }

@@ -221,6 +221,16 @@ impl Path {
         &self.samples
     }
 
+    /// The sample (every [`SmoothOptions::step_mm`] of arc length) nearest `p_mm`, and its
+    /// distance from `p_mm`, mm: where along the path a camera off it stands.
+    pub fn nearest_sample(&self, p_mm: DVec3) -> (&PathSample, f64) {
+        self.samples
+            .iter()
+            .map(|sample| (sample, sample.position_mm.distance(p_mm)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or_else(|| unreachable!("a path has at least two samples"))
+    }
+
     /// Position at arc length `s_mm` (clamped to the path), mm.
     pub fn point_at(&self, s_mm: f64) -> DVec3 {
         self.spline.point(self.table.parameter_at(s_mm))

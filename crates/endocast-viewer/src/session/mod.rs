@@ -9,7 +9,7 @@ mod key_frames;
 pub use key_frames::{Playback, KEY_FRAME_UNDO};
 
 use crate::geometry::{Geometry, SceneRef, Toggles};
-use crate::jobs::{Job, Polled};
+use crate::jobs::{Job, Notify, Polled};
 use crate::scene::{Navigation, Scene};
 use crate::worker::{RenderWorker, View};
 use endocast_core::animation::KeyFrame;
@@ -164,6 +164,18 @@ pub struct Session {
     /// Grows with every change of the annotations or the stroke being drawn.
     marks_revision: u64,
     geometry: Geometry,
+    /// Called from the render thread after each delivered frame.
+    on_frame: OnFrame,
+}
+
+/// What the render thread calls after each delivered frame (kept to start another worker).
+#[derive(Clone)]
+struct OnFrame(Notify);
+
+impl std::fmt::Debug for OnFrame {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("OnFrame")
+    }
 }
 
 impl Session {
@@ -191,7 +203,8 @@ impl Session {
             .unwrap_or_else(|| {
                 FlyCamera::new(DVec3::ZERO, DVec3::Z, DVec3::NEG_Y).expect("a valid frame")
             });
-        let worker = RenderWorker::start(Arc::clone(&scene.renderer), on_frame);
+        let on_frame = OnFrame(Arc::new(on_frame));
+        let worker = start_worker(&scene, &on_frame);
         let mut session = Self {
             scene,
             study,
@@ -212,6 +225,7 @@ impl Session {
             stroke: Vec::new(),
             marks_revision: 0,
             geometry: Geometry::default(),
+            on_frame,
         };
         // The first lumen is found here, on the loading thread; later ones off the UI thread.
         session.navigation = session.lumen_search().and_then(|search| search());
@@ -221,6 +235,20 @@ impl Session {
     /// The scene.
     pub fn scene(&self) -> &Arc<Scene> {
         &self.scene
+    }
+
+    /// Shows `scene` from now on, understood as `study` says (the same scan cleansed, or as
+    /// acquired again): a render worker of its own, the lumen around the eye found in it; the
+    /// camera, the controls, the key frames and the marks stay.
+    pub fn show_scene(&mut self, scene: Arc<Scene>, study: Arc<Study>) {
+        self.worker = start_worker(&scene, &self.on_frame);
+        self.scene = scene;
+        self.study = study;
+        self.last_view = None;
+        self.last_submit = None;
+        self.stereo_focus = None;
+        self.navigation = None;
+        self.find_lumen();
     }
 
     /// The flying camera.
@@ -682,4 +710,10 @@ impl Session {
             Ok(image)
         }
     }
+}
+
+/// A render worker on `scene`'s renderer, calling `on_frame` after each delivered frame.
+fn start_worker(scene: &Scene, on_frame: &OnFrame) -> RenderWorker {
+    let on_frame = Arc::clone(&on_frame.0);
+    RenderWorker::start(Arc::clone(&scene.renderer), move || on_frame())
 }
