@@ -32,12 +32,12 @@ pub(super) struct Node {
     pub point_mm: DVec3,
     /// Its distance to the nearest wall voxel centre, mm.
     pub distance_mm: f64,
-    /// The node before it towards the trachea's top (`None` for node 0, at that top).
+    /// The node before it towards the root (`None` for the root, node 0).
     pub parent: Option<usize>,
 }
 
 /// The tree of centreline voxels of `lumen` (with its distance `field`) grown from `root` (see
-/// [`root_near`]), the trachea's top above the root first, every node after its parent. No
+/// [`root_near`]), root first, every node after its parent. No
 /// branch starts within [`ROOT_REACH_MM`] of the lumen's seed (the trachea's top, above the
 /// root); a branch the scan's face cuts ends in the middle of the cut ([`Tree::trimmed`]).
 pub(super) fn skeletonise(
@@ -62,9 +62,8 @@ pub(super) fn skeletonise(
         node_of: vec![u32::MAX; voxels.len()],
         nodes: Vec::new(),
     };
-    let trunk = trunk(&paths, lumen.seed(), root);
-    tree.add(&trunk, None);
-    tree.cover(&trunk);
+    tree.add(&[root], None);
+    tree.cover(&[root]);
     let mut tried = 0;
     for &(n, _) in &farthest_first {
         if tried == MAX_PATHS {
@@ -206,21 +205,6 @@ impl Tree<'_> {
                 }
             }
         }
-    }
-}
-
-/// The centred path from `seed` (on the scan's top face) down to `root`: the trachea's top,
-/// which no branch starts in, so that routes start where the scan does. Only the root when the
-/// seed is not reached.
-fn trunk(paths: &CentredPaths, seed: [usize; 3], root: [usize; 3]) -> Vec<[usize; 3]> {
-    let mut chain = vec![seed];
-    while let Some(up) = paths.parent(chain[chain.len() - 1]) {
-        chain.push(up);
-    }
-    if chain[chain.len() - 1] == root {
-        chain
-    } else {
-        vec![root]
     }
 }
 
