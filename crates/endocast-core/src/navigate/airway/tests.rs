@@ -151,7 +151,10 @@ fn a_thinner_scope_reaches_nearer_to_a_target() {
     assert_eq!(names(&thick)[..2], ["trachea", "left main bronchus"]);
     assert!(thick.remaining_mm > thin.remaining_mm + 5.0);
     let mouth = thick.end_mm().distance(DVec3::new(18.0, 0.0, -10.0));
-    assert!(mouth < 6.0, "ends {mouth} mm from the left main bronchus's end");
+    assert!(
+        mouth < 6.0,
+        "ends {mouth} mm from the left main bronchus's end"
+    );
 }
 
 #[test]
