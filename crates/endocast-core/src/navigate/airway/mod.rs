@@ -4,8 +4,8 @@
 //!
 //! The centrelines come from the centred paths of [`super::centreline`] from the trachea's top
 //! ([`skeleton`]); a lumen diameter along them is twice the distance to the nearest wall voxel
-//! centre less half a voxel (the wall's surface lies on average half a voxel inside that centre,
-//! see [`DistanceField`]).
+//! centre on the distance field's ridge beside a node, less half a voxel (the wall's surface
+//! lies on average half a voxel inside that centre, see [`DistanceField`]).
 
 mod body;
 mod branches;
