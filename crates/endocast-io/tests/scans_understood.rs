@@ -2,6 +2,7 @@
 //! dark or bright), and the ventricles found at the brain's centre on T1, FLAIR and a T2-like
 //! volume made from the T1.
 
+use endocast_core::cleanse::cleanse;
 use endocast_core::navigate::{default_view, find_trachea, DefaultView, LumenChoice};
 use endocast_core::presets::Preset;
 use endocast_core::tissue::{self, ScanValues, ValueKind};
@@ -154,6 +155,18 @@ fn the_airway_tree_is_found_on_the_chest_ct_without_the_lung() {
         (tree.voxel_count(), threshold)
     );
     assert!(tree_s.voxels().all(|[a, b, c]| tree.contains([b, c, a])));
+}
+
+/// Issue 36: the abdomen CT has no oral contrast; the CT table's bright top under the air
+/// beneath it and an enhanced bowel wall under gas gave three false pools.
+#[test]
+fn the_abdomen_ct_without_oral_contrast_has_no_pool_to_cleanse() {
+    let Some(abdomen) = load("abdomen-ct-pancreas-dicom") else {
+        return;
+    };
+    let cleansed = cleanse(&abdomen).unwrap();
+    assert!(cleansed.pools.is_empty(), "{}", cleansed.summary());
+    assert_eq!(cleansed.volume.voxels(), abdomen.voxels());
 }
 
 #[test]

@@ -4,8 +4,8 @@
 //!
 //! The centrelines come from the centred paths of [`super::centreline`] from the trachea's top
 //! ([`skeleton`]); a lumen diameter along them is twice the distance to the nearest wall voxel
-//! centre less half a voxel (the wall's surface lies on average half a voxel inside that centre,
-//! see [`DistanceField`]).
+//! centre on the distance field's ridge beside a node, less half a voxel (the wall's surface
+//! lies on average half a voxel inside that centre, see [`DistanceField`]).
 
 mod body;
 mod branches;
@@ -47,9 +47,10 @@ impl AirwayBranch {
     }
 }
 
-/// The lumen's diameter at a centreline node, mm: twice its distance to the nearest wall voxel
-/// centre less half a voxel; infinite where the scan's border is as near as the wall (the lumen
-/// runs on out of the scan, as the trachea does at its top).
+/// The lumen's diameter at a centreline node, mm: twice the distance to the nearest wall voxel
+/// centre on the lumen's medial ridge beside the node ([`ridge_distance_mm`]) less half a voxel;
+/// infinite where the scan's border is as near as the wall (the lumen runs on out of the scan,
+/// as the trachea does at its top).
 fn diameter_mm(volume: &Volume, field: &DistanceField, node: &Node) -> f64 {
     let spacing = volume.geometry().spacing_mm().to_array();
     let dims = volume.dims();
@@ -59,7 +60,28 @@ fn diameter_mm(volume: &Volume, field: &DistanceField, node: &Node) -> f64 {
     if node.distance_mm >= border_mm - 1e-6 {
         return f64::INFINITY;
     }
-    2.0 * (node.distance_mm - 0.5 * field.min_spacing_mm()).max(0.0)
+    let ridge_mm = ridge_distance_mm(field, node, volume.geometry().spacing_mm().length());
+    2.0 * (ridge_mm - 0.5 * field.min_spacing_mm()).max(0.0)
+}
+
+/// The distance to the wall on the lumen's medial ridge beside a centreline node, mm. A node
+/// is a voxel centre, up to half a voxel diagonal off the ridge, where the distance is smaller
+/// by that offset (a tube's distance field is a cone around its axis): a 6.5 mm scope did not
+/// fit an 8 mm bronchus whose nodes lay half a voxel off its axis. Along the field's gradient
+/// the distance rises to the ridge and falls back to the node's value as far beyond it, so
+/// the ridge adds half that chord. Where it does not fall back within `reach_mm` (the voxel
+/// diagonal) the node lies on a slope along the lumen (a narrowing), not beside its ridge,
+/// and keeps its own distance.
+fn ridge_distance_mm(field: &DistanceField, node: &Node, reach_mm: f64) -> f64 {
+    let Some(up) = field.gradient(node.point_mm).try_normalize() else {
+        return node.distance_mm;
+    };
+    let step_mm = 0.05 * field.min_spacing_mm();
+    let chord_mm = (1..)
+        .map(|n| f64::from(n) * step_mm)
+        .take_while(|&t| t <= reach_mm)
+        .find(|&t| field.distance_mm(node.point_mm + up * t) <= node.distance_mm);
+    node.distance_mm + chord_mm.map_or(0.0, |t| 0.5 * t)
 }
 
 /// An airway tree: its branches, the trachea first, every branch after the one it leaves.

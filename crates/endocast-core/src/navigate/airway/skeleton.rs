@@ -16,10 +16,6 @@ const COVER_MARGIN_MM: f64 = 2.0;
 /// A branch is kept when it runs this far beyond the lumen around the tree, mm: shorter ones
 /// are the wall's bumps.
 const MIN_BRANCH_MM: f64 = 3.0;
-/// Lumen voxels this close to the scan's faces (in voxels) start no branch: the scan cuts the
-/// lumen there (the trachea at the top), and its cut rim would give spurious tips. Nor do those
-/// within [`ROOT_REACH_MM`] of the seed: the trachea's top, above the root.
-const BORDER_VOXELS: usize = 3;
 /// The root is the widest lumen voxel this near the seed, mm: the seed lies on the scan's top
 /// face, where the border, not the wall, limits the distance to the wall.
 pub(super) const ROOT_REACH_MM: f64 = 25.0;
@@ -41,8 +37,9 @@ pub(super) struct Node {
 }
 
 /// The tree of centreline voxels of `lumen` (with its distance `field`) grown from `root` (see
-/// [`root_near`]), root first, every node after its parent. No branch starts within
-/// [`BORDER_VOXELS`] of the scan's faces nor within [`ROOT_REACH_MM`] of the lumen's seed.
+/// [`root_near`]), root first, every node after its parent. No
+/// branch starts within [`ROOT_REACH_MM`] of the lumen's seed (the trachea's top, above the
+/// root); a branch the scan's face cuts ends in the middle of the cut ([`Tree::trimmed`]).
 pub(super) fn skeletonise(
     volume: &Volume,
     lumen: &Lumen,
@@ -55,13 +52,8 @@ pub(super) fn skeletonise(
         .filter_map(|n| paths.length_mm(n).map(|l| (n, l)))
         .collect();
     farthest_first.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let dims = volume.dims();
-    // The cut rim and the top of the trachea, above the root, start no branch.
     let seed_mm = field.world_of_voxel(lumen.seed());
-    let settled = |v: &[usize; 3]| {
-        (0..3).any(|a| v[a].min(dims[a] - 1 - v[a]) < BORDER_VOXELS)
-            || field.world_of_voxel(*v).distance(seed_mm) <= ROOT_REACH_MM
-    };
+    let settled = |v: &[usize; 3]| field.world_of_voxel(*v).distance(seed_mm) <= ROOT_REACH_MM;
     let mut tree = Tree {
         field,
         paths: &paths,
@@ -123,7 +115,7 @@ impl Tree<'_> {
             .collect();
         let length: f64 = points.windows(2).map(|w| w[0].distance(w[1])).sum();
         if length >= MIN_BRANCH_MM {
-            self.add(new, Some(junction));
+            self.add(self.trimmed(new), Some(junction));
         }
         self.cover(&chain);
     }
@@ -150,6 +142,24 @@ impl Tree<'_> {
             junction = nearest;
         }
         (junction, chain.len())
+    }
+
+    /// `chain` less its tail inside the inscribed ball of an earlier voxel. The farthest voxel of
+    /// a branch lies on the wall of its end (or on the rim where the scan cuts it), so the path
+    /// to it leaves the axis over its last radius; the branch ends at the first voxel whose
+    /// inscribed ball holds that tip: the centre of a rounded end, the middle of a cut.
+    fn trimmed<'c>(&self, chain: &'c [[usize; 3]]) -> &'c [[usize; 3]] {
+        let Some(&tip) = chain.last() else {
+            return chain;
+        };
+        let tip_mm = self.field.world_of_voxel(tip);
+        let end = chain
+            .iter()
+            .position(|&v| {
+                self.field.world_of_voxel(v).distance(tip_mm) <= self.field.distance_at_voxel(v)
+            })
+            .unwrap_or(chain.len() - 1);
+        &chain[..=end]
     }
 
     /// Appends `chain` as a path of nodes below `parent`.

@@ -104,8 +104,6 @@ fn tree() -> (Volume, AirwayTree) {
 }
 
 #[test]
-#[ignore = "fails on main (open, issue 36 item 7): the right lower lobe's centreline runs 2.0 mm off its axis \
-            (1.5 allowed)"]
 fn every_branch_of_the_phantom_is_found_and_named() {
     let (_, tree) = tree();
     for (name, a, b, r) in SEGMENTS {
@@ -132,8 +130,6 @@ fn every_branch_of_the_phantom_is_found_and_named() {
 }
 
 #[test]
-#[ignore = "fails on main (open, issue 36 item 7): the 6.5 mm scope's route stops in the trachea, not in the \
-            8 mm left main bronchus"]
 fn a_thinner_scope_reaches_nearer_to_a_target() {
     let (volume, tree) = tree();
     // Beside the left upper lobe bronchus's far end, in the tissue.
@@ -154,8 +150,23 @@ fn a_thinner_scope_reaches_nearer_to_a_target() {
     let thick = tree.route(&volume, target, 6.5).unwrap();
     assert_eq!(names(&thick)[..2], ["trachea", "left main bronchus"]);
     assert!(thick.remaining_mm > thin.remaining_mm + 5.0);
-    assert!(thick.end_mm().distance(DVec3::new(18.0, 0.0, -10.0)) < 6.0);
-    // The route runs from the trachea's top without gaps.
+    let mouth = thick.end_mm().distance(DVec3::new(18.0, 0.0, -10.0));
+    assert!(
+        mouth < 6.0,
+        "ends {mouth} mm from the left main bronchus's end"
+    );
+}
+
+#[test]
+#[ignore = "open (issue 36 item 7): the route starts at the root, 5 mm below the scan's top (the chest \
+            CT's seed lies on the rim of the tracheal section, so the path from it is no start either), and a \
+            branch's raw points jump from its junction to where it leaves its parent's lumen (6 mm into the \
+            left upper lobe bronchus; a straight link there cuts the corner and narrows the route)"]
+fn a_route_runs_from_the_tracheas_top_without_gaps() {
+    let (volume, tree) = tree();
+    let thin = tree
+        .route(&volume, DVec3::new(25.0, -7.0, 5.0), 3.0)
+        .unwrap();
     assert!(thin.points_mm[0].z > 30.0);
     assert!(thin.points_mm.windows(2).all(|w| w[0].distance(w[1]) < 1.8));
 }
