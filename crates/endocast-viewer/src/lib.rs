@@ -13,6 +13,8 @@
 //!   without a window;
 //! - [`case`]: case files, written atomically and autosaved;
 //! - [`case_choice`]: which case a session reopens and saves to (never one it would replace);
+//! - [`compare`]: a second scan of the patient (prone beside supine) beside the view, its
+//!   camera following the first's through the scans' correspondence;
 //! - [`planner`]: the centred path between two points (or to the farthest) as key frames;
 //! - [`export`]: the flight filmed (GIF, MP4, PNGs) and its path files (ours, Slicer Markups);
 //! - [`geometry`]: the grid, the endoscope's instrument, marker spheres and meshes drawn;
@@ -34,6 +36,7 @@
 //!     on_screenshot: None,
 //!     look: None,
 //!     layout: None,
+//!     compare: None,
 //! })
 //! .unwrap();
 //! # }
@@ -43,6 +46,9 @@
 pub mod app;
 pub mod case;
 pub mod case_choice;
+pub mod compare;
+#[cfg(feature = "window")]
+mod compare_ui;
 pub mod controller;
 pub mod export;
 #[cfg(feature = "window")]

@@ -1,6 +1,7 @@
 //! What the window keeps beside the session, shared by the window's parts.
 
 use crate::case::Autosave;
+use crate::compare_ui::CompareView;
 use crate::flight_ui::FlightTools;
 use crate::geometry_ui::MeshLoader;
 use crate::jobs::Job;
@@ -35,6 +36,8 @@ pub(crate) struct Ready {
     pub last_input: Option<Instant>,
     /// The review of the wall a flight missed.
     pub review: ReviewTools,
+    /// A second scan (prone beside supine) whose view follows this one.
+    pub compare: CompareView,
 }
 
 /// What the control panel asks of the application.
@@ -46,6 +49,9 @@ pub(crate) enum Action {
     /// Read the scan again with its index axes pointing as this code says (a file that
     /// declares no orientation, turned the other way up).
     Reorient(String),
+    /// Open the path typed in the panel as a second scan beside this one (prone beside
+    /// supine), its camera following this one.
+    Compare,
     /// Save the case now.
     SaveCase,
     /// Show a line in the status bar.

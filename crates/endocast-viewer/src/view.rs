@@ -172,7 +172,7 @@ fn show_frame(ui: &egui::Ui, ready: &mut Ready, rect: Rect) {
 }
 
 /// The largest rectangle of `aspect` (width / height) centred in `rect`.
-fn fit(rect: Rect, aspect: f32) -> Rect {
+pub(crate) fn fit(rect: Rect, aspect: f32) -> Rect {
     let size = if rect.width() / rect.height().max(1.0) > aspect {
         Vec2::new(rect.height() * aspect, rect.height())
     } else {

@@ -26,6 +26,9 @@ const LINE_PX: f64 = 1.3;
 /// and the share of it the dash takes (the line's round ends fill some of the gap).
 const DASH_PERIOD_PX: f64 = 10.0;
 const DASH_SHARE: f64 = 0.4;
+/// The off-view arrow's length and its tip's distance from the image's edge, pixels.
+const ARROW_PX: f64 = 18.0;
+const ARROW_MARGIN_PX: f64 = 6.0;
 
 /// Where the target stands in a view.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,7 +48,7 @@ pub enum TargetSight {
         /// Straight distance from the eye, mm.
         distance_mm: f64,
     },
-    /// Outside the image or behind the camera: not drawn.
+    /// Outside the image or behind the camera: an arrow at the image's edge points the way.
     OutOfView {
         /// Straight distance from the eye, mm.
         distance_mm: f64,
@@ -94,7 +97,10 @@ pub fn draw_target(image: &mut Image, view: &SurfaceView<'_>, target_mm: DVec3) 
             true,
             format!("target {distance_mm:.1} mm, behind the wall"),
         ),
-        TargetSight::OutOfView { .. } => return sight,
+        TargetSight::OutOfView { distance_mm } => {
+            edge_arrow(image, view, target_mm, distance_mm);
+            return sight;
+        }
     };
     let radius = ring_radius_px(view, target_mm, at);
     ring(image, at, radius, color, dashed);
@@ -117,6 +123,40 @@ pub fn draw_target(image: &mut Image, view: &SurfaceView<'_>, target_mm: DVec3) 
         .max(1.0);
     image.text_shadowed(left as i64, top as i64, &caption, scale, color);
     sight
+}
+
+/// An arrow near the image's edge pointing the way to `target_mm` (outside the view), with its
+/// distance; nothing when it lies straight behind the camera.
+fn edge_arrow(image: &mut Image, view: &SurfaceView<'_>, target_mm: DVec3, distance_mm: f64) {
+    let camera = view.camera;
+    let to = target_mm - camera.eye_mm();
+    let (dx, dy) = (to.dot(camera.right()), -to.dot(camera.up()));
+    let length = dx.hypot(dy);
+    if length.is_nan() || length <= 1e-9 {
+        return;
+    }
+    let (w, h) = (image.width() as f64, image.height() as f64);
+    let reach = 0.5 * w.min(h) - ARROW_MARGIN_PX;
+    let along = |r: f64| (0.5 * w + dx / length * r, 0.5 * h + dy / length * r);
+    let (tail, tip) = (along(reach - ARROW_PX), along(reach));
+    for (radius, color) in [(LINE_PX + 1.0, [0; 3]), (LINE_PX, TARGET_COLOR)] {
+        for n in 0..=(2.0 * ARROW_PX) as usize {
+            image.disc(along(reach - 0.5 * n as f64), radius, color);
+        }
+    }
+    image.arrow(tail, tip, 0.4 * ARROW_PX, TARGET_COLOR);
+    let scale = if image.height() <= 300 { 1 } else { 2 };
+    let caption = format!("target {distance_mm:.0} mm");
+    let (width, height) = (
+        text_width(&caption, scale) as f64,
+        (GLYPH_HEIGHT * scale) as f64,
+    );
+    // Centred inside the arrow's tail, clear of it.
+    let clear = 0.5 * (width * dx.abs() + height * dy.abs()) / length + 4.0;
+    let centre = along(reach - ARROW_PX - clear);
+    let left = (centre.0 - 0.5 * width).clamp(1.0, (w - width - 1.0).max(1.0));
+    let top = (centre.1 - 0.5 * height).clamp(1.0, (h - height - 1.0).max(1.0));
+    image.text_shadowed(left as i64, top as i64, &caption, scale, TARGET_COLOR);
 }
 
 /// The radius of the outline of the target's sphere in the image, pixels (within
@@ -230,14 +270,19 @@ mod tests {
             (0.3..0.7).contains(&painted[1]),
             "the ring behind the wall is dashed: {painted:?}"
         );
-        // Behind the camera: not drawn.
-        let behind = centre - DVec3::Z * 5.0;
+        // Behind the camera and to its right: an arrow at the right edge points the way.
+        let behind = centre - DVec3::Z * 5.0 + camera.right() * 3.0;
         let mut image = Image::from_frame(&frame, settings.background).unwrap();
-        let before = image.clone();
         assert!(matches!(
             draw_target(&mut image, &view, behind),
             TargetSight::OutOfView { .. }
         ));
-        assert_eq!(image.rgb(), before.rgb());
+        let marked = |columns: std::ops::Range<usize>| {
+            let rows = 0..image.height();
+            rows.flat_map(|y| columns.clone().map(move |x| (x, y)))
+                .filter(|&(x, y)| image.pixel(x, y) == Some(TARGET_COLOR))
+                .count()
+        };
+        assert!(marked(80..96) > 10 && marked(0..12) == 0);
     }
 }
