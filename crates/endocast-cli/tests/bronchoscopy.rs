@@ -52,6 +52,20 @@ fn route(chest: &str, target: [f64; 3], scope_mm: f64) -> Value {
     serde_json::from_slice(&run.stdout).unwrap()
 }
 
+/// `endocast path CHEST --preset bronchoscopy --target TARGET -o OUT`.
+fn path_to<'a>(chest: &'a str, target: &'a str, out: &'a str) -> [&'a str; 8] {
+    [
+        "path",
+        chest,
+        "--preset",
+        "bronchoscopy",
+        "--target",
+        target,
+        "-o",
+        out,
+    ]
+}
+
 /// The names of the branches a route passes.
 fn passed(report: &Value) -> Vec<String> {
     report["branches"]
@@ -132,17 +146,7 @@ fn the_last_frame_of_the_route_to_the_nodule_rings_the_target() {
     let (route, frames) = (dir.path().join("route.json"), dir.path().join("frames"));
     let (route, frames) = (route.to_str().unwrap(), frames.to_str().unwrap());
     let target = "52.0,79.2,-50.5";
-    let planned = [
-        "path",
-        chest,
-        "--preset",
-        "bronchoscopy",
-        "--target",
-        target,
-        "-o",
-        route,
-    ];
-    assert!(endocast(&planned).status.success());
+    assert!(endocast(&path_to(chest, target, route)).status.success());
     let file: Value = serde_json::from_str(&std::fs::read_to_string(route).unwrap()).unwrap();
     assert_eq!(file["target"], serde_json::json!([52.0, 79.2, -50.5]));
     // Two frames: the route's start and its end.
@@ -187,21 +191,8 @@ fn targets_outside_the_body_or_not_numbers_are_errors() {
         return;
     };
     let chest = chest.to_str().unwrap();
-    let run = |target: &str, needle: &str| {
-        fails_with(
-            &[
-                "path",
-                chest,
-                "--preset",
-                "bronchoscopy",
-                "--target",
-                target,
-                "-o",
-                "/tmp/x.json",
-            ],
-            needle,
-        );
-    };
+    let run =
+        |target: &str, needle: &str| fails_with(&path_to(chest, target, "/tmp/x.json"), needle);
     // The air in front of the chest, inside the scan.
     run("0,-150,0", "outside the body");
     run("0,0,500", "outside");

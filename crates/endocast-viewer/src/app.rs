@@ -387,10 +387,9 @@ impl ViewerApp {
         let Some(path) = self.options.screenshot.clone() else {
             return;
         };
-        let refined = self
-            .ready
-            .as_ref()
-            .is_some_and(|r| matches!(r.shown, Some((_, Stage::Still(n), _)) if n >= 4));
+        let refined = self.ready.as_ref().is_some_and(|r| {
+            matches!(r.shown, Some((_, Stage::Still(n), _)) if n >= 4) && r.compare.settled()
+        });
         if refined && !self.screenshot_requested {
             self.screenshot_requested = true;
             ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::default()));

@@ -6,8 +6,8 @@ use crate::compare::{Compare, CompareJob};
 use crate::jobs::Polled;
 use crate::scene::ScanSource;
 use crate::session::Session;
-use crate::view::fit;
-use egui::{Color32, Pos2, Rect, TextureOptions, Vec2};
+use crate::view::picture_ui;
+use egui::{Rect, TextureOptions};
 use endocast_core::render::progressive::Stage;
 use std::sync::Arc;
 
@@ -59,6 +59,13 @@ impl CompareView {
     /// Whether the second view takes part of the window (open or being opened).
     pub fn is_shown(&self) -> bool {
         self.opening.is_some() || self.open.is_some()
+    }
+
+    /// Whether nothing is left to wait for: no second scan, or its view shown at full
+    /// resolution (a `--screenshot` waits for it).
+    pub fn settled(&self) -> bool {
+        let full = matches!(self.shown, Some((_, Stage::Full | Stage::Still(_))));
+        self.opening.is_none() && (self.open.is_none() || full)
     }
 
     /// The second scan, once open.
@@ -123,19 +130,6 @@ fn show_frame(ui: &egui::Ui, view: &mut CompareView, rect: Rect) {
             }
         }
     }
-    if let Some(texture) = &view.texture {
-        let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
-        let shown = fit(rect, texture.aspect_ratio());
-        ui.painter().image(texture.id(), shown, uv, Color32::WHITE);
-    }
     let error = view.error.clone().or_else(|| compare.worker().error());
-    if let Some(error) = error {
-        ui.painter().text(
-            rect.left_top() + Vec2::splat(8.0),
-            egui::Align2::LEFT_TOP,
-            error,
-            egui::FontId::proportional(14.0),
-            Color32::LIGHT_RED,
-        );
-    }
+    picture_ui(ui, view.texture.as_ref(), rect, error);
 }
