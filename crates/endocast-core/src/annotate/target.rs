@@ -207,15 +207,15 @@ mod tests {
 
     /// The fraction of the ring's circle (radius `radius` around `at`) painted `color`.
     fn ring_painted(image: &Image, at: (f64, f64), radius: f64, color: Rgb) -> f64 {
-        let samples = 96;
+        let samples = 96u32;
         let painted = (0..samples)
             .filter(|&n| {
-                let angle = std::f64::consts::TAU * (n as f64 + 0.5) / samples as f64;
+                let angle = std::f64::consts::TAU * (f64::from(n) + 0.5) / f64::from(samples);
                 let (x, y) = (at.0 + radius * angle.cos(), at.1 + radius * angle.sin());
                 image.pixel(x as usize, y as usize) == Some(color)
             })
             .count();
-        painted as f64 / samples as f64
+        painted as f64 / f64::from(samples)
     }
 
     /// On the sphere shell (inner wall known exactly), from its centre: a target inside the
