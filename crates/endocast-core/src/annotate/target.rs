@@ -270,9 +270,13 @@ mod tests {
             (0.3..0.7).contains(&painted[1]),
             "the ring behind the wall is dashed: {painted:?}"
         );
-        // Behind the camera and to its right: an arrow at the right edge points the way.
-        let behind = centre - DVec3::Z * 5.0 + camera.right() * 3.0;
-        let mut image = Image::from_frame(&frame, settings.background).unwrap();
+        // Behind the camera and to its right: an arrow at the right edge points the way, its
+        // distance beside it (a wider image, so that the caption fits beside the arrow).
+        let wide = Camera::look_at(centre, centre + DVec3::Z, DVec3::Y, 90.0, [256, 256]).unwrap();
+        let empty = vec![f32::NAN; 256 * 256];
+        let view = SurfaceView::new(&wide, &empty, spacing);
+        let behind = centre - DVec3::Z * 5.0 + wide.right() * 3.0;
+        let mut image = Image::new(256, 256, [0; 3]).unwrap();
         assert!(matches!(
             draw_target(&mut image, &view, behind),
             TargetSight::OutOfView { .. }
@@ -283,6 +287,6 @@ mod tests {
                 .filter(|&(x, y)| image.pixel(x, y) == Some(TARGET_COLOR))
                 .count()
         };
-        assert!(marked(80..96) > 10 && marked(0..12) == 0);
+        assert!(marked(230..256) > 10 && marked(0..128) == 0);
     }
 }
