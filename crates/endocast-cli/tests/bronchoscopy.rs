@@ -12,7 +12,8 @@
 //! branches that run on down (z < −38 mm): the lower lobe bronchi. A coronal projection of the
 //! component shows the same tree.
 
-use crate::common::{endocast, fails_with};
+use crate::common::{count_color, endocast, fails_with};
+use endocast_core::annotate::{HIDDEN_TARGET_COLOR, TARGET_COLOR};
 use serde_json::Value;
 
 /// (name the route must pass, a point in that branch's lumen: world mm, LPS).
@@ -49,6 +50,20 @@ fn route(chest: &str, target: [f64; 3], scope_mm: f64) -> Value {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{args:?} failed: {stderr}");
     serde_json::from_slice(&run.stdout).unwrap()
+}
+
+/// `endocast path CHEST --preset bronchoscopy --target TARGET -o OUT`.
+fn path_to<'a>(chest: &'a str, target: &'a str, out: &'a str) -> [&'a str; 8] {
+    [
+        "path",
+        chest,
+        "--preset",
+        "bronchoscopy",
+        "--target",
+        target,
+        "-o",
+        out,
+    ]
 }
 
 /// The names of the branches a route passes.
@@ -119,27 +134,65 @@ fn the_chest_ct_tree_is_labelled_and_routes_reach_targets_beside_it() {
     }
 }
 
+/// The target drawn in the endoscope view (issue 36): the route to the left lower lobe nodule
+/// keeps its target, and the last frame of the flight along it rings the target.
+#[test]
+fn the_last_frame_of_the_route_to_the_nodule_rings_the_target() {
+    let Some(chest) = endocast_testdata::shared_data("chest-ct-airways-dicom") else {
+        return;
+    };
+    let chest = chest.to_str().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (route, frames) = (dir.path().join("route.json"), dir.path().join("frames"));
+    let (route, frames) = (route.to_str().unwrap(), frames.to_str().unwrap());
+    let target = "52.0,79.2,-50.5";
+    assert!(endocast(&path_to(chest, target, route)).status.success());
+    let file: Value = serde_json::from_str(&std::fs::read_to_string(route).unwrap()).unwrap();
+    assert_eq!(file["target"], serde_json::json!([52.0, 79.2, -50.5]));
+    // Two frames: the route's start and its end.
+    let flown = [
+        "fly",
+        chest,
+        "--path",
+        route,
+        "--preset",
+        "bronchoscopy",
+        "--frame-step",
+        "1000",
+        "--size",
+        "192x192",
+        "-o",
+        frames,
+    ];
+    let run = endocast(&flown);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let mut pngs: Vec<_> = std::fs::read_dir(frames)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    pngs.sort();
+    let last = pngs.last().unwrap();
+    let ringed = count_color(last, TARGET_COLOR) + count_color(last, HIDDEN_TARGET_COLOR);
+    assert!(
+        ringed > 30,
+        "{} pixels of the target's ring in {}",
+        ringed,
+        last.display()
+    );
+}
+
 #[test]
 fn targets_outside_the_body_or_not_numbers_are_errors() {
     let Some(chest) = endocast_testdata::shared_data("chest-ct-airways-dicom") else {
         return;
     };
     let chest = chest.to_str().unwrap();
-    let run = |target: &str, needle: &str| {
-        fails_with(
-            &[
-                "path",
-                chest,
-                "--preset",
-                "bronchoscopy",
-                "--target",
-                target,
-                "-o",
-                "/tmp/x.json",
-            ],
-            needle,
-        );
-    };
+    let run =
+        |target: &str, needle: &str| fails_with(&path_to(chest, target, "/tmp/x.json"), needle);
     // The air in front of the chest, inside the scan.
     run("0,-150,0", "outside the body");
     run("0,0,500", "outside");

@@ -10,6 +10,7 @@
 //!   "units": "mm",
 //!   "name": "sigmoid",
 //!   "points": [[0.0, 0.0, 0.0], [1.5, 0.2, 0.0]],
+//!   "target": [2.0, 9.0, -1.0],
 //!   "key_frames": [
 //!     {"eye": [0, 0, 0], "forward": [1, 0, 0], "up": [0, 0, 1],
 //!      "fov_deg": 60, "iso_hu": -500, "iso_opacity": 1.0, "tf": "colonoscopy"}
@@ -19,7 +20,9 @@
 //!
 //! Reading is strict so that a typo never silently changes a flight: unknown keys are errors
 //! (except comments, keys starting with `_`), every number is finite, `version` must be one we
-//! know. Files are written in LPS, one point or key frame per line.
+//! know. Files are written in LPS, one point or key frame per line. `"target"` (optional, since
+//! `endocast path --target`) is the point the route leads to — a nodule beyond the airway's
+//! end — which the endoscope views draw; files without it read as before.
 
 use crate::error::{ReadError, Result};
 use crate::markups::{short, vec3, within_range, CoordinateSystem};
@@ -37,7 +40,7 @@ pub const VERSION: u64 = 1;
 /// A path file of a million points is about 60 MiB; refuse larger unread.
 const MAX_BYTES: u64 = 64 << 20;
 /// Keys of the top-level object.
-const KEYS: [&str; 7] = [
+const KEYS: [&str; 8] = [
     "format",
     "version",
     "coordinate_system",
@@ -45,6 +48,7 @@ const KEYS: [&str; 7] = [
     "name",
     "points",
     "key_frames",
+    "target",
 ];
 
 /// The content of a path file: points to pass through, key frames, or both.
@@ -56,6 +60,9 @@ pub struct PathDocument {
     pub points_mm: Vec<DVec3>,
     /// Key frames of an animation, in playback order.
     pub key_frames: Vec<KeyFrame>,
+    /// The point the route leads to (a bronchoscopy target), LPS mm; `None` when the file
+    /// names none.
+    pub target_mm: Option<DVec3>,
 }
 
 /// One key frame as the file has it: a view direction and an up vector rather than a
@@ -111,6 +118,14 @@ pub fn parse_path_json(path: &Path, text: &str) -> Result<PathDocument> {
     };
     let points_mm = points(&map, system).map_err(error)?;
     let key_frames = key_frames(&map, system).map_err(error)?;
+    let target_mm = match map.get("target") {
+        None => None,
+        Some(value) => Some(
+            vec3(value)
+                .map(|p| system.to_lps(p))
+                .map_err(|why| error(format!("target: {why}")))?,
+        ),
+    };
     if points_mm.is_empty() && key_frames.is_empty() {
         return Err(error(
             "the file has neither \"points\" nor \"key_frames\"".into(),
@@ -120,6 +135,7 @@ pub fn parse_path_json(path: &Path, text: &str) -> Result<PathDocument> {
         name,
         points_mm,
         key_frames,
+        target_mm,
     })
 }
 
@@ -260,6 +276,11 @@ pub fn write_path_json(path: &Path, document: &PathDocument) -> Result<()> {
         })
         .collect::<std::result::Result<_, _>>()
         .map_err(error)?;
+    let target = document
+        .target_mm
+        .map(|t| finite_json("the target", &t.to_array(), &t.to_array()))
+        .transpose()
+        .map_err(error)?;
     let name = serde_json::to_string(&document.name).map_err(|e| error(e.to_string()))?;
     crate::atomic::write_file(path, |w| {
         writeln!(
@@ -270,6 +291,9 @@ pub fn write_path_json(path: &Path, document: &PathDocument) -> Result<()> {
         write!(w, "  \"name\": {name}")?;
         write_list(w, "points", &points)?;
         write_list(w, "key_frames", &keys)?;
+        if let Some(target) = &target {
+            write!(w, ",\n  \"target\": {target}")?;
+        }
         writeln!(w, "\n}}")
     })
 }
@@ -333,11 +357,13 @@ mod tests {
                 .map(|i| DVec3::new(f64::from(i) / 3.0, 1e-9, -1e3))
                 .collect(),
             key_frames: keys,
+            target_mm: Some(DVec3::new(2.5, -7.0, 31.25)),
         };
         write_path_json(&file, &document).unwrap();
         let read = read_path_json(&file).unwrap();
         assert_eq!(read.name, document.name);
         assert_eq!(read.points_mm, document.points_mm);
+        assert_eq!(read.target_mm, document.target_mm);
         for (a, b) in read.key_frames.iter().zip(&document.key_frames) {
             assert_eq!(
                 (a.eye_mm, a.fov_deg, a.iso_hu, a.iso_opacity),
@@ -349,6 +375,7 @@ mod tests {
         // Points only, and key frames only, are documents too.
         let points_only = PathDocument {
             key_frames: vec![],
+            target_mm: None,
             ..document.clone()
         };
         write_path_json(&file, &points_only).unwrap();
@@ -358,6 +385,10 @@ mod tests {
         let e = write_path_json(&file, &bad).unwrap_err().to_string();
         assert!(e.contains("point 3") && e.contains("not finite"), "{e}");
         assert!(write_path_json(&file, &PathDocument::default()).is_err());
+        let mut bad = document.clone();
+        bad.target_mm = Some(DVec3::new(0.0, f64::INFINITY, 0.0));
+        let e = write_path_json(&file, &bad).unwrap_err().to_string();
+        assert!(e.contains("the target") && e.contains("not finite"), "{e}");
         // The failed writes left the good file in place.
         assert_eq!(read_path_json(&file).unwrap(), points_only);
     }
@@ -366,7 +397,7 @@ mod tests {
     fn ras_files_are_converted_to_lps() {
         let text = r#"{"format": "endocast-path", "version": 1, "coordinate_system": "RAS", "units": "mm",
             "_comment": "made by hand",
-            "points": [[1, 2, 3], [4, 5, 6]],
+            "points": [[1, 2, 3], [4, 5, 6]], "target": [7, 8, 9],
             "key_frames": [{"eye": [1, 2, 3], "forward": [1, 0, 0], "up": [0, 1, 0],
                             "fov_deg": 60, "iso_hu": -500, "iso_opacity": 1}]}"#;
         let d = parse(text).unwrap();
@@ -374,6 +405,7 @@ mod tests {
             d.points_mm,
             vec![DVec3::new(-1.0, -2.0, 3.0), DVec3::new(-4.0, -5.0, 6.0)]
         );
+        assert_eq!(d.target_mm, Some(DVec3::new(-7.0, -8.0, 9.0)));
         let k = &d.key_frames[0];
         assert_eq!(k.eye_mm, DVec3::new(-1.0, -2.0, 3.0));
         assert!(k.forward().distance(-DVec3::X) < 1e-12 && k.up().distance(-DVec3::Y) < 1e-12);
@@ -430,6 +462,10 @@ mod tests {
                 "not valid JSON".into(),
             ),
             (with(r#""pionts": []"#), "unknown key \"pionts\"".into()),
+            (
+                with(r#""points": [[0, 0, 0], [1, 2, 3]], "target": [1, "x", 2]"#),
+                "target: expected [x, y, z]".into(),
+            ),
             (with(r#""key_frames": []"#), "non-empty list".into()),
             (
                 with(&format!(

@@ -34,6 +34,15 @@ pub fn read_route(file: &Path) -> Result<Route> {
     parse_route(file, &text)
 }
 
+/// The target the route in `file` leads to: endocast's path JSON's `"target"` (a bronchoscopy
+/// target, see [`path_file`]); none in a file without one or in Markups.
+pub fn read_target(file: &Path) -> Result<Option<DVec3>> {
+    if is_markups(file) {
+        return Ok(None);
+    }
+    Ok(path_file::read_path_json(file)?.target_mm)
+}
+
 /// Parses the text of a route file named `file` (its name decides the format, see
 /// [`read_route`]).
 pub fn parse_route(file: &Path, text: &str) -> Result<Route> {

@@ -8,7 +8,7 @@ use crate::scene::{warn, SceneFiles};
 use crate::volume::Volume;
 use endocast_core::flight::{Flight, FlightOptions, Layout, Route, ShotSettings};
 use endocast_core::study::LOOK_AHEAD_MM;
-use endocast_io::route_file::read_route;
+use endocast_io::route_file::{read_route, read_target};
 use endocast_io::transfer_json::transfer_function;
 use endocast_io::video::{open_sink, VideoOptions};
 use glam::DVec3;
@@ -30,7 +30,8 @@ use std::path::PathBuf;
 /// `peel_threshold`, `peel_falling`, `peel_keep`, `unpeeled`, `tf_after`, `look`,
 /// `secretion`, `secretion_iso`, `wetness`, `texture`, `texture_scale`, `specular_map`,
 /// `attenuation`, `lighting`, `fov`, `near`, `lens`, `distortion`, `vignetting`,
-/// `lumen_threshold`, `bright_lumen`, `threads`,
+/// `lumen_threshold`, `bright_lumen`, `threads`, `target` (ringed in every frame; default: the
+/// path file's target, as `endocast path --target` writes it),
 /// `meshes`, `overlays` (see `help(endocast.render)`). The volume may be a nibabel or SimpleITK image.
 #[pyfunction]
 #[pyo3(signature = (volume, route, out = None, **options))]
@@ -49,6 +50,13 @@ pub fn fly<'py>(
     let frame_step = kw.take::<f64>("frame_step")?.unwrap_or(1.0);
     let look_ahead = kw.take::<f64>("look_ahead")?.unwrap_or(LOOK_AHEAD_MM);
     let fps = kw.take::<f64>("fps")?.unwrap_or(25.0);
+    let target = match crate::target::take(&kw)? {
+        Some(target) => Some(target),
+        None => match route.extract::<PathBuf>() {
+            Ok(file) => read_target(&file).map_err(to_py)?,
+            Err(_) => None,
+        },
+    };
     let route = read(py, route)?;
     let shots = route.shots(frame_step, look_ahead).map_err(to_py)?;
     let first = shots
@@ -77,6 +85,7 @@ pub fn fly<'py>(
     let mut flight = Flight::new(volume.renderer().clone(), options);
     flight.set_look(look.look.clone());
     flight.set_scene(scene);
+    flight.set_target(target);
     let mut looks = ShotSettings::new(look.settings.clone(), transfer_function);
     let mut frame = |n: usize| {
         py.detach(|| {

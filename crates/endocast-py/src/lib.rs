@@ -21,6 +21,7 @@ mod polyps;
 mod render;
 mod route;
 mod scene;
+mod target;
 mod volume;
 
 use pyo3::prelude::*;

@@ -72,6 +72,9 @@ struct View {
 ///   tricubic B-splines, surfaces exact at the voxels and smooth normals, about ten times
 ///   slower a frame);
 /// - lumen: `lumen_threshold`, `bright_lumen`;
+/// - `target` (x, y, z; LPS mm, e.g. a nodule `endocast path --target` routes to): ringed in
+///   the view, solid where the view sees it, dashed and dimmer where it lies behind the wall,
+///   with its distance from the eye (not with `stereo`);
 /// - geometry: `meshes` (STL, OBJ or PLY files, world mm), `overlays` (DICOM segmentations,
 ///   each segment a surface in its colour, and dose grids, isodose surfaces at `FILE:LEVELS`
 ///   or 50, 80 and 95 % of the maximum), as `--mesh` and `--overlay` draw them.
@@ -99,7 +102,11 @@ pub fn render<'py>(
         None => Filter::Trilinear,
     };
     let files = SceneFiles::take(&kw)?;
+    let target = crate::target::take(&kw)?;
     kw.finish()?;
+    if target.is_some() && stereo.is_some() {
+        return Err(error("target draws on one view: leave out stereo"));
+    }
     if !(1..=MAX_STILL_FRAMES).contains(&still) {
         return Err(error(format!(
             "still must be between 1 and {MAX_STILL_FRAMES} frames, not {still}"
@@ -125,6 +132,10 @@ pub fn render<'py>(
                     .in_pool(|| still_view(&prepared, look.look.as_ref(), &camera, still, filter))
                     .map_err(to_py)?;
                 let mut view = single(&frame, look.settings.background);
+                if let Some(target) = target {
+                    let spacing = renderer.volume().geometry().spacing_mm();
+                    crate::target::ring(&mut view.rgba, &camera, &frame.depth_mm, spacing, target);
+                }
                 lens_marks::draw_rgba(&mut view.rgba, &camera);
                 Ok((view, partial))
             }

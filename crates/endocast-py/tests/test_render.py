@@ -68,6 +68,21 @@ def test_the_cube_and_the_panorama_equal_the_cli(volume, colon, cli, tmp_path, l
         endocast.render(volume, preset="colonoscopy", lens=lens, stereo="anaglyph", size=size)
 
 
+def test_a_target_is_ringed_as_the_cli_rings_it(volume, colon, cli, tmp_path):
+    eye, look_at, _ = endocast.default_view(volume, preset="colonoscopy")
+    ahead = np.asarray(look_at) - np.asarray(eye)
+    target = tuple(np.asarray(eye) + 3.0 * ahead / np.linalg.norm(ahead))
+    png = tmp_path / "cli.png"
+    cli("render", colon, "--preset", "colonoscopy", "--size", "96x80", "-o", png,
+        "--target=" + ",".join(map(str, target)))
+    rgba, _ = endocast.render(volume, preset="colonoscopy", size=(96, 80), target=target)
+    np.testing.assert_array_equal(rgba[..., :3], read_png_rgb(png))
+    plain, _ = endocast.render(volume, preset="colonoscopy", size=(96, 80))
+    assert (rgba != plain).any(), "the target is drawn"
+    with pytest.raises(endocast.EndocastError, match="target"):
+        endocast.render(volume, preset="colonoscopy", target=(0, float("nan"), 0))
+
+
 def test_default_view_is_inside_the_colon(volume):
     eye, look_at, up = endocast.default_view(volume, preset="colonoscopy")
     rgba, depth = endocast.render(volume, preset="colonoscopy", eye=eye, look_at=look_at, up=up,

@@ -5,6 +5,8 @@
 
 use crate::case::Autosave;
 use crate::case_choice::{choose_case, default_case_path, CaseChoice};
+use crate::compare::Compare;
+use crate::compare_ui::{compare_ui, CompareView};
 use crate::flight_ui::FlightTools;
 use crate::geometry_ui::MeshLoader;
 use crate::jobs::Polled;
@@ -53,6 +55,9 @@ pub struct ViewerOptions {
     pub look: Option<LookKind>,
     /// A slice to show large beside the endoscope from the start; `None`: the endoscope alone.
     pub layout: Option<Plane>,
+    /// A second scan of the patient (prone beside supine) to show beside the endoscope, its
+    /// camera following the first's; `None`: none.
+    pub compare: Option<ScanSource>,
 }
 
 /// What to do with the session when `--screenshot` grabs the window.
@@ -125,6 +130,11 @@ impl ViewerApp {
         self.ready.as_mut().map(|r| &mut r.session)
     }
 
+    /// The second scan beside the first (`--compare`, or the panel's "Compare"), once open.
+    pub fn compare(&self) -> Option<&Compare> {
+        self.ready.as_ref().and_then(|r| r.compare.compare())
+    }
+
     /// Whether a scan is being read.
     pub fn is_loading(&self) -> bool {
         self.loading.is_some()
@@ -173,6 +183,13 @@ impl ViewerApp {
                 .resizable(false)
                 .exact_width(250.0)
                 .show(ctx, |ui| side_ui(ui, ready));
+            if ready.compare.is_shown() {
+                egui::SidePanel::right("compare")
+                    .resizable(false)
+                    .exact_width(ctx.available_rect().width() / 2.0)
+                    .frame(egui::Frame::NONE.fill(egui::Color32::BLACK))
+                    .show(ctx, |ui| compare_ui(ui, &mut ready.compare, &ready.session));
+            }
             if let Some(viewer) = &mut ready.large_slice {
                 // The rest of the window shared between the large slice and the endoscope.
                 egui::SidePanel::right("large slice")
@@ -257,8 +274,13 @@ impl ViewerApp {
                     review: ReviewTools::default(),
                     dissection: Default::default(),
                     cleanse: Default::default(),
+                    compare: CompareView::default(),
                 });
                 self.loading = None;
+                if let (Some(source), Some(ready)) = (self.options.compare.clone(), &mut self.ready)
+                {
+                    ready.compare.start(&ready.session, source, &self.ctx);
+                }
             }
         }
     }
@@ -273,6 +295,7 @@ impl ViewerApp {
             ready.meshes.poll(&mut ready.session),
             ready.review.poll(),
             ready.dissection.tools.poll(),
+            ready.compare.poll(),
         ];
         if let Some(message) = finished.into_iter().flatten().last() {
             self.message = message;
@@ -357,6 +380,17 @@ impl ViewerApp {
                 };
                 self.start_loading(source, None);
             }
+            Action::Compare => {
+                let path = PathBuf::from(self.open_path.trim());
+                let source = ScanSource::File {
+                    path,
+                    series: None,
+                    orientation: None,
+                };
+                if let Some(ready) = &mut self.ready {
+                    ready.compare.start(&ready.session, source, &self.ctx);
+                }
+            }
             Action::SaveCase => self.autosave(true),
             Action::Message(m) => self.message = m,
         }
@@ -380,10 +414,9 @@ impl ViewerApp {
         let Some(path) = self.options.screenshot.clone() else {
             return;
         };
-        let refined = self
-            .ready
-            .as_ref()
-            .is_some_and(|r| matches!(r.shown, Some((_, Stage::Still(n), _)) if n >= 4));
+        let refined = self.ready.as_ref().is_some_and(|r| {
+            matches!(r.shown, Some((_, Stage::Still(n), _)) if n >= 4) && r.compare.settled()
+        });
         if refined && !self.screenshot_requested {
             self.screenshot_requested = true;
             ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::default()));

@@ -8,6 +8,7 @@ use crate::jobs::{Job, Notify, Polled};
 use crate::planner::{key_look, read_key_frames, start_planning, PlannedFlight};
 use crate::session::Session;
 use endocast_core::navigate::PathEnd;
+use endocast_io::route_file::read_target;
 use glam::DVec3;
 use std::path::Path;
 use std::sync::Arc;
@@ -257,12 +258,25 @@ fn film_options_ui(ui: &mut egui::Ui, film: &mut FilmOptions) {
 /// Replaces the key frames by the path in `file` (ours or 3D Slicer Markups) and goes to the
 /// first; says what was read, or why not.
 pub(crate) fn read_flight_path(session: &mut Session, file: &Path) -> String {
+    let target = match read_target(file) {
+        Ok(target) => target,
+        Err(e) => return e.to_string(),
+    };
     match read_key_frames(file, key_look(session)) {
         Ok(keys) => {
             let count = keys.len();
             session.set_key_frames(keys);
             session.go_to_key_frame(0);
-            format!("read {}: {count} key frames, P plays", file.display())
+            session.set_target(target);
+            let ringed = if target.is_some() {
+                ", its target ringed"
+            } else {
+                ""
+            };
+            format!(
+                "read {}: {count} key frames{ringed}, P plays",
+                file.display()
+            )
         }
         Err(e) => e,
     }

@@ -15,6 +15,8 @@
 //! - [`case_choice`]: which case a session reopens and saves to (never one it would replace);
 //! - [`review`], [`dissection`], [`cleansing`]: the reading tools of CT colonography (the
 //!   wall a flight missed, the wall laid flat, the tagged fluid removed);
+//! - [`compare`]: a second scan of the patient (prone beside supine) beside the view, its
+//!   camera following the first's through the scans' correspondence;
 //! - [`planner`]: the centred path between two points (or to the farthest) as key frames;
 //! - [`export`]: the flight filmed (GIF, MP4, PNGs) and its path files (ours, Slicer Markups);
 //! - [`geometry`]: the grid, the endoscope's instrument, marker spheres and meshes drawn;
@@ -36,6 +38,7 @@
 //!     on_screenshot: None,
 //!     look: None,
 //!     layout: None,
+//!     compare: None,
 //! })
 //! .unwrap();
 //! # }
@@ -48,6 +51,9 @@ pub mod case_choice;
 pub mod cleansing;
 #[cfg(feature = "window")]
 mod cleansing_ui;
+pub mod compare;
+#[cfg(feature = "window")]
+mod compare_ui;
 pub mod controller;
 pub mod dissection;
 #[cfg(feature = "window")]

@@ -7,7 +7,7 @@ use crate::session::Session;
 use crate::state::Ready;
 use crate::worker::Delivered;
 use egui::{Align2, Color32, Pos2, Rect, Response, Stroke, Vec2};
-use endocast_core::annotate::{draw, Annotation, DrawOptions, Shape, SurfaceView};
+use endocast_core::annotate::{draw, draw_target, Annotation, DrawOptions, Shape, SurfaceView};
 use endocast_core::views::Image;
 use glam::DVec3;
 
@@ -140,7 +140,7 @@ fn describe(a: &Annotation) -> String {
 }
 
 /// The delivered frame's picture with the annotations, and the stroke being drawn in white,
-/// drawn where that frame sees their tissue.
+/// drawn where that frame sees their tissue, and the target ringed.
 pub(crate) fn with_marks(session: &Session, frame: &Delivered) -> Image {
     let mut image = frame.image.clone();
     let spacing = session.scene().volume().geometry().spacing_mm();
@@ -151,6 +151,9 @@ pub(crate) fn with_marks(session: &Session, frame: &Delivered) -> Image {
         let mut stroke = Annotation::new(Shape::Stroke(session.stroke_in_progress().to_vec()));
         stroke.color = [255; 3];
         draw(&mut image, &view, [&stroke], &options);
+    }
+    if let Some(target) = session.target() {
+        draw_target(&mut image, &view, target);
     }
     image
 }

@@ -30,10 +30,17 @@ pub(crate) fn controls_ui(
         ui.add(
             egui::TextEdit::singleline(open_path)
                 .hint_text("scan or case .json")
-                .desired_width(200.0),
+                .desired_width(150.0),
         );
         if ui.button("Open").clicked() {
             action = Some(Action::Open);
+        }
+        let compare = ui.button("Compare").on_hover_text(
+            "open the scan typed as a second scan of the patient (prone beside supine): its \
+             view beside this one, its camera following this one",
+        );
+        if compare.clicked() {
+            action = Some(Action::Compare);
         }
     });
     if let Some(uid) = series_ui(ui, &ready.session) {

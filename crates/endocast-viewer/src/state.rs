@@ -3,6 +3,7 @@
 use crate::case::Autosave;
 use crate::cleansing::CleanseSwitch;
 use crate::dissection_ui::DissectionView;
+use crate::compare_ui::CompareView;
 use crate::flight_ui::FlightTools;
 use crate::geometry_ui::MeshLoader;
 use crate::jobs::Job;
@@ -41,6 +42,8 @@ pub(crate) struct Ready {
     pub dissection: DissectionView,
     /// The scan cleansed of tagged fluid, or as acquired.
     pub cleanse: CleanseSwitch,
+    /// A second scan (prone beside supine) whose view follows this one.
+    pub compare: CompareView,
 }
 
 impl Ready {
@@ -67,6 +70,9 @@ pub(crate) enum Action {
     /// Read the scan again with its index axes pointing as this code says (a file that
     /// declares no orientation, turned the other way up).
     Reorient(String),
+    /// Open the path typed in the panel as a second scan beside this one (prone beside
+    /// supine), its camera following this one.
+    Compare,
     /// Save the case now.
     SaveCase,
     /// Show a line in the status bar.

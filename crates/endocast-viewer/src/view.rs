@@ -151,16 +151,22 @@ fn show_frame(ui: &egui::Ui, ready: &mut Ready, rect: Rect) {
             }
         }
     }
-    if let Some(texture) = &ready.view_texture {
+    picture_ui(ui, ready.view_texture.as_ref(), rect, worker.error());
+}
+
+/// Draws `texture` in `rect`, aspect kept, and `error` in red over its top left corner.
+pub(crate) fn picture_ui(
+    ui: &egui::Ui,
+    texture: Option<&egui::TextureHandle>,
+    rect: Rect,
+    error: Option<String>,
+) {
+    if let Some(texture) = texture {
         let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
-        ui.painter().image(
-            texture.id(),
-            fit(rect, texture.aspect_ratio()),
-            uv,
-            Color32::WHITE,
-        );
+        let shown = fit(rect, texture.aspect_ratio());
+        ui.painter().image(texture.id(), shown, uv, Color32::WHITE);
     }
-    if let Some(error) = worker.error() {
+    if let Some(error) = error {
         ui.painter().text(
             rect.left_top() + Vec2::splat(8.0),
             egui::Align2::LEFT_TOP,

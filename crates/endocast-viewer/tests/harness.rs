@@ -26,6 +26,7 @@ pub fn options(source: ScanSource) -> ViewerOptions {
         on_screenshot: None,
         look: None,
         layout: None,
+        compare: None,
     }
 }
 

@@ -5,6 +5,7 @@
 
 mod case;
 mod common;
+mod compare;
 mod flight;
 mod harness;
 mod plan_export;

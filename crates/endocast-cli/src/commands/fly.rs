@@ -172,6 +172,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     flight.set_scene(scene);
     flight.set_look(look);
     flight.set_annotations(marks);
+    flight.set_target(args.case.target(Some(&args.route))?);
     if let Some(lumen) = &lumen {
         let geometry = renderer.volume().geometry();
         if args.layout == LayoutArg::Dashboard {

@@ -63,7 +63,8 @@ pub struct PathArgs {
     /// trachea through the labelled airway tree, in airways at least --scope-diameter wide, to
     /// the reachable centreline point nearest the target; --json then also lists the branches
     /// passed (trachea, main, lobar, segmental), the distance left to the target and the
-    /// labelled tree.
+    /// labelled tree. The path JSON keeps the target ("target"), so that `fly`, Python and the
+    /// workstation's "Read path" draw it in the endoscope view.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
           conflicts_with_all = ["from", "from_voxel", "to", "to_voxel"])]
     target: Option<[f64; 3]>,
@@ -122,7 +123,7 @@ pub fn run(args: &PathArgs) -> Result<()> {
         .path
         .points_every(args.step)
         .with_context(|| format!("--step {}", args.step))?;
-    write(&args.output, &points)?;
+    write(&args.output, &points, args.target.map(DVec3::from))?;
     let mut summary = json!({
         "output": args.output,
         "points": points.len(),
@@ -200,18 +201,27 @@ fn point(
 }
 
 /// Writes the points as Slicer Markups (`.mrk.json`) or as our path JSON.
-fn write(output: &Path, points: &[DVec3]) -> Result<()> {
+/// Writes the path's points, and the target it leads to (path JSON only: Markups has no
+/// place for it).
+fn write(output: &Path, points: &[DVec3], target_mm: Option<DVec3>) -> Result<()> {
     let name = output
         .file_name()
         .and_then(|n| n.to_str())
         .map_or("path", |n| n.split('.').next().unwrap_or(n));
     if is_markups(output) {
+        if target_mm.is_some() {
+            eprintln!(
+                "note: a Markups curve has no place for the target: write a .json path for the \
+                 endoscope views to draw it"
+            );
+        }
         endocast_io::markups::write_markups_curve(output, name, points)
     } else {
         let document = PathDocument {
             name: name.to_owned(),
             points_mm: points.to_vec(),
             key_frames: Vec::new(),
+            target_mm,
         };
         write_path_json(output, &document)
     }

@@ -1,6 +1,6 @@
 //! `endocast render`: one view of a scan, from inside (endoscopic) or framing it from outside.
 
-use crate::case_args::{draw_marks, CaseArgs};
+use crate::case_args::{draw_marks, draw_target_mark, CaseArgs};
 use crate::input::InputArgs;
 use crate::look::{in_pool, LookArgs};
 use crate::lumen::LumenArgs;
@@ -120,8 +120,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         structure::write(path, &loaded.volume, &look.study)?;
     }
     let marks = args.case.annotations(&loaded.volume)?;
-    if marks.is_some() && args.stereo.stereo.is_some() {
-        bail!("--case draws on one view: leave out --stereo");
+    let target = args.case.target(None)?;
+    if (marks.is_some() || target.is_some()) && args.stereo.stereo.is_some() {
+        bail!("--case and --target draw on one view: leave out --stereo");
     }
     let voxels = loaded.volume.voxels().len();
     let (filter, warning) = args.input.limits().still_filter(args.still_filter, voxels);
@@ -166,9 +167,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .context("invalid look")?;
             let [w, h] = [frame.width as u32, frame.height as u32];
             let mut image = Image::from_frame(&frame, settings.background)?;
+            let spacing = renderer.volume().geometry().spacing_mm();
             if let Some(marks) = &marks {
-                let spacing = renderer.volume().geometry().spacing_mm();
                 draw_marks(&mut image, marks, &camera, &frame.depth_mm, spacing);
+            }
+            if let Some(target) = target {
+                draw_target_mark(&mut image, target, &camera, &frame.depth_mm, spacing);
             }
             lens_marks::draw(&mut image, &camera);
             endocast_io::write_image_rgb8(&args.output, w, h, image.rgb())

@@ -46,6 +46,12 @@ pub struct ViewArgs {
     /// (the slice column's "large:" buttons change it).
     #[arg(long, value_name = "PLANE")]
     layout: Option<String>,
+    /// A second scan of the same patient (e.g. prone beside supine; a file, or `phantom:NAME`
+    /// for a phantom of --size) shown beside the endoscope: the scans' colon paths are matched
+    /// as `endocast match` matches them, and its camera follows this one's (its eye at the
+    /// counterpart, turned as the wall is). The panel's "Compare" button opens one too.
+    #[arg(long, value_name = "SCAN")]
+    compare: Option<PathBuf>,
     /// Write a screenshot of the window (PNG) once the view has refined, then quit.
     #[arg(long, value_name = "FILE.png")]
     screenshot: Option<PathBuf>,
@@ -108,8 +114,27 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         on_screenshot,
         look,
         layout,
+        compare: args
+            .compare
+            .as_deref()
+            .map(|scan| second_scan(scan, args.size)),
     })
     .map_err(anyhow::Error::msg)
+}
+
+/// The second scan of `--compare`: a file, or `phantom:NAME` (a phantom of `size`).
+fn second_scan(scan: &std::path::Path, size: usize) -> ScanSource {
+    match scan.to_str().and_then(|s| s.strip_prefix("phantom:")) {
+        Some(name) => ScanSource::Phantom {
+            name: name.to_owned(),
+            size,
+        },
+        None => ScanSource::File {
+            path: scan.to_path_buf(),
+            series: None,
+            orientation: None,
+        },
+    }
 }
 
 /// Prints what `session` resolved and its camera, as JSON on stdout.

@@ -10,6 +10,8 @@
 //!   surface away, so the view's ray runs past the point);
 //! - [`draw`] puts the annotations into a view's image as decals where they are visible, labels
 //!   in the built-in bitmap font;
+//! - [`draw_target`] rings a bronchoscopy route's target, solid where the view sees it and
+//!   dashed where it lies behind the wall the view shows, with its distance from the eye;
 //! - [`ScanIdentity`] fingerprints a scan (dimensions, spacing, origin, voxels) so that a case's
 //!   annotations are never drawn on another scan.
 //!
@@ -27,6 +29,7 @@
 mod draw;
 mod identity;
 mod pick;
+mod target;
 
 #[cfg(test)]
 mod tests;
@@ -34,6 +37,7 @@ mod tests;
 pub use draw::{draw, DrawOptions};
 pub use identity::{IdentityMismatch, ScanIdentity};
 pub use pick::{SurfaceView, Visibility};
+pub use target::{draw_target, TargetSight, HIDDEN_TARGET_COLOR, TARGET_COLOR, TARGET_RADIUS_MM};
 
 use crate::views::Rgb;
 use glam::DVec3;

@@ -206,22 +206,57 @@ impl Correspondence {
                 x_mm.x, x_mm.y, x_mm.z
             )));
         }
+        let local = self.local(x_mm);
+        let point_mm = local.carry(x_mm);
+        let view_first = view(local.centre_a, x_mm, local.tangent_a, None);
+        let up = local.rotation * view_first.up;
+        Ok(Counterpart {
+            arc_first_mm: local.s_a,
+            distance_mm: local.distance_mm,
+            arc_mm: self.own_arc(local.s_b),
+            point_mm,
+            view_first,
+            view: view(local.centre_b, point_mm, local.tangent_b, Some(up)),
+        })
+    }
+
+    /// A camera of the first scan carried to the second (the side-by-side views): its eye to
+    /// the eye's counterpart, its view and up directions turned as the wall around the eye is
+    /// turned (the patient's turn, then the paths' rotation-minimising turn at the matched arc
+    /// length), so that the second view shows the counterpart of what the first shows, the
+    /// same way up, at the same distance.
+    pub fn follow(&self, pose: &Pose) -> Result<Pose, MatchError> {
+        let finite = pose.eye_mm.is_finite() && pose.look_at_mm.is_finite() && pose.up.is_finite();
+        if !finite {
+            let e = pose.eye_mm;
+            return Err(MatchError::BadPoint(format!("{},{},{}", e.x, e.y, e.z)));
+        }
+        let local = self.local(pose.eye_mm);
+        let eye_mm = local.carry(pose.eye_mm);
+        Ok(Pose {
+            eye_mm,
+            look_at_mm: eye_mm + local.rotation * (pose.look_at_mm - pose.eye_mm),
+            up: local.rotation * pose.up,
+        })
+    }
+
+    /// The stretch of both paths nearest `x_mm` (world mm, first scan) and the turn between.
+    fn local(&self, x_mm: DVec3) -> Local {
         let (s_a, distance_mm) = self.a.closest(x_mm);
         let (centre_a, tangent_a) = (self.a.point_at(s_a), self.a.tangent_at(s_a));
         let s_b = self.track_arc_in_second(s_a);
         let (centre_b, tangent_b) = (self.b.point_at(s_b), self.b.tangent_at(s_b));
         let rotation = DQuat::from_rotation_arc(self.turn * tangent_a, tangent_b) * self.turn;
-        let point_mm = centre_b + rotation * (x_mm - centre_a);
-        let view_first = view(centre_a, x_mm, tangent_a, None);
-        let up = rotation * view_first.up;
-        Ok(Counterpart {
-            arc_first_mm: s_a,
+        Local {
+            s_a,
             distance_mm,
-            arc_mm: self.own_arc(s_b),
-            point_mm,
-            view_first,
-            view: view(centre_b, point_mm, tangent_b, Some(up)),
-        })
+            centre_a,
+            tangent_a,
+            s_b,
+            centre_b,
+            tangent_b,
+            rotation,
+        }
     }
 
     /// The matched arc length along the second path's track (as run for the match).
@@ -239,6 +274,26 @@ impl Correspondence {
         } else {
             s_mm
         }
+    }
+}
+
+/// Where a point of the first scan lies along the two paths: the nearest point of the first
+/// path, its match on the second (track arc lengths), and the turn from one to the other.
+struct Local {
+    s_a: f64,
+    distance_mm: f64,
+    centre_a: DVec3,
+    tangent_a: DVec3,
+    s_b: f64,
+    centre_b: DVec3,
+    tangent_b: DVec3,
+    rotation: DQuat,
+}
+
+impl Local {
+    /// The counterpart of `x_mm` (first scan): the same offset from the path, turned.
+    fn carry(&self, x_mm: DVec3) -> DVec3 {
+        self.centre_b + self.rotation * (x_mm - self.centre_a)
     }
 }
 

@@ -76,6 +76,15 @@ fn bad_input_is_refused() {
     let matched = Correspondence::between(&a, &a).unwrap();
     let error = matched.counterpart(DVec3::new(f64::NAN, 0.0, 0.0));
     assert!(matches!(error, Err(MatchError::BadPoint(_))));
+    let pose = Pose {
+        eye_mm: DVec3::ZERO,
+        look_at_mm: DVec3::new(0.0, f64::INFINITY, 0.0),
+        up: DVec3::Z,
+    };
+    assert!(matches!(
+        matched.follow(&pose),
+        Err(MatchError::BadPoint(_))
+    ));
 }
 
 /// The acceptance test of issue 36: on the supine/prone phantom pair, points along the colon
@@ -124,6 +133,26 @@ fn supine_points_find_their_prone_counterparts_within_10_mm() {
                 "s = {s}: {found:?}, expected {expected}"
             );
         }
+        // The side-by-side views: a camera on the axis looking along the colon, carried to
+        // the prone scan, stands at the counterpart and looks along the prone colon.
+        let eye = axis - half;
+        let along = line.tangent_at(s);
+        let pose = Pose {
+            eye_mm: eye,
+            look_at_mm: eye + along * 10.0,
+            up: along.any_orthonormal_vector(),
+        };
+        let followed = matched.follow(&pose).unwrap();
+        let truth = pair.prone_arc_vox(s);
+        let (at, _) = pair.prone.centreline.closest(followed.eye_mm + half);
+        worst = worst.max((at - truth).abs());
+        let forward = (followed.look_at_mm - followed.eye_mm) / 10.0;
+        let prone_along = pair.prone.centreline.tangent_at(truth);
+        assert!(
+            forward.dot(prone_along) > 0.9,
+            "s = {s}: {forward} vs {prone_along}"
+        );
+        assert!(followed.up.dot(forward).abs() < 1e-9);
     }
     assert!(worst < 10.0, "worst error along the colon {worst} mm");
 }

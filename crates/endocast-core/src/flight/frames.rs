@@ -80,6 +80,8 @@ pub struct Flight {
     scene: Option<Arc<Scene>>,
     /// Annotations drawn as decals on every endoscope frame.
     marks: Option<Annotations>,
+    /// A target ringed on every endoscope frame (world mm).
+    target_mm: Option<DVec3>,
     /// The frames rendered into (the second for a stereo pair's right eye), their buffers
     /// reused from shot to shot.
     frames: StereoFrames,
@@ -103,6 +105,7 @@ impl Flight {
             prepared: None,
             scene: None,
             marks: None,
+            target_mm: None,
             frames: StereoFrames::default(),
             look: None,
             look_pass: None,
@@ -133,13 +136,22 @@ impl Flight {
         self.marks = marks;
     }
 
-    /// `image`, the picture of `frame` taken by `camera`, with the annotations and the lens's
-    /// marks (the cube's faces, the panorama's directions) drawn on it.
+    /// Rings `target_mm` (world mm; a bronchoscopy target) on every endoscope frame from now
+    /// on: solid where the frame sees it, dashed where it lies behind the wall.
+    pub fn set_target(&mut self, target_mm: Option<DVec3>) {
+        self.target_mm = target_mm;
+    }
+
+    /// `image`, the picture of `frame` taken by `camera`, with the annotations, the target and
+    /// the lens's marks (the cube's faces, the panorama's directions) drawn on it.
     fn with_marks(&self, mut image: Image, camera: &Camera, frame: &Frame) -> Image {
+        let spacing = self.renderer.volume().geometry().spacing_mm();
+        let view = SurfaceView::new(camera, &frame.depth_mm, spacing);
         if let Some(marks) = &self.marks {
-            let spacing = self.renderer.volume().geometry().spacing_mm();
-            let view = SurfaceView::new(camera, &frame.depth_mm, spacing);
             annotate::draw(&mut image, &view, marks.items(), &DrawOptions::default());
+        }
+        if let Some(target) = self.target_mm {
+            annotate::draw_target(&mut image, &view, target);
         }
         lens_marks::draw(&mut image, camera);
         image

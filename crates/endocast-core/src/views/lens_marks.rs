@@ -45,20 +45,7 @@ pub fn draw_rgba(rgba: &mut [u8], camera: &Camera) {
             pixel[3] = 0;
         }
     }
-    let rgb: Vec<u8> = rgba
-        .chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect();
-    let Ok(mut image) = Image::from_rgb(w, h, rgb) else {
-        return;
-    };
-    draw(&mut image, camera);
-    for (pixel, marked) in rgba.chunks_exact_mut(4).zip(image.rgb().chunks_exact(3)) {
-        if pixel[..3] != *marked {
-            pixel[..3].copy_from_slice(marked);
-            pixel[3] = 255;
-        }
-    }
+    Image::draw_on_rgba(rgba, [w, h], |image| draw(image, camera));
 }
 
 /// Font pixels per glyph pixel for labels on a view `edge_px` pixels across.

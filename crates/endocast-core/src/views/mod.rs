@@ -129,6 +129,33 @@ impl Image {
         Ok(Self { width, height, rgb })
     }
 
+    /// Draws with `draw` on a `width · height · 4` RGBA buffer (row 0 at the top) as on an
+    /// image: every pixel it changes takes the new colour and becomes opaque. Nothing happens
+    /// when the buffer is not that size.
+    pub fn draw_on_rgba(
+        rgba: &mut [u8],
+        [width, height]: [usize; 2],
+        draw: impl FnOnce(&mut Self),
+    ) {
+        let rgb: Vec<u8> = rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        if rgba.len() != 4 * width * height {
+            return;
+        }
+        let Ok(mut image) = Self::from_rgb(width, height, rgb) else {
+            return;
+        };
+        draw(&mut image);
+        for (pixel, marked) in rgba.chunks_exact_mut(4).zip(image.rgb().chunks_exact(3)) {
+            if pixel[..3] != *marked {
+                pixel[..3].copy_from_slice(marked);
+                pixel[3] = 255;
+            }
+        }
+    }
+
     /// A rendered frame's colour over `background` (display values, 0–1).
     pub fn from_frame(frame: &Frame, background: [f32; 3]) -> Result<Self, ViewError> {
         Self::from_rgb(frame.width, frame.height, frame.to_rgb8(background))

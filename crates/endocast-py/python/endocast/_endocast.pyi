@@ -128,6 +128,7 @@ def render(
     threads: Optional[int] = None,
     meshes: Sequence[_Path] = (),
     overlays: Sequence[_Path] = (),
+    target: Optional[_Point] = None,
 ) -> Tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32]]:
     """Render one view as ``endocast render`` does: (rgba, depth).
 
@@ -142,7 +143,9 @@ def render(
     averages that many jittered frames, reconstructed by ``still_filter`` ("trilinear", the
     default, or "bspline": tricubic B-splines, about ten times slower a frame). ``meshes``
     (STL, OBJ, PLY) and ``overlays`` (DICOM SEG; RTDOSE as ``FILE`` or ``FILE:LEVEL,...``)
-    are drawn with the scan as ``--mesh`` and ``--overlay`` draw them."""
+    are drawn with the scan as ``--mesh`` and ``--overlay`` draw them. ``target`` (LPS mm,
+    e.g. a nodule ``endocast path --target`` routes to) is ringed in the view: solid where
+    the view sees it, dashed and dimmer where it lies behind the wall, with its distance."""
 
 def default_view(
     volume: _VolumeLike,
@@ -224,6 +227,7 @@ def fly(
     threads: Optional[int] = None,
     meshes: Sequence[_Path] = (),
     overlays: Sequence[_Path] = (),
+    target: Optional[_Point] = None,
 ) -> npt.NDArray[np.uint8]:
     """Fly along ``route`` (an (N, 3) array of LPS points or a path file) as ``endocast fly``
     films the endoscopic view: without ``out`` the frames, RGB uint8 (frames, height, width, 3)."""

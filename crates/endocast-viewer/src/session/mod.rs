@@ -161,8 +161,10 @@ pub struct Session {
     marks: Annotations,
     /// The stroke being drawn, surface points so far.
     stroke: Vec<DVec3>,
-    /// Grows with every change of the annotations or the stroke being drawn.
+    /// Grows with every change of the annotations, the stroke being drawn or the target.
     marks_revision: u64,
+    /// A target ringed in the view (a bronchoscopy route's, read with its path), world mm.
+    target_mm: Option<DVec3>,
     geometry: Geometry,
     /// Called from the render thread after each delivered frame.
     on_frame: OnFrame,
@@ -224,6 +226,7 @@ impl Session {
             marks: Annotations::default(),
             stroke: Vec::new(),
             marks_revision: 0,
+            target_mm: None,
             geometry: Geometry::default(),
             on_frame,
         };
@@ -679,6 +682,18 @@ impl Session {
         self.marks_revision
     }
 
+    /// Rings `target_mm` (world mm; a bronchoscopy target) in the view from now on: solid
+    /// where the view sees it, dashed where it lies behind the wall; `None`: no target.
+    pub fn set_target(&mut self, target_mm: Option<DVec3>) {
+        self.target_mm = target_mm;
+        self.marks_revision += 1;
+    }
+
+    /// The target ringed in the view, world mm.
+    pub fn target(&self) -> Option<DVec3> {
+        self.target_mm
+    }
+
     /// Deletes annotation `id`.
     pub fn delete_annotation(&mut self, id: u32) {
         self.marks.remove(id);
@@ -686,7 +701,7 @@ impl Session {
     }
 
     /// The current view rendered at full quality, with the annotations drawn where it sees
-    /// their tissue.
+    /// their tissue, and the target.
     pub fn screenshot(&self) -> Result<Image, String> {
         self.screenshot_work()()
     }
@@ -697,6 +712,7 @@ impl Session {
         let settings = self.controls.settings();
         let camera = self.camera().map_err(|e| e.to_string());
         let marks = self.marks.clone();
+        let target = self.target_mm;
         move || {
             let camera = camera?;
             let prepared = renderer.prepare(&settings).map_err(|e| e.to_string())?;
@@ -706,6 +722,9 @@ impl Session {
             let spacing = renderer.volume().geometry().spacing_mm();
             let view = SurfaceView::new(&camera, &frame.depth_mm, spacing);
             annotate::draw(&mut image, &view, marks.items(), &DrawOptions::default());
+            if let Some(target) = target {
+                annotate::draw_target(&mut image, &view, target);
+            }
             lens_marks::draw(&mut image, &camera);
             Ok(image)
         }
