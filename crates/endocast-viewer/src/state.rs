@@ -2,8 +2,8 @@
 
 use crate::case::Autosave;
 use crate::cleansing::CleanseSwitch;
-use crate::dissection_ui::DissectionView;
 use crate::compare_ui::CompareView;
+use crate::dissection_ui::DissectionView;
 use crate::flight_ui::FlightTools;
 use crate::geometry_ui::MeshLoader;
 use crate::jobs::Job;
