@@ -31,8 +31,8 @@ pub enum DatasetError {
     /// A projection with no camera model in COLMAP and nerfstudio (equisolid fisheye,
     /// orthographic, cube, panorama).
     #[error(
-        "a {0} camera has no COLMAP/nerfstudio model: training data takes a pinhole \
-         (OPENCV) or equidistant fisheye (OPENCV_FISHEYE) camera"
+        "{0} camera: COLMAP and nerfstudio have no model for it; training data takes a \
+         pinhole (OPENCV) or equidistant fisheye (OPENCV_FISHEYE) camera"
     )]
     Projection(&'static str),
     /// A stereo eye (an off-axis frustum): export one eye.

@@ -13,10 +13,13 @@ mod tests;
 
 use crate::error::{ReadError, Result};
 use crate::image_out::{write_png_gray16, write_png_gray8, write_png_rgb8, write_png_rgb8_data};
-use endocast_core::camera::Camera;
-use endocast_core::dataset::{depth_scale_mm, depth_to_u16, Extrinsics, FrameLayers, Intrinsics};
+use endocast_core::camera::{Camera, Optics};
+use endocast_core::dataset::{
+    depth_scale_mm, depth_to_u16, DatasetError, Extrinsics, FrameLayers, Intrinsics,
+};
 use endocast_core::views::Image;
 use endocast_core::Volume;
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 
 /// The per-frame folders, in the order the files are written.
@@ -41,9 +44,15 @@ pub struct DatasetWriter {
 
 impl DatasetWriter {
     /// A dataset in `folder` — a new folder or an empty one, never one with files in it (a
-    /// dataset is not written over another) — of frames of `volume`: depths up to twice the
-    /// volume's diagonal are stored, in codes of [`depth_scale_mm`] of that range.
-    pub fn create(folder: &Path, volume: &Volume) -> Result<Self> {
+    /// dataset is not written over another) — of frames of `volume` seen through `optics`
+    /// (refused before anything is written when the formats have no model for them): depths
+    /// up to twice the volume's diagonal are stored, in codes of [`depth_scale_mm`] of that
+    /// range.
+    pub fn create(folder: &Path, volume: &Volume, optics: &Optics) -> Result<Self> {
+        let probe = optics.camera(DVec3::ZERO, DVec3::X, DVec3::Z, [1, 1]);
+        if let Ok(camera) = probe {
+            Intrinsics::of(&camera).map_err(|e| unsupported(folder, e))?;
+        }
         check_folder(folder)?;
         for name in FOLDERS {
             let path = folder.join(name);
@@ -72,11 +81,8 @@ impl DatasetWriter {
         depth_mm: &[f32],
         volume: &Volume,
     ) -> Result<()> {
-        let unsupported = |e: endocast_core::dataset::DatasetError| {
-            ReadError::unsupported(&self.folder, e.to_string())
-        };
-        let intrinsics = Intrinsics::of(camera).map_err(unsupported)?;
-        let pose = Extrinsics::of(camera).map_err(unsupported)?;
+        let intrinsics = Intrinsics::of(camera).map_err(|e| unsupported(&self.folder, e))?;
+        let pose = Extrinsics::of(camera).map_err(|e| unsupported(&self.folder, e))?;
         let [w, h] = camera.size();
         if [image.width(), image.height()] != [w, h] || depth_mm.len() != w * h {
             return Err(ReadError::inconsistent(
@@ -120,6 +126,11 @@ impl DatasetWriter {
         colmap::write(&self.folder.join("colmap"), &self.frames)?;
         Ok(self.folder)
     }
+}
+
+/// A camera the formats cannot take, as an error about `folder`.
+fn unsupported(folder: &Path, error: DatasetError) -> ReadError {
+    ReadError::unsupported(folder, error.to_string())
 }
 
 /// Fails unless `folder` is a folder with nothing in it, or nothing at all yet.

@@ -2,7 +2,7 @@
 //! and the cameras of transforms.json and COLMAP's text, used with their own formulas only.
 
 use super::DatasetWriter;
-use endocast_core::camera::{Camera, Projection};
+use endocast_core::camera::{Camera, Optics, Projection};
 use endocast_core::phantom::{self, PhantomOptions, SphereShell};
 use endocast_core::render::{Mode, RenderSettings, Renderer};
 use endocast_core::views::Image;
@@ -26,7 +26,8 @@ fn write(renderer: &Arc<Renderer>, cameras: &[Camera], folder: &Path) {
     settings.mode = Mode::Iso;
     settings.iso_hu = -480.0;
     let prepared = renderer.prepare(&settings).unwrap();
-    let mut writer = DatasetWriter::create(folder, renderer.volume()).unwrap();
+    let mut writer =
+        DatasetWriter::create(folder, renderer.volume(), &optics(&cameras[0])).unwrap();
     for camera in cameras {
         let frame = prepared.render(camera);
         let image = Image::from_frame(&frame, settings.background).unwrap();
@@ -61,6 +62,16 @@ fn two_cameras(
         at(DVec3::new(2.0, 1.0, 0.0), DVec3::new(1.0, 0.2, 0.1)),
         at(DVec3::new(-3.0, 2.0, 1.0), DVec3::new(0.8, 0.5, -0.2)),
     ]
+}
+
+/// The optics of `camera`.
+fn optics(camera: &Camera) -> Optics {
+    Optics {
+        projection: camera.projection(),
+        field: camera.field(),
+        lens: camera.lens(),
+        near_mm: camera.near_mm(),
+    }
 }
 
 /// A 16-bit greyscale PNG's samples.
@@ -279,25 +290,25 @@ fn a_file_or_a_folder_with_files_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("taken");
     std::fs::write(&file, "x").unwrap();
-    let error = DatasetWriter::create(&file, renderer.volume()).unwrap_err();
+    let error = DatasetWriter::create(&file, renderer.volume(), &Optics::default()).unwrap_err();
     assert!(error.to_string().contains("is a file"), "{error}");
-    let error = DatasetWriter::create(dir.path(), renderer.volume()).unwrap_err();
+    let error =
+        DatasetWriter::create(dir.path(), renderer.volume(), &Optics::default()).unwrap_err();
     assert!(error.to_string().contains("files in it"), "{error}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     let orthographic = Camera::look_at(DVec3::ZERO, DVec3::X, DVec3::Z, 90.0, [4, 4])
         .unwrap()
         .with_projection(Projection::Orthographic, 30.0)
         .unwrap();
-    let mut writer = DatasetWriter::create(&dir.path().join("new"), renderer.volume()).unwrap();
+    let new = dir.path().join("new");
+    let error = DatasetWriter::create(&new, renderer.volume(), &optics(&orthographic)).unwrap_err();
+    assert!(error.to_string().contains("orthographic"), "{error}");
+    assert!(!new.exists());
+    let mut writer = DatasetWriter::create(&new, renderer.volume(), &Optics::default()).unwrap();
     let image = Image::from_rgb(4, 4, vec![0; 48]).unwrap();
     let error = writer
         .push(&image, &orthographic, &[f32::NAN; 16], renderer.volume())
         .unwrap_err();
     assert!(error.to_string().contains("orthographic"), "{error}");
-    assert_eq!(
-        std::fs::read_dir(dir.path().join("new/images"))
-            .unwrap()
-            .count(),
-        0
-    );
+    assert_eq!(std::fs::read_dir(new.join("images")).unwrap().count(), 0);
 }
