@@ -51,7 +51,7 @@ impl DatasetWriter {
     pub fn create(folder: &Path, volume: &Volume, optics: &Optics) -> Result<Self> {
         let probe = optics.camera(DVec3::ZERO, DVec3::X, DVec3::Z, [1, 1]);
         if let Ok(camera) = probe {
-            Intrinsics::of(&camera).map_err(|e| unsupported(folder, e))?;
+            Intrinsics::of(&camera).map_err(|e| unsupported(folder, &e))?;
         }
         check_folder(folder)?;
         for name in FOLDERS {
@@ -81,8 +81,8 @@ impl DatasetWriter {
         depth_mm: &[f32],
         volume: &Volume,
     ) -> Result<()> {
-        let intrinsics = Intrinsics::of(camera).map_err(|e| unsupported(&self.folder, e))?;
-        let pose = Extrinsics::of(camera).map_err(|e| unsupported(&self.folder, e))?;
+        let intrinsics = Intrinsics::of(camera).map_err(|e| unsupported(&self.folder, &e))?;
+        let pose = Extrinsics::of(camera).map_err(|e| unsupported(&self.folder, &e))?;
         let [w, h] = camera.size();
         if [image.width(), image.height()] != [w, h] || depth_mm.len() != w * h {
             return Err(ReadError::inconsistent(
@@ -129,7 +129,7 @@ impl DatasetWriter {
 }
 
 /// A camera the formats cannot take, as an error about `folder`.
-fn unsupported(folder: &Path, error: DatasetError) -> ReadError {
+fn unsupported(folder: &Path, error: &DatasetError) -> ReadError {
     ReadError::unsupported(folder, error.to_string())
 }
 
