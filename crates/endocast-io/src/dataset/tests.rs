@@ -312,3 +312,28 @@ fn a_file_or_a_folder_with_files_is_refused() {
     assert!(error.to_string().contains("orthographic"), "{error}");
     assert_eq!(std::fs::read_dir(new.join("images")).unwrap().count(), 0);
 }
+
+#[test]
+fn a_frame_with_another_field_carries_its_own_intrinsics_and_colmap_camera() {
+    let (renderer, shell) = shell();
+    let [a, b] = two_cameras(renderer.volume(), &shell, Projection::Pinhole, 90.0);
+    let b = b.with_projection(Projection::Pinhole, 60.0).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    write(&renderer, &[a, b, a], dir.path());
+    let json = read_json(&dir.path().join("transforms.json"));
+    let frames = json["frames"].as_array().unwrap();
+    assert!(frames[0].get("fl_x").is_none() && frames[2].get("fl_x").is_none());
+    let narrower = 15.0 / (30f64.to_radians()).tan();
+    assert!((number(&frames[1], "fl_x") - narrower).abs() < 1e-9);
+    assert!((number(&json, "fl_x") - 15.0).abs() < 1e-9);
+    let colmap = dir.path().join("colmap");
+    let cameras = std::fs::read_to_string(colmap.join("cameras.txt")).unwrap();
+    assert_eq!(cameras.lines().filter(|l| !l.starts_with('#')).count(), 2);
+    let images = std::fs::read_to_string(colmap.join("images.txt")).unwrap();
+    let ids: Vec<&str> = images
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.is_empty())
+        .map(|l| l.split_whitespace().nth(8).unwrap())
+        .collect();
+    assert_eq!(ids, ["1", "2", "1"]);
+}
