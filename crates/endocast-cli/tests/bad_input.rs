@@ -122,3 +122,51 @@ fn refused_under_4_gib(size: &str, options: &[&str]) {
     );
     assert!(!png.exists());
 }
+
+/// `fly --dataset` (issue 37) refuses a file, a folder with files in it, a camera with no
+/// COLMAP/nerfstudio model, a stereo flight and the dashboard, each with its reason.
+#[test]
+fn fly_dataset_refusals() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    let scan = at("shell.nii.gz");
+    crate::common::endocast(&["phantom", "sphere-shell", "-o", &scan, "--size", "24"]);
+    let route = at("route.json");
+    let points = r#"{"format": "endocast-path", "version": 1, "coordinate_system": "LPS",
+        "units": "mm", "points": [[-2, 0, 0], [2, 0, 0]]}"#;
+    std::fs::write(&route, points).unwrap();
+    let fly = |dataset: &str, film: &str, extra: &[&str], needle: &str| {
+        let mut args = vec!["fly", &scan, "--path", &route, "--size", "16x16"];
+        args.extend(["-o", film, "--dataset", dataset, "--preset", "sinus"]);
+        args.extend(extra);
+        fails_with(&args, needle);
+    };
+    fly(&scan, &at("a.gif"), &[], "is a file");
+    fly(
+        dir.path().to_str().unwrap(),
+        &at("b.gif"),
+        &[],
+        "files in it",
+    );
+    fly(
+        &at("c"),
+        &at("c.gif"),
+        &["--lens", "equisolid"],
+        "equisolid camera",
+    );
+    fly(
+        &at("d"),
+        &at("d.gif"),
+        &["--stereo", "anaglyph"],
+        "--stereo",
+    );
+    fly(
+        &at("e"),
+        &at("e.gif"),
+        &["--layout", "dashboard"],
+        "--layout endoscope",
+    );
+    for name in ["c", "d", "e"] {
+        assert!(!dir.path().join(name).exists(), "{name} written");
+    }
+}

@@ -18,6 +18,7 @@ pub mod camera;
 pub mod cleanse;
 pub mod correspond;
 pub mod coverage;
+pub mod dataset;
 pub mod dissect;
 pub mod flight;
 pub mod geometry;

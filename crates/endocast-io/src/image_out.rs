@@ -159,47 +159,91 @@ fn write_png(
     color: png::ColorType,
     pixels: &[u8],
 ) -> Result<()> {
-    check_png(path, width, height, color, pixels)?;
-    write_file(path, |w| encode_png(w, width, height, color, pixels))
+    check_png(path, width, height, color.samples(), pixels.len())?;
+    write_file(path, |w| {
+        encode_png(w, (width, height), color, Depth::Srgb8, pixels)
+    })
+}
+
+/// Writes an 8-bit greyscale PNG of data (no colour tag; e.g. a mask): `values` holds
+/// `width·height` bytes, row 0 at the top.
+pub fn write_png_gray8(path: &Path, width: u32, height: u32, values: &[u8]) -> Result<()> {
+    let color = png::ColorType::Grayscale;
+    check_png(path, width, height, 1, values.len())?;
+    write_file(path, |w| {
+        encode_png(w, (width, height), color, Depth::Data8, values)
+    })
+}
+
+/// Writes an 8-bit RGB PNG of data (no colour tag; e.g. normals): `values` holds
+/// `width·height·3` bytes, row 0 at the top.
+pub fn write_png_rgb8_data(path: &Path, width: u32, height: u32, values: &[u8]) -> Result<()> {
+    let color = png::ColorType::Rgb;
+    check_png(path, width, height, 3, values.len())?;
+    write_file(path, |w| {
+        encode_png(w, (width, height), color, Depth::Data8, values)
+    })
+}
+
+/// Writes a 16-bit greyscale PNG of data (no colour tag; e.g. depth codes): `values` holds
+/// `width·height` samples, row 0 at the top.
+pub fn write_png_gray16(path: &Path, width: u32, height: u32, values: &[u16]) -> Result<()> {
+    let color = png::ColorType::Grayscale;
+    check_png(path, width, height, 1, values.len())?;
+    // PNG stores 16-bit samples big-endian.
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_be_bytes()).collect();
+    write_file(path, |w| {
+        encode_png(w, (width, height), color, Depth::Data16, &bytes)
+    })
 }
 
 /// Writes a fly-through's frame, an 8-bit RGB PNG, as a new file in a folder only this
 /// process writes (see [`crate::atomic::write_new`]).
 pub(crate) fn write_frame_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()> {
     let color = png::ColorType::Rgb;
-    check_png(path, width, height, color, rgb)?;
-    write_new(path, |w| encode_png(w, width, height, color, rgb))
+    check_png(path, width, height, 3, rgb.len())?;
+    write_new(path, |w| {
+        encode_png(w, (width, height), color, Depth::Srgb8, rgb)
+    })
 }
 
-/// Fails unless `pixels` make a PNG of `width × height` and `color`.
-fn check_png(
-    path: &Path,
-    width: u32,
-    height: u32,
-    color: png::ColorType,
-    pixels: &[u8],
-) -> Result<()> {
+/// Fails unless `len` samples make a PNG of `width × height` with `channels` per pixel.
+fn check_png(path: &Path, width: u32, height: u32, channels: usize, len: usize) -> Result<()> {
     if width == 0 || height == 0 {
         return Err(ReadError::format(
             path,
             format!("a PNG needs at least one pixel, the image is {width}×{height}"),
         ));
     }
-    check_len(path, width, height, color.samples(), pixels.len())
+    check_len(path, width, height, channels, len)
+}
+
+/// What a PNG's samples are.
+#[derive(Clone, Copy, PartialEq)]
+enum Depth {
+    /// 8-bit colour, tagged sRGB.
+    Srgb8,
+    /// 8-bit data, untagged.
+    Data8,
+    /// 16-bit data (big-endian bytes), untagged.
+    Data16,
 }
 
 /// Encodes `pixels` (checked by [`check_png`]) into `w`.
 fn encode_png(
     w: &mut dyn Write,
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
     color: png::ColorType,
+    depth: Depth,
     pixels: &[u8],
 ) -> std::io::Result<()> {
     let mut encoder = png::Encoder::new(w, width, height);
     encoder.set_color(color);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    match depth {
+        Depth::Srgb8 => encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual),
+        Depth::Data8 => {}
+        Depth::Data16 => encoder.set_depth(png::BitDepth::Sixteen),
+    }
     let mut writer = encoder.write_header().map_err(png_to_io)?;
     writer.write_image_data(pixels).map_err(png_to_io)?;
     writer.finish().map_err(png_to_io)

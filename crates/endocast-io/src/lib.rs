@@ -20,6 +20,7 @@
 pub mod atomic;
 pub mod case;
 mod compressed;
+pub mod dataset;
 mod detached;
 pub mod dicom;
 mod encode;

@@ -8,6 +8,7 @@ use crate::scene::{warn, SceneFiles};
 use crate::volume::Volume;
 use endocast_core::flight::{Flight, FlightOptions, Layout, Route, ShotSettings};
 use endocast_core::study::LOOK_AHEAD_MM;
+use endocast_io::dataset::DatasetWriter;
 use endocast_io::route_file::{read_route, read_target};
 use endocast_io::transfer_json::transfer_function;
 use endocast_io::video::{open_sink, VideoOptions};
@@ -22,7 +23,9 @@ use std::path::PathBuf;
 /// or 3D Slicer writes it (points or key frames) — one frame every `frame_step` mm (default
 /// 1) looking `look_ahead` mm ahead (default 10). With `out` (a `.gif`, an `.mp4` or a folder
 /// of PNGs) writes the film and returns its path (a `pathlib.Path`); without, returns the
-/// frames as an RGB uint8 array (frames, height, width, 3).
+/// frames as an RGB uint8 array (frames, height, width, 3). With `dataset` (a new or empty
+/// folder) also writes the training data `endocast fly --dataset` writes: images, depth,
+/// normals, masks, transforms.json and colmap/ (docs/dataset-format.md).
 ///
 /// Options: `size` (width, height; default 384 × 384), `frame_step`, `look_ahead` (mm), `fps`,
 /// and `render`'s look, peel, lens and lumen options: `preset`, `mode`, `iso`, `iso2`,
@@ -57,6 +60,7 @@ pub fn fly<'py>(
             Err(_) => None,
         },
     };
+    let dataset = kw.take::<PathBuf>("dataset")?;
     let route = read(py, route)?;
     let shots = route.shots(frame_step, look_ahead).map_err(to_py)?;
     let first = shots
@@ -82,7 +86,12 @@ pub fn fly<'py>(
         layout: Layout::Endoscope,
         window: look.study.window(),
     };
-    let mut flight = Flight::new(volume.renderer().clone(), options);
+    let renderer = volume.renderer().clone();
+    let mut writer = dataset
+        .map(|folder| DatasetWriter::create(&folder, renderer.volume(), &options.optics))
+        .transpose()
+        .map_err(to_py)?;
+    let mut flight = Flight::new(renderer.clone(), options);
     flight.set_look(look.look.clone());
     flight.set_scene(scene);
     flight.set_target(target);
@@ -93,6 +102,10 @@ pub fn fly<'py>(
             let (image, _) = look
                 .in_pool(|| flight.frame(n, &shots[n], &settings))
                 .map_err(to_py)?;
+            if let (Some(writer), Some((camera, depth))) = (&mut writer, flight.last_view()) {
+                let volume = renderer.volume();
+                writer.push(&image, &camera, depth, volume).map_err(to_py)?;
+            }
             PyResult::Ok(image)
         })
     };
@@ -104,6 +117,7 @@ pub fn fly<'py>(
             sink.push_image(&frame(n)?).map_err(to_py)?;
         }
         let written = sink.finish().map_err(to_py)?;
+        finish(writer)?;
         return Ok(written.into_pyobject(py)?.into_any());
     }
     let mut rgb = Vec::new();
@@ -113,8 +127,18 @@ pub fn fly<'py>(
         (shape.1, shape.2) = (image.height(), image.width());
         rgb.extend_from_slice(image.rgb());
     }
+    finish(writer)?;
     let frames = Array4::from_shape_vec(shape, rgb).map_err(to_py)?;
     Ok(frames.into_pyarray(py).into_any())
+}
+
+/// Writes the dataset's cameras, if one is written.
+fn finish(writer: Option<DatasetWriter>) -> PyResult<()> {
+    writer
+        .map(DatasetWriter::finish)
+        .transpose()
+        .map_err(to_py)?;
+    Ok(())
 }
 
 /// The route `value` gives: a path file's name, or an (N, 3) array of points.

@@ -4,6 +4,7 @@
 
 use crate::case_args::CaseArgs;
 use crate::commands::fly_coverage;
+use crate::commands::fly_dataset::{self, DatasetSink};
 use crate::input::InputArgs;
 use crate::look::{set_threads, transfer_function, LookArgs, ScanLook};
 use crate::lumen::LumenArgs;
@@ -24,6 +25,7 @@ use endocast_core::render::{RenderSettings, Renderer};
 use endocast_core::study::{Study, LOOK_AHEAD_MM};
 use endocast_core::views::slices::Window;
 use endocast_core::views::stereo::StereoOutput;
+use endocast_core::views::Image;
 use endocast_core::Volume;
 use endocast_io::route_file::read_route;
 use endocast_io::video::{open_sink, FrameSink, VideoOptions};
@@ -93,6 +95,14 @@ pub struct FlyArgs {
     /// Print the result (output, frames, length, speed, coverage) as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// Also write training data into FOLDER (new or empty; one with files is refused): per
+    /// frame images/NNNNN.png (the frame: plain, or the look's), depth/ and depth_z/ (16-bit
+    /// PNG, mm = code × depth_scale_mm, along the ray and the view axis), normals/ (camera
+    /// frame, (n+1)/2), masks/ (the wall seen); the cameras as nerfstudio's transforms.json
+    /// and COLMAP's text model in colmap/ (docs/dataset-format.md). A pinhole or equidistant
+    /// fisheye camera, without --stereo, with --layout endoscope.
+    #[arg(long, value_name = "FOLDER")]
+    dataset: Option<PathBuf>,
 }
 
 /// The `--layout` choices.
@@ -114,6 +124,9 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         );
     }
     let stereo = flight_stereo(args)?;
+    if args.dataset.is_some() {
+        fly_dataset::check(stereo.is_some(), args.layout == LayoutArg::Dashboard)?;
+    }
     // Per frame: the view (both eyes of a pair) and, for a dashboard, its composite image
     // (counted as one more view); checked again once the look is known.
     let views = 1 + u64::from(args.layout == LayoutArg::Dashboard);
@@ -167,6 +180,10 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         },
         window,
     };
+    let mut dataset = match &args.dataset {
+        Some(folder) => Some(DatasetSink::create(folder, &renderer, &options.optics)?),
+        None => None,
+    };
     let mut flight = Flight::new(Arc::clone(&renderer), options.clone());
     let scene = args.scene.scene()?;
     flight.set_scene(scene);
@@ -192,11 +209,15 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     let mut looks = ShotSettings::new(settings.clone(), transfer_function);
     for (n, shot) in shots.iter().enumerate() {
         let shot_settings = looks.for_shot(shot)?;
-        sinks.push(&mut flight, n, shot, &shot_settings)?;
+        let image = sinks.push(&mut flight, n, shot, &shot_settings)?;
+        if let (Some(dataset), Some(image)) = (&mut dataset, image) {
+            dataset.push(&flight, &image)?;
+        }
         progress.step();
     }
     progress.finish();
     let written = sinks.finish()?;
+    let dataset = dataset.map(DatasetSink::finish).transpose()?;
     if !args.json {
         println!(
             "{}: {} frames along {:.1} mm ({:.1} frames/s)",
@@ -227,6 +248,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
             "frames_per_s": progress.rate(),
             "first_camera": study_report::pose_json(&first),
             "coverage": coverage,
+            "dataset": dataset,
         });
         println!("{}", serde_json::to_string_pretty(&summary)?);
     }
@@ -312,23 +334,27 @@ impl Sinks {
         })
     }
 
-    /// Renders and writes frame `n`.
+    /// Renders and writes frame `n`; returns it unless it is a pair.
     fn push(
         &mut self,
         flight: &mut Flight,
         n: usize,
         shot: &Shot,
         settings: &RenderSettings,
-    ) -> Result<()> {
+    ) -> Result<Option<Image>> {
         match self {
-            Self::One(sink) => sink.push_image(&flight.frame(n, shot, settings)?.0)?,
+            Self::One(sink) => {
+                let image = flight.frame(n, shot, settings)?.0;
+                sink.push_image(&image)?;
+                Ok(Some(image))
+            }
             Self::Pair([left, right]) => {
                 let ([l, r], _) = flight.stereo_frame(shot, settings)?;
                 left.push_image(&l)?;
                 right.push_image(&r)?;
+                Ok(None)
             }
         }
-        Ok(())
     }
 
     /// Finishes the film(s); returns where the (first) one is.

@@ -8,6 +8,7 @@ pub mod coverage;
 pub mod dissect;
 pub mod fly;
 mod fly_coverage;
+mod fly_dataset;
 pub mod info;
 pub mod match_scans;
 pub mod mesh;

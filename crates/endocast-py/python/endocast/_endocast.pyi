@@ -228,9 +228,12 @@ def fly(
     meshes: Sequence[_Path] = (),
     overlays: Sequence[_Path] = (),
     target: Optional[_Point] = None,
+    dataset: Optional[_Path] = None,
 ) -> npt.NDArray[np.uint8]:
     """Fly along ``route`` (an (N, 3) array of LPS points or a path file) as ``endocast fly``
-    films the endoscopic view: without ``out`` the frames, RGB uint8 (frames, height, width, 3)."""
+    films the endoscopic view: without ``out`` the frames, RGB uint8 (frames, height, width, 3).
+    With ``dataset`` (a new or empty folder) also writes the training data of
+    ``endocast fly --dataset`` (docs/dataset-format.md)."""
 @overload
 def fly(
     volume: _VolumeLike,
