@@ -22,7 +22,7 @@ fn phantom(size: usize, count: usize, seed: u64) -> (Volume, Lumen, PolypColon) 
 
 /// Size and where the tests draw their phantoms: the lumen 7.5–12.5 mm in radius, its folds
 /// every 22 mm.
-const SIZE: usize = 192;
+const SIZE: usize = 320;
 
 /// A polyp counts as found by a candidate whose tip lies within its radius and this of its
 /// own, mm.
