@@ -29,12 +29,14 @@ pub use view::{annotations, view_pose, CANDIDATE_COLOR, VIEW_DISTANCE_MM, VIEW_F
 pub struct PolypOptions {
     /// Standard deviation of the Gaussian smoothing before the derivatives, mm (default 1).
     pub sigma_mm: f64,
-    /// Shape index a seed voxel reaches (default 0.9: a cap).
+    /// Shape index a seed voxel reaches (default 0.88: a cap; a flat polyp's dome on the
+    /// colon's concave wall peaks at 0.88–0.90 under the default smoothing).
     pub seed_shape_index: f64,
     /// Shape index a region grows through (default 0.8, hysteresis below the seeds').
     pub grow_shape_index: f64,
-    /// Curvedness band of seeds and regions, 1/mm: from the inverse radius of the largest
-    /// polyp to that of noise bumps (default 0.08..=1.0: radii 1–12.5 mm).
+    /// Curvedness band of seeds and regions, 1/mm: from the inverse radius of the flattest
+    /// polyp's dome to that of noise bumps (default 0.05..=1.0: radii 1–20 mm; a 6 mm flat
+    /// polyp 1 mm high is a dome of radius 5 mm, flatter still once smoothed).
     pub curvedness_per_mm: (f64, f64),
     /// Candidates smaller than this across the wall are dropped, mm (default 4: a 6 mm polyp
     /// between folds measures 4.7–5.5 mm, its cap region narrowed by the wall's concavity).
@@ -45,9 +47,9 @@ impl Default for PolypOptions {
     fn default() -> Self {
         Self {
             sigma_mm: 1.0,
-            seed_shape_index: 0.9,
+            seed_shape_index: 0.88,
             grow_shape_index: 0.8,
-            curvedness_per_mm: (0.08, 1.0),
+            curvedness_per_mm: (0.05, 1.0),
             min_size_mm: 4.0,
         }
     }
