@@ -15,7 +15,8 @@ for p in colon colon-prone; do
 done
 [ -f "$out/scans/polyps.nii.gz" ] ||
   $endocast phantom colon --size 128 --polyps 6 --seed 3 -o "$out/scans/polyps.nii.gz" >/dev/null
-head -c 100000 "$out/scans/colon.nii.gz" >"$out/scans/corrupt.nii.gz"
+size=$(stat -c %s "$out/scans/colon.nii.gz")
+head -c $((size / 2)) "$out/scans/colon.nii.gz" >"$out/scans/corrupt.nii.gz"
 cat >"$out/manifest.csv" <<CSV
 scan,preset,output,orientation
 $data/abdomen-ct-pancreas-dicom,colonoscopy,abdomen-colon,
