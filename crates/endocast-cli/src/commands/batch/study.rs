@@ -102,42 +102,39 @@ fn run_steps(
         .with_context(|| format!("cannot create {}", folder.display()))?;
     let path_file = folder.join("path.json");
     let path_arg = path_file.display().to_string();
+    // Each step: its command, its output file in `folder` (if any) and its own options.
     let mut plan = vec![
-        ("path", vec!["-o", "path.json", "--json"]),
+        ("path", Some("path.json"), vec!["--json"]),
         (
             "fly",
-            vec![
-                "--path",
-                &path_arg,
-                "-o",
-                "film.mp4",
-                "--coverage",
-                "--json",
-            ],
+            Some("film.mp4"),
+            vec!["--path", &path_arg, "--coverage", "--json"],
         ),
-        ("render", vec!["-o", "start.png"]),
+        ("render", Some("start.png"), vec![]),
     ];
     if entry.preset.as_deref() == Some("colonoscopy") {
         plan.push((
             "dissect",
-            vec!["--path", &path_arg, "-o", "flat.png", "--json"],
+            Some("flat.png"),
+            vec!["--path", &path_arg, "--json"],
         ));
-        plan.push(("polyps", vec!["--path", &path_arg, "--json"]));
+        plan.push(("polyps", None, vec!["--path", &path_arg, "--json"]));
     }
-    for (command, own) in plan {
-        let args = step_args(command, &own, entry, folder, setup);
+    for (command, output, own) in plan {
+        let output = output.map(|file| folder.join(file));
+        let args = step_args(command, output.as_deref(), &own, entry, setup);
         steps.insert(command.into(), run_step(&setup.program, command, &args)?);
     }
     Ok(())
 }
 
 /// The arguments of step `command`: the scan, the preset, the options of the manifest it
-/// takes, the step's own (outputs in `folder`), and the batch's threads and memory share.
+/// takes, its output file and own options, and the batch's threads and memory share.
 fn step_args(
     command: &str,
+    output: Option<&Path>,
     own: &[&str],
     entry: &Entry,
-    folder: &Path,
     setup: &Setup,
 ) -> Vec<String> {
     let takes = |name: &str| takes_option(setup.cli, command, name);
@@ -152,14 +149,10 @@ fn step_args(
             _ => args.extend([format!("--{name}"), value.clone()]),
         }
     }
-    let mut own = own.iter();
-    while let Some(arg) = own.next() {
-        args.push(arg.to_string());
-        if *arg == "-o" {
-            let file = own.next().expect("-o has its file");
-            args.push(folder.join(file).display().to_string());
-        }
+    if let Some(file) = output {
+        args.extend(["-o".to_owned(), file.display().to_string()]);
     }
+    args.extend(own.iter().map(|arg| arg.to_string()));
     if takes("threads") {
         args.extend(["--threads".to_owned(), setup.threads.to_string()]);
     }
