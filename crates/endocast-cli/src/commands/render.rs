@@ -197,7 +197,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             args.output.display(),
             frame.width,
             frame.height,
-            settings.mode.name(),
+            look.look
+                .as_ref()
+                .map_or(settings.mode.name(), |l| l.kind.name()),
             frame.stats.time.as_secs_f64() * 1e3
         );
     }

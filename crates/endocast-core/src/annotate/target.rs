@@ -106,7 +106,7 @@ pub fn draw_target(image: &mut Image, view: &SurfaceView<'_>, target_mm: DVec3) 
     ring(image, at, radius, color, dashed);
     image.disc(at, LINE_PX + 1.0, [0; 3]);
     image.disc(at, LINE_PX, color);
-    let scale = if image.height() <= 300 { 1 } else { 2 };
+    let scale = label_scale(image, &caption);
     // Above the ring, kept inside the image (below it where the ring touches the top).
     let (width, height) = (
         (text_width(&caption, scale)) as f64,
@@ -145,8 +145,8 @@ fn edge_arrow(image: &mut Image, view: &SurfaceView<'_>, target_mm: DVec3, dista
         }
     }
     image.arrow(tail, tip, 0.4 * ARROW_PX, TARGET_COLOR);
-    let scale = if image.height() <= 300 { 1 } else { 2 };
     let caption = format!("target {distance_mm:.0} mm");
+    let scale = label_scale(image, &caption);
     let (width, height) = (
         text_width(&caption, scale) as f64,
         (GLYPH_HEIGHT * scale) as f64,
@@ -157,6 +157,17 @@ fn edge_arrow(image: &mut Image, view: &SurfaceView<'_>, target_mm: DVec3, dista
     let left = (centre.0 - 0.5 * width).clamp(1.0, (w - width - 1.0).max(1.0));
     let top = (centre.1 - 0.5 * height).clamp(1.0, (h - height - 1.0).max(1.0));
     image.text_shadowed(left as i64, top as i64, &caption, scale, TARGET_COLOR);
+}
+
+/// The font scale of `caption` on `image`: double on images taller than 300 pixels where it
+/// fits across, single otherwise.
+fn label_scale(image: &Image, caption: &str) -> usize {
+    let fits = text_width(caption, 2) + 2 <= image.width();
+    if image.height() > 300 && fits {
+        2
+    } else {
+        1
+    }
 }
 
 /// The radius of the outline of the target's sphere in the image, pixels (within
@@ -288,5 +299,15 @@ mod tests {
                 .count()
         };
         assert!(marked(230..256) > 10 && marked(0..128) == 0);
+    }
+
+    /// The caption halves its font where double would run past the image's edge.
+    #[test]
+    fn a_caption_too_wide_for_double_size_is_written_single() {
+        let caption = "target 34.5 mm, behind the wall";
+        let scale = |w, h| label_scale(&Image::new(w, h, [0; 3]).unwrap(), caption);
+        assert_eq!(scale(512, 512), 2);
+        assert_eq!(scale(320, 320), 1, "371 px of text on 320");
+        assert_eq!(scale(512, 256), 1, "small images write single");
     }
 }

@@ -412,14 +412,17 @@ fn field(
     }
 }
 
-/// The axial, coronal and sagittal slices through the camera's eye, with the camera drawn.
+/// The axial, coronal and sagittal slices through the camera's eye, with the camera drawn;
+/// where the eye lies outside the scan, a slice that would miss it passes through the scan's
+/// middle instead.
 pub fn camera_slices(
     volume: &Volume,
     camera: &Camera,
     options: &SliceOptions,
 ) -> Result<[Slice; 3], ViewError> {
+    let centre = inside_or_middle(volume, camera.eye_mm());
     let one = |plane: Plane| {
-        let plane = SlicePlane::standard(plane, camera.eye_mm())?;
+        let plane = SlicePlane::standard(plane, centre)?;
         let mut slice = reformat(volume, &plane, options)?;
         slice.draw_camera(camera.eye_mm(), camera.forward());
         Ok(slice)
@@ -429,6 +432,24 @@ pub fn camera_slices(
         one(Plane::Coronal)?,
         one(Plane::Sagittal)?,
     ])
+}
+
+/// `point_mm`, with each voxel coordinate that lies outside the scan's grid moved to the grid's
+/// middle (a slice through the scan's middle rather than one past its edge or along its rim).
+fn inside_or_middle(volume: &Volume, point_mm: DVec3) -> DVec3 {
+    let g = volume.geometry();
+    let voxel = g.voxel_from_world().transform_point3(point_mm);
+    let last = DVec3::from_array(g.dims().map(|d| d.saturating_sub(1) as f64));
+    let moved = DVec3::select(
+        voxel.cmpge(DVec3::ZERO) & voxel.cmple(last),
+        voxel,
+        0.5 * last,
+    );
+    if moved == voxel || !voxel.is_finite() {
+        point_mm
+    } else {
+        g.world_of(moved)
+    }
 }
 
 /// The cross-section through the camera's eye perpendicular to `tangent` (the path's direction
@@ -607,6 +628,28 @@ mod tests {
                 slice.image().pixel(p.0 as usize, p.1 as usize),
                 Some(CAMERA_COLOR)
             );
+        }
+    }
+
+    /// From outside the scan (an overview of the whole object), each slice still cuts the
+    /// scan: the tube's wall shows in all three.
+    #[test]
+    fn slices_from_outside_the_scan_cut_it_through_its_middle() {
+        let (volume, _) = phantom::straight_tube(&PhantomOptions {
+            size: 32,
+            ..Default::default()
+        });
+        let g = volume.geometry();
+        let eye = g.world_of(DVec3::new(16.0, -40.0, -25.0));
+        let camera =
+            Camera::look_at(eye, g.world_of(DVec3::splat(16.0)), DVec3::Z, 60.0, [8, 8]).unwrap();
+        let slices = camera_slices(&volume, &camera, &options(64, None, false)).unwrap();
+        for slice in &slices {
+            let image = slice.image();
+            let levels: std::collections::BTreeSet<_> = (0..image.height())
+                .flat_map(|y| (0..image.width()).filter_map(move |x| image.pixel(x, y)))
+                .collect();
+            assert!(levels.len() > 4, "{:?} is blank", slice.plane());
         }
     }
 
