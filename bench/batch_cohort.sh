@@ -44,3 +44,16 @@ done
 start=$(date +%s.%N)
 $endocast batch "$out/manifest.csv" -o "$out/run2" --workers 2 2>/dev/null | head -1
 echo "resume: $(echo "$(date +%s.%N) - $start" | bc) s"
+# Per pipeline (preset) with one worker: seconds per study, and studies an hour at that rate.
+python3 - "$out" <<'PY'
+import csv, json, sys
+out = sys.argv[1]
+preset = {row["output"]: row["preset"] for row in csv.DictReader(open(f"{out}/manifest.csv"))}
+per = {}
+for r in json.load(open(f"{out}/run1/summary.json"))["studies"]:
+    name = r["output"].rstrip("/").split("/")[-1]
+    if r["status"] == "ok":
+        per.setdefault(preset[name], []).append(r["seconds"])
+for p, s in sorted(per.items()):
+    print(f"{p}: {len(s)} studies, {sum(s):.0f} s, {3600 * len(s) / sum(s):.0f} studies/h")
+PY

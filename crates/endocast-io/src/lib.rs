@@ -41,6 +41,7 @@ pub mod overlay_scene;
 pub mod path_file;
 mod progress;
 pub mod raw;
+pub mod review_json;
 pub mod route_file;
 pub mod samples;
 mod text;

@@ -8,14 +8,14 @@ use crate::look::{optics, LookOptions};
 use crate::volume::Volume;
 use endocast_core::flight::{
     review, FlightError, FlightOptions, Layout, PatchView, Review, ReviewRequest, Route,
-    DEFAULT_MIN_AREA_MM2, REVIEW_AREA_MM2, REVIEW_FRAME_PX, REVIEW_STEP_MM,
+    DEFAULT_MIN_AREA_MM2, REVIEW_FRAME_PX, REVIEW_STEP_MM,
 };
 use endocast_core::path::SmoothOptions;
 use endocast_core::study::LOOK_AHEAD_MM;
 use endocast_core::views::Image;
-use glam::DVec3;
+use endocast_io::review_json;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
 
 /// Flies `path` — an (N, 3) array of points (LPS mm) or a path file, as `fly` takes it; without
@@ -40,7 +40,7 @@ pub fn coverage<'py>(
     volume: &Bound<'py, Volume>,
     path: Option<&Bound<'py, PyAny>>,
     options: Option<&Bound<'py, PyDict>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<Bound<'py, PyAny>> {
     let kw = Kwargs::new(py, "coverage", options)?;
     let volume = volume.get();
     let look_options = LookOptions::take(&kw)?;
@@ -107,7 +107,7 @@ pub fn coverage<'py>(
     let review = py.detach(|| {
         look.in_pool(|| {
             let write = |n: usize, _: &PatchView, image: &Image| match &views {
-                Some(dir) => save(&view_file(dir, n), image),
+                Some(dir) => save(&review_json::view_file(dir, n), image),
                 None => Ok(()),
             };
             review::<ViewError>(volume.renderer(), &lumen, &route, &request, || {}, write)
@@ -137,54 +137,27 @@ fn positive(name: &str, value: f64) -> PyResult<f64> {
     }
 }
 
-/// The view file of patch `n`, as `endocast coverage --views` names it.
-fn view_file(dir: &Path, n: usize) -> PathBuf {
-    dir.join(format!("patch_{n:03}.png"))
-}
-
 fn save(path: &Path, image: &Image) -> Result<(), ViewError> {
     let (w, h) = (image.width() as u32, image.height() as u32);
     endocast_io::image_out::write_png_rgb8(path, w, h, image.rgb())
         .map_err(|e| ViewError(format!("cannot write {}: {e}", path.display())))
 }
 
-/// The review as the dict `endocast coverage --json` prints.
+/// The review as the dict `endocast coverage --json` prints (each patch's `view` a path).
 fn to_dict<'py>(
     py: Python<'py>,
     review: &Review,
     request: &ReviewRequest,
     views: Option<&Path>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let v = |p: DVec3| [p.x, p.y, p.z];
-    let patches = PyList::empty(py);
-    for (n, (view, seen)) in review.views.iter().zip(&review.seen_by_view).enumerate() {
-        let patch = PyDict::new(py);
-        patch.set_item("area_mm2", view.patch.area_mm2)?;
-        patch.set_item("centroid", v(view.patch.centroid_mm))?;
-        patch.set_item("eye", v(view.pose.eye_mm))?;
-        patch.set_item("look_at", v(view.pose.look_at_mm))?;
-        patch.set_item("up", v(view.pose.up))?;
-        patch.set_item("fov_deg", view.fov_deg)?;
-        patch.set_item("clear", view.clear)?;
-        patch.set_item("voxels", view.patch.voxels.len())?;
-        patch.set_item("voxels_seen_by_view", seen)?;
-        patch.set_item("view", views.map(|d| view_file(d, n)))?;
-        patches.append(patch)?;
+) -> PyResult<Bound<'py, PyAny>> {
+    let json = review_json::to_json(review, request.min_area_mm2, request.both_ways, None);
+    let dict = py
+        .import("json")?
+        .call_method1("loads", (json.to_string(),))?;
+    if let Some(dir) = views {
+        for (n, patch) in dict.get_item("patches")?.try_iter()?.enumerate() {
+            patch?.set_item("view", review_json::view_file(dir, n))?;
+        }
     }
-    let big = |view: &&PatchView| view.patch.area_mm2 >= REVIEW_AREA_MM2;
-    let out = PyDict::new(py);
-    out.set_item("patches", patches)?;
-    out.set_item("patches_total", review.patches_total)?;
-    out.set_item(
-        "patches_at_least_300_mm2",
-        review.views.iter().filter(big).count(),
-    )?;
-    out.set_item("min_area_mm2", request.min_area_mm2)?;
-    out.set_item("both_ways", request.both_ways)?;
-    out.set_item("wall_voxels", review.flight.wall_voxels())?;
-    out.set_item("reach_mm", review.reach_mm)?;
-    out.set_item("coverage_forward", review.flight.fraction_forward())?;
-    out.set_item("coverage_before", review.before().seen_fraction())?;
-    out.set_item("coverage_after", review.after.seen_fraction())?;
-    Ok(out)
+    Ok(dict)
 }

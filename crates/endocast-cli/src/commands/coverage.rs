@@ -23,9 +23,8 @@ use endocast_core::path::SmoothOptions;
 use endocast_core::render::Renderer;
 use endocast_core::study::LOOK_AHEAD_MM;
 use endocast_core::views::Image;
+use endocast_io::review_json;
 use endocast_io::route_file::read_route;
-use glam::DVec3;
-use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -141,7 +140,7 @@ pub fn run(args: &CoverageArgs) -> Result<()> {
     let mut progress = Progress::new("flying", frames);
     let renderer = Arc::new(Renderer::for_many_frames(volume));
     let write_view = |n: usize, _: &PatchView, image: &Image| match &args.views {
-        Some(dir) => write_png(&view_file(dir, n), image),
+        Some(dir) => write_png(&review_json::view_file(dir, n), image),
         None => Ok(()),
     };
     let review = review(
@@ -153,7 +152,12 @@ pub fn run(args: &CoverageArgs) -> Result<()> {
         write_view,
     )?;
     progress.finish();
-    let report = to_json(&review, args);
+    let report = review_json::to_json(
+        &review,
+        args.min_area,
+        !args.forward_only,
+        args.views.as_deref(),
+    );
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -179,11 +183,6 @@ fn check(args: &CoverageArgs) -> Result<()> {
     Ok(())
 }
 
-/// The view file of patch `n`.
-fn view_file(dir: &Path, n: usize) -> PathBuf {
-    dir.join(format!("patch_{n:03}.png"))
-}
-
 fn write_png(path: &Path, image: &Image) -> Result<()> {
     endocast_io::image_out::write_png_rgb8(
         path,
@@ -192,50 +191,6 @@ fn write_png(path: &Path, image: &Image) -> Result<()> {
         image.rgb(),
     )
     .with_context(|| format!("cannot write {}", path.display()))
-}
-
-/// The review as JSON: the patches (largest first) and the coverage before and after.
-fn to_json(review: &Review, args: &CoverageArgs) -> Value {
-    let v = |p: DVec3| [p.x, p.y, p.z];
-    let patches: Vec<Value> = review
-        .views
-        .iter()
-        .zip(&review.seen_by_view)
-        .enumerate()
-        .map(|(n, (view, seen))| {
-            json!({
-                "area_mm2": view.patch.area_mm2,
-                "centroid": v(view.patch.centroid_mm),
-                "eye": v(view.pose.eye_mm),
-                "look_at": v(view.pose.look_at_mm),
-                "up": v(view.pose.up),
-                "fov_deg": view.fov_deg,
-                "clear": view.clear,
-                "voxels": view.patch.voxels.len(),
-                "voxels_seen_by_view": seen,
-                "view": args.views.as_deref().map(|d| view_file(d, n)),
-            })
-        })
-        .collect();
-    let flight = &review.flight;
-    json!({
-        "patches": patches,
-        "patches_total": review.patches_total,
-        "patches_at_least_300_mm2": at_least(review, REVIEW_AREA_MM2),
-        "min_area_mm2": args.min_area,
-        "both_ways": !args.forward_only,
-        "wall_voxels": flight.wall_voxels(),
-        "reach_mm": review.reach_mm,
-        "coverage_forward": flight.fraction_forward(),
-        "coverage_before": review.before().seen_fraction(),
-        "coverage_after": review.after.seen_fraction(),
-    })
-}
-
-/// How many listed patches have at least `area_mm2`.
-fn at_least(review: &Review, area_mm2: f64) -> usize {
-    let big = |v: &&PatchView| v.patch.area_mm2 >= area_mm2;
-    review.views.iter().filter(big).count()
 }
 
 /// The review in words.
@@ -256,7 +211,7 @@ fn say(review: &Review, args: &CoverageArgs) {
         review.patches_total,
         review.views.len(),
         args.min_area,
-        at_least(review, REVIEW_AREA_MM2)
+        review_json::at_least(review, REVIEW_AREA_MM2)
     );
     for (n, view) in review.views.iter().enumerate() {
         let c = view.patch.centroid_mm;
