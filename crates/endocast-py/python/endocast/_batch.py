@@ -146,10 +146,9 @@ def _failed(study, message):
 def _study(study, command):
     """Task: runs ``endocast batch ... --study K --json`` on this worker; its record."""
     program, *args = command
-    if not Path(program).is_file():
-        program = find_program()  # another machine: its own command
+    args = ["batch", *map(str, args), "--study", str(study["study"]), "--json"]
     done = subprocess.run(
-        [str(program), "batch", *map(str, args), "--study", str(study["study"]), "--json"],
+        [str(_here(program)), *args],
         capture_output=True,
         text=True,
     )
@@ -200,9 +199,13 @@ def _fly_part(command):
     """Task: flies one part (``endocast fly ... --frames K/N``); an ``EndocastError`` when it
     fails."""
     program, *args = command
-    if not Path(program).is_file():
-        program = find_program()
-    _run(program, args)
+    _run(_here(program), args)
+
+
+def _here(program):
+    """The command on this worker: the client's when this machine has it at the same path,
+    else this machine's own (``ENDOCAST_BIN``, ``PATH``)."""
+    return program if Path(program).is_file() else find_program()
 
 
 def _options(options):
