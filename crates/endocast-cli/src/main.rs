@@ -69,6 +69,8 @@ enum Command {
     /// coverage and film, a key view, and for colonoscopy the dissection and polyp candidates;
     /// resumable, each study isolated, summarised in summary.csv and summary.json.
     Batch(Box<commands::batch::BatchArgs>),
+    /// Join the frames of a flight flown in parts (`fly --frames`, PNG folders) into one film.
+    Film(commands::film::FilmArgs),
 }
 
 fn main() -> ExitCode {
@@ -91,6 +93,7 @@ fn main() -> ExitCode {
         Command::Annotate(args) => commands::annotate::run(&args),
         Command::Match(args) => commands::match_scans::run(&args),
         Command::Batch(args) => commands::batch::run(&args, &Cli::command()),
+        Command::Film(args) => commands::film::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -130,3 +130,191 @@ fn a_bad_manifest_or_failures_with_fail_on_error_fail_the_run() {
     assert!(out.join("summary.csv").is_file());
     fails_with(&["batch", m, "-o", o, "--workers", "0"], "--workers");
 }
+
+#[test]
+fn a_study_past_its_timeout_is_killed_and_recorded_failed() {
+    let dir = tempfile::tempdir().unwrap();
+    let colon = phantom(dir.path(), "colon", "48");
+    let manifest = dir.path().join("m.csv");
+    std::fs::write(&manifest, format!("scan,preset\n{colon},colonoscopy\n")).unwrap();
+    let out = dir.path().join("out");
+    let clock = Instant::now();
+    let studies = batch(&manifest, &out, &["--timeout", "0.2"]);
+    assert!(clock.elapsed().as_secs_f64() < 5.0);
+    assert_eq!(studies[0]["status"], "failed");
+    let message = studies[0]["message"].as_str().unwrap();
+    assert!(message.contains("timed out after 0.2 s"), "{message}");
+    let (m, o) = (manifest.to_str().unwrap(), out.to_str().unwrap());
+    for bad in ["0", "-1", "NaN", "inf"] {
+        fails_with(&["batch", m, "-o", o, "--timeout", bad], "--timeout");
+    }
+}
+
+#[test]
+fn a_dataset_column_makes_the_flight_write_its_training_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let colon = phantom(dir.path(), "colon", "48");
+    let manifest = dir.path().join("m.jsonl");
+    std::fs::write(
+        &manifest,
+        format!(
+            "{{\"scan\": \"{colon}\", \"preset\": \"colonoscopy\", \"size\": \"24x24\", \
+             \"frame-step\": 4, \"dataset\": true}}\n"
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let studies = batch(&manifest, &out, &[]);
+    assert_eq!(studies[0]["status"], "ok", "{studies:#?}");
+    let dataset = out.join("colon/dataset");
+    assert_eq!(studies[0]["outputs"]["dataset"], dataset.to_str().unwrap());
+    let transforms: Value =
+        serde_json::from_str(&std::fs::read_to_string(dataset.join("transforms.json")).unwrap())
+            .unwrap();
+    let frames = transforms["frames"].as_array().unwrap().len();
+    assert!(frames > 2, "{frames} frames");
+    assert!(dataset.join("images/00000.png").is_file());
+    // A changed dataset column is a new study; running it again replaces the old data.
+    std::fs::write(
+        &manifest,
+        std::fs::read_to_string(&manifest)
+            .unwrap()
+            .replace("true", "false"),
+    )
+    .unwrap();
+    let again = batch(&manifest, &out, &[]);
+    assert_eq!(again[0]["status"], "ok");
+    assert!(again[0]["outputs"].get("dataset").is_none());
+}
+
+#[test]
+fn a_run_split_into_studies_writes_the_summary_of_a_whole_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let colon = phantom(dir.path(), "colon", "48");
+    let manifest = dir.path().join("m.csv");
+    std::fs::write(
+        &manifest,
+        format!("scan,preset,size\n{colon},colonoscopy,24x24\nmissing.nii,,\n"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let (m, o) = (manifest.to_str().unwrap(), out.to_str().unwrap());
+    let plan = endocast(&["batch", m, "-o", o, "--plan"]);
+    let plan: Value = serde_json::from_slice(&plan.stdout).unwrap();
+    assert_eq!(plan["studies"][1]["study"], 2);
+    assert_eq!(
+        plan["studies"][0]["output"],
+        out.join("colon").to_str().unwrap()
+    );
+    assert!(!out.exists(), "--plan runs nothing");
+    let records: Vec<Value> = (1..=2)
+        .map(|k| {
+            let run = endocast(&["batch", m, "-o", o, "--study", &k.to_string(), "--json"]);
+            assert!(run.status.success());
+            serde_json::from_slice(&run.stdout).unwrap()
+        })
+        .collect();
+    assert_eq!(records[0]["status"], "ok");
+    assert_eq!(records[1]["status"], "failed");
+    assert!(!out.join("summary.json").exists());
+    let file = dir.path().join("records.json");
+    std::fs::write(&file, serde_json::json!({ "studies": records }).to_string()).unwrap();
+    let summary = batch(&manifest, &out, &["--from-records", file.to_str().unwrap()]);
+    assert_eq!(summary, records);
+    // A whole run finds the study a split run finished.
+    assert_eq!(batch(&manifest, &out, &[])[0]["status"], "skipped");
+    let f = file.to_str().unwrap();
+    fails_with(&["batch", m, "-o", o, "--study", "3"], "studies 1 to 2");
+    std::fs::write(
+        &file,
+        serde_json::json!({ "studies": [records[1], records[0]] }).to_string(),
+    )
+    .unwrap();
+    fails_with(
+        &["batch", m, "-o", o, "--from-records", f],
+        "record 1 is of",
+    );
+    fails_with(
+        &["batch", m, "-o", o, "--plan", "--study", "1"],
+        "cannot be used",
+    );
+}
+
+#[test]
+fn a_flight_flown_in_parts_joins_into_the_whole_flights_film() {
+    let dir = tempfile::tempdir().unwrap();
+    let colon = dir.path().join(phantom(dir.path(), "colon", "48"));
+    let path = dir.path().join("path.json");
+    let (scan, route) = (colon.to_str().unwrap(), path.to_str().unwrap());
+    let made = endocast(&["path", scan, "--preset", "colonoscopy", "-o", route]);
+    assert!(made.status.success());
+    let fly = |output: &Path, extra: &[&str]| {
+        let mut args = vec!["fly", scan, "--path", route, "--preset", "colonoscopy"];
+        args.extend(["--size", "24x20", "--frame-step", "3", "-o"]);
+        args.push(output.to_str().unwrap());
+        args.extend_from_slice(extra);
+        let run = endocast(&args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    };
+    let whole = dir.path().join("whole");
+    fly(&whole, &[]);
+    let parts: Vec<_> = ["1/2", "2/2"]
+        .iter()
+        .enumerate()
+        .map(|(n, part)| {
+            let folder = dir.path().join(format!("part{n}"));
+            fly(&folder, &["--frames", part]);
+            folder
+        })
+        .collect();
+    let frames = |folder: &Path| {
+        let mut names: Vec<_> = std::fs::read_dir(folder)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    };
+    let all = frames(&whole);
+    assert!(all.len() > 3, "{all:?}");
+    let split = [frames(&parts[0]), frames(&parts[1])].concat();
+    assert_eq!(split, all);
+    for (n, name) in all.iter().enumerate() {
+        let part = &parts[usize::from(n >= frames(&parts[0]).len())];
+        let same =
+            std::fs::read(whole.join(name)).unwrap() == std::fs::read(part.join(name)).unwrap();
+        assert!(same, "{name}");
+    }
+    let range = dir.path().join("range");
+    fly(&range, &["--frames", "1:3"]);
+    assert_eq!(frames(&range), all[1..3]);
+
+    let (whole_mp4, joined) = (dir.path().join("whole.mp4"), dir.path().join("joined.mp4"));
+    fly(&whole_mp4, &[]);
+    let mut args = vec![
+        "film",
+        parts[1].to_str().unwrap(),
+        parts[0].to_str().unwrap(),
+        "-o",
+    ];
+    args.push(joined.to_str().unwrap());
+    assert!(endocast(&args).status.success());
+    assert!(std::fs::read(&whole_mp4).unwrap() == std::fs::read(&joined).unwrap());
+    let j = joined.to_str().unwrap();
+    fails_with(
+        &["film", parts[1].to_str().unwrap(), "-o", j],
+        "frame 0 is missing",
+    );
+    fails_with(
+        &["fly", scan, "--path", route, "-o", j, "--frames", "1/2"],
+        "--frames writes a folder of PNGs",
+    );
+    fails_with(
+        &["fly", scan, "--path", route, "-o", j, "--frames", "4:2"],
+        "END must be past START",
+    );
+}

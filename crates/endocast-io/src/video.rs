@@ -33,7 +33,10 @@ use std::process::{Child, ChildStdin, Command, Stdio};
 use std::thread::JoinHandle;
 
 mod h264;
+mod join;
 mod mp4;
+
+pub use join::{frame_files, read_frame};
 
 /// Where the frames of a fly-through go.
 pub trait FrameSink {
@@ -99,6 +102,9 @@ pub struct VideoOptions {
     /// GIF colour quantisation speed, 1 (best) to 30 (fastest), NeuQuant's sampling factor.
     /// Default 10.
     pub gif_speed: i32,
+    /// The number of the first frame in a folder of PNGs: a part of a flight (`fly --frames`)
+    /// numbers its frames as the whole flight does, so that parts join by name. Default 0.
+    pub first_number: usize,
 }
 
 impl Default for VideoOptions {
@@ -107,6 +113,7 @@ impl Default for VideoOptions {
             fps: 25.0,
             ffmpeg: None,
             gif_speed: 10,
+            first_number: 0,
         }
     }
 }
@@ -123,7 +130,7 @@ pub fn open_sink(path: &Path, options: &VideoOptions) -> Result<Box<dyn FrameSin
         return Err(ReadError::format(path, message));
     }
     Ok(match SinkKind::for_path(path)? {
-        SinkKind::PngFolder => Box::new(PngFolder::create(path)?),
+        SinkKind::PngFolder => Box::new(PngFolder::create(path, options.first_number)?),
         SinkKind::Gif => Box::new(GifSink::create(path, options)?),
         SinkKind::Mp4 => match &options.ffmpeg {
             None => Box::new(H264Sink::create(path, options)?),
@@ -186,16 +193,18 @@ struct PngFolder {
     folder: TemporaryFolder,
     size: FrameSize,
     frames: usize,
+    first_number: usize,
 }
 
 impl PngFolder {
-    fn create(dir: &Path) -> Result<Self> {
+    fn create(dir: &Path, first_number: usize) -> Result<Self> {
         other_files(dir)?;
         Ok(Self {
             dir: dir.to_path_buf(),
             folder: TemporaryFolder::create(dir)?,
             size: FrameSize::default(),
             frames: 0,
+            first_number,
         })
     }
 
@@ -238,16 +247,22 @@ fn other_files(dir: &Path) -> Result<Vec<OsString>> {
 
 /// Whether `name` is a frame's, `frame_NNNNN.png` (five digits or more).
 fn is_frame_name(name: &str) -> bool {
+    frame_number(name).is_some()
+}
+
+/// The number of the frame named `name`, `frame_NNNNN.png` (five digits or more).
+fn frame_number(name: &str) -> Option<usize> {
     name.strip_prefix("frame_")
         .and_then(|n| n.strip_suffix(".png"))
-        .is_some_and(|digits| digits.len() >= 5 && digits.bytes().all(|b| b.is_ascii_digit()))
+        .filter(|digits| digits.len() >= 5 && digits.bytes().all(|b| b.is_ascii_digit()))
+        .and_then(|digits| digits.parse().ok())
 }
 
 impl FrameSink for PngFolder {
     fn push(&mut self, rgb: &[u8], width: usize, height: usize) -> Result<()> {
         self.size
             .check(&self.dir, rgb, (width, height), u32::MAX as usize)?;
-        let name = format!("frame_{:05}.png", self.frames);
+        let name = format!("frame_{:05}.png", self.first_number + self.frames);
         let path = self.folder.path().join(name);
         write_frame_png(&path, width as u32, height as u32, rgb)?;
         self.frames += 1;

@@ -5,6 +5,7 @@
 use crate::case_args::CaseArgs;
 use crate::commands::fly_coverage;
 use crate::commands::fly_dataset::{self, DatasetSink};
+use crate::commands::fly_frames::{self, parse_frames, FrameRange};
 use crate::input::InputArgs;
 use crate::look::{set_threads, transfer_function, LookArgs, ScanLook};
 use crate::lumen::LumenArgs;
@@ -103,6 +104,11 @@ pub struct FlyArgs {
     /// fisheye camera, without --stereo, with --layout endoscope.
     #[arg(long, value_name = "FOLDER")]
     dataset: Option<PathBuf>,
+    /// Fly only these frames, START:END (frame START to before END, from 0) or K/N (part K of
+    /// N equal parts), into a folder of PNGs numbered as in the whole flight, with the same
+    /// pixels; `endocast film` joins the parts' folders into the whole flight's film.
+    #[arg(long, value_name = "START:END|K/N", value_parser = parse_frames)]
+    frames: Option<FrameRange>,
 }
 
 /// The `--layout` choices.
@@ -127,6 +133,9 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     if args.dataset.is_some() {
         fly_dataset::check(stereo.is_some(), args.layout == LayoutArg::Dashboard)?;
     }
+    if args.frames.is_some() {
+        fly_frames::check(&args.output, args.coverage, args.dataset.is_some())?;
+    }
     // Per frame: the view (both eyes of a pair) and, for a dashboard, its composite image
     // (counted as one more view); checked again once the look is known.
     let views = 1 + u64::from(args.layout == LayoutArg::Dashboard);
@@ -138,7 +147,13 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     check(None)?;
     let route = read_route(&args.route).context("cannot read the path")?;
     let shots = shots(&route, args)?;
-    let mut sinks = Sinks::open(&args.output, &video_options(args), stereo.map(|s| s.output))?;
+    let frames = match args.frames {
+        Some(range) => range.of(shots.len())?,
+        None => 0..shots.len(),
+    };
+    let mut video = video_options(args);
+    video.first_number = frames.start;
+    let mut sinks = Sinks::open(&args.output, &video, stereo.map(|s| s.output))?;
     let loaded = args.input.open()?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
@@ -205,9 +220,9 @@ pub fn run(args: &FlyArgs) -> Result<()> {
             flight = flight.with_coverage(wall);
         }
     }
-    let mut progress = Progress::new("flying", shots.len());
+    let mut progress = Progress::new("flying", frames.len());
     let mut looks = ShotSettings::new(settings.clone(), transfer_function);
-    for (n, shot) in shots.iter().enumerate() {
+    for (n, shot) in shots.iter().enumerate().take(frames.end).skip(frames.start) {
         let shot_settings = looks.for_shot(shot)?;
         let image = sinks.push(&mut flight, n, shot, &shot_settings)?;
         if let (Some(dataset), Some(image)) = (&mut dataset, image) {
@@ -222,7 +237,7 @@ pub fn run(args: &FlyArgs) -> Result<()> {
         println!(
             "{}: {} frames along {:.1} mm ({:.1} frames/s)",
             written.display(),
-            shots.len(),
+            frames.len(),
             route.len_mm(),
             progress.rate()
         );
@@ -243,7 +258,8 @@ pub fn run(args: &FlyArgs) -> Result<()> {
     if args.json {
         let summary = serde_json::json!({
             "output": written,
-            "frames": shots.len(),
+            "frames": frames.len(),
+            "first_frame": frames.start,
             "length_mm": route.len_mm(),
             "frames_per_s": progress.rate(),
             "first_camera": study_report::pose_json(&first),

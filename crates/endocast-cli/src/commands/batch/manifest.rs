@@ -1,7 +1,8 @@
 //! The batch manifest: one study a row of a CSV file with a header, or a line of JSON lines,
 //! with the same keys: `scan` (required; relative to the manifest's folder), `preset`,
-//! `output` (relative to the batch's output folder) and any `render`/`fly` option without its
-//! dashes (`iso`, `orientation`, `bright-lumen`, …).
+//! `output` (relative to the batch's output folder), `dataset` (true: the flight also writes
+//! its training data) and any `render`/`fly` option without its dashes (`iso`, `orientation`,
+//! `bright-lumen`, …).
 
 use anyhow::{bail, Context, Result};
 use serde_json::Value;
@@ -25,6 +26,8 @@ pub struct Entry {
     pub preset: Option<String>,
     /// Its output folder, relative to the batch's (default: named after the scan).
     pub output: Option<PathBuf>,
+    /// Whether its flight also writes its training data (`fly --dataset`). Default false.
+    pub dataset: bool,
     /// Further options, `(name, value)`: name without dashes; a value `true` is a flag.
     pub options: Vec<(String, String)>,
 }
@@ -115,6 +118,7 @@ fn entry(
         scan: PathBuf::new(),
         preset: None,
         output: None,
+        dataset: false,
         options: Vec::new(),
     };
     for (key, value) in keys {
@@ -126,13 +130,14 @@ fn entry(
             "scan" => entry.scan = base.join(value),
             "preset" => entry.preset = Some(value),
             "output" => entry.output = Some(PathBuf::from(value)),
+            "dataset" => entry.dataset = yes_or_no(line, &key, &value)?,
             name if RESERVED.contains(&name) => {
                 bail!("line {line}: {name} is set by the batch itself and cannot be given")
             }
             name if is_option(name) => entry.options.push((key, value)),
             name => bail!(
-                "line {line}: {name:?} is not a column of a manifest (scan, preset, output) nor \
-                 an option of render or fly"
+                "line {line}: {name:?} is not a column of a manifest (scan, preset, output, \
+                 dataset) nor an option of render or fly"
             ),
         }
     }
@@ -140,6 +145,15 @@ fn entry(
         bail!("line {line}: no scan");
     }
     Ok(entry)
+}
+
+/// A yes/no column: `true`/`false` (any case), `1`/`0`, `yes`/`no`.
+fn yes_or_no(line: usize, key: &str, value: &str) -> Result<bool> {
+    match value.to_ascii_lowercase().as_str() {
+        "true" | "1" | "yes" => Ok(true),
+        "false" | "0" | "no" => Ok(false),
+        _ => bail!("line {line}: {key} is {value:?}, not true or false"),
+    }
 }
 
 #[cfg(test)]
@@ -201,5 +215,6 @@ mod tests {
         assert!(said("m.csv", "scan\n").contains("lists no study"));
         assert!(said("m.jsonl", "{\"scan\": \"a\"}\n{\"scan\": [1]}\n").contains("line 2"));
         assert!(said("m.jsonl", "{\"scan\": \"a\", \"--scan\": \"b\"}\n").contains("twice"));
+        assert!(said("m.csv", "scan,dataset\na.nii,maybe\n").contains("dataset is \"maybe\""));
     }
 }

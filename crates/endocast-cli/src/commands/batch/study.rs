@@ -1,14 +1,14 @@
 //! One study of a batch: its steps, each this program run as a child process (`path`, `fly`
 //! with coverage, `render`, and for colonoscopy `dissect` and `polyps`), so that a study that
-//! fails, panics or runs out of memory takes nothing else down; its report, `report.json`; and
-//! the fingerprint of its inputs and settings that lets a later run skip it.
+//! fails, panics, runs out of memory or past its time takes nothing else down; its report,
+//! `report.json`; and the fingerprint of its inputs and settings that lets a later run skip it.
 
+use super::child::{run_step, Deadline};
 use super::manifest::Entry;
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::{Instant, UNIX_EPOCH};
+use std::time::{Duration, Instant, UNIX_EPOCH};
 
 /// The report of each study, in its output folder.
 pub const REPORT: &str = "report.json";
@@ -23,10 +23,12 @@ pub struct Setup<'a> {
     pub threads: usize,
     /// The largest volume a study may read (its share of the memory).
     pub max_voxels: u64,
+    /// The most time a study may take (`--timeout`); none by default.
+    pub timeout: Option<Duration>,
 }
 
 /// How a study ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Status {
     /// Every step ran.
@@ -38,7 +40,7 @@ pub enum Status {
 }
 
 /// One study's line of the run summary.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Record {
     /// The scan, as the manifest resolved it.
     pub scan: String,
@@ -77,7 +79,11 @@ pub fn run(entry: &Entry, folder: &Path, setup: &Setup) -> Record {
         };
     }
     let mut steps = serde_json::Map::new();
-    let ran = run_steps(entry, folder, setup, &mut steps);
+    let deadline = setup.timeout.map(|timeout| Deadline {
+        at: clock + timeout,
+        timeout,
+    });
+    let ran = run_steps(entry, folder, setup, deadline, &mut steps);
     let outputs = outputs(folder, &steps);
     let done = match ran {
         Ok(()) => record(Status::Ok, String::new(), outputs),
@@ -91,25 +97,29 @@ pub fn run(entry: &Entry, folder: &Path, setup: &Setup) -> Record {
 }
 
 /// The steps of a study, each adding its JSON (or `null`) to `steps`; stops at the first
-/// that fails.
+/// that fails or runs past `deadline`.
 fn run_steps(
     entry: &Entry,
     folder: &Path,
     setup: &Setup,
+    deadline: Option<Deadline>,
     steps: &mut serde_json::Map<String, Value>,
 ) -> Result<()> {
     std::fs::create_dir_all(folder)
         .with_context(|| format!("cannot create {}", folder.display()))?;
     let path_file = folder.join("path.json");
     let path_arg = path_file.display().to_string();
+    let mut fly = vec!["--path", &path_arg, "--coverage", "--json"];
+    let dataset = folder.join(DATASET);
+    let dataset_arg = dataset.display().to_string();
+    clear_dataset(&dataset)?;
+    if entry.dataset {
+        fly.extend(["--dataset", &dataset_arg]);
+    }
     // Each step: its command, its output file in `folder` (if any) and its own options.
     let mut plan = vec![
         ("path", Some("path.json"), vec!["--json"]),
-        (
-            "fly",
-            Some("film.mp4"),
-            vec!["--path", &path_arg, "--coverage", "--json"],
-        ),
+        ("fly", Some("film.mp4"), fly),
         ("render", Some("start.png"), vec![]),
     ];
     if entry.preset.as_deref() == Some("colonoscopy") {
@@ -123,7 +133,22 @@ fn run_steps(
     for (command, output, own) in plan {
         let output = output.map(|file| folder.join(file));
         let args = step_args(command, output.as_deref(), &own, entry, setup);
-        steps.insert(command.into(), run_step(&setup.program, command, &args)?);
+        let said = run_step(&setup.program, command, &args, deadline)?;
+        steps.insert(command.into(), said);
+    }
+    Ok(())
+}
+
+/// The study's training-data folder (manifest column `dataset`), written by its flight.
+const DATASET: &str = "dataset";
+
+/// Removes the training data of an earlier run of the study, which this run replaces or no
+/// longer makes (`fly --dataset` writes only into a new or empty folder); the folder is the
+/// batch's own, inside the study's.
+fn clear_dataset(dataset: &Path) -> Result<()> {
+    if dataset.is_dir() {
+        std::fs::remove_dir_all(dataset)
+            .with_context(|| format!("cannot clear {}", dataset.display()))?;
     }
     Ok(())
 }
@@ -166,37 +191,6 @@ pub fn takes_option(cli: &clap::Command, command: &str, name: &str) -> bool {
         .is_some_and(|sub| sub.get_arguments().any(|arg| arg.get_long() == Some(name)))
 }
 
-/// Runs one step; its JSON output (or `null` when it prints none), or its error message.
-fn run_step(program: &Path, command: &str, args: &[String]) -> Result<Value> {
-    let output = Command::new(program)
-        .args(args)
-        .output()
-        .with_context(|| format!("cannot run {}", program.display()))?;
-    if !output.status.success() {
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        let said = stderr
-            .lines()
-            .rev()
-            .find_map(|line| line.strip_prefix("error: "))
-            .map_or_else(|| last_lines(&stderr), str::to_owned);
-        bail!("{command}: {said} ({})", output.status);
-    }
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    Ok(serde_json::from_str(&stdout).unwrap_or(Value::Null))
-}
-
-/// The last lines of a step's standard error (a panic's message and where), for a failure
-/// that printed no `error:` line.
-fn last_lines(stderr: &str) -> String {
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    let tail = &lines[lines.len().saturating_sub(3)..];
-    if tail.is_empty() {
-        "no message".to_owned()
-    } else {
-        tail.join(" / ")
-    }
-}
-
 /// The files the steps wrote that exist, by name.
 fn outputs(
     folder: &Path,
@@ -216,6 +210,10 @@ fn outputs(
         .filter(|(_, file)| file.is_file())
         .map(|(name, file)| (name.to_owned(), json!(file.display().to_string())))
         .collect();
+    let dataset = folder.join(DATASET);
+    if dataset.join("transforms.json").is_file() {
+        found.insert("dataset".into(), json!(dataset.display().to_string()));
+    }
     if let Some(candidates) = steps.get("polyps").and_then(|p| p.get("candidates")) {
         found.insert(
             "polyp_candidates".into(),
@@ -252,12 +250,17 @@ fn fingerprint(entry: &Entry) -> Result<Value> {
             ]))
         })
         .collect::<Result<_>>()?;
-    Ok(json!({
+    let mut inputs = json!({
         "files": files,
         "preset": entry.preset,
         "options": entry.options,
         "version": env!("CARGO_PKG_VERSION"),
-    }))
+    });
+    // Only when asked, so that the reports of studies without it stay current.
+    if entry.dataset {
+        inputs["dataset"] = json!(true);
+    }
+    Ok(inputs)
 }
 
 /// Every file under `folder`, sorted (a DICOM series' folder).
