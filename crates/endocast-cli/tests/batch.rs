@@ -67,6 +67,7 @@ fn a_manifest_runs_each_study_records_failures_and_resumes() {
         .collect();
     assert_eq!(status, ["ok", "failed", "failed", "ok"], "{first:#?}");
     let message = |n: usize| first[n]["message"].as_str().unwrap();
+    assert_eq!(message(0), "", "the colon is found with confidence");
     assert!(message(1).contains("corrupt.nii.gz"), "{}", message(1));
     assert!(
         message(2).contains("no colonoscopy structure"),

@@ -86,7 +86,7 @@ pub fn run(entry: &Entry, folder: &Path, setup: &Setup) -> Record {
     let ran = run_steps(entry, folder, setup, deadline, &mut steps);
     let outputs = outputs(folder, &steps);
     let done = match ran {
-        Ok(()) => record(Status::Ok, String::new(), outputs),
+        Ok(()) => record(Status::Ok, warning(&steps), outputs),
         Err(e) => record(Status::Failed, format!("{e:#}"), outputs),
     };
     let report = json!({"record": &done, "inputs": inputs, "steps": steps});
@@ -94,6 +94,16 @@ pub fn run(entry: &Entry, folder: &Path, setup: &Setup) -> Record {
         return record(Status::Failed, format!("{e:#}"), done.outputs);
     }
     done
+}
+
+/// What a reader of the summary must know of a study that ran: its structure found without
+/// confidence (the path step's study says why), or nothing.
+fn warning(steps: &serde_json::Map<String, Value>) -> String {
+    let study = &steps.get("path").unwrap_or(&Value::Null)["study"];
+    match (&study["confident"], &study["structure"]) {
+        (Value::Bool(false), Value::String(structure)) => format!("warning: {structure}"),
+        _ => String::new(),
+    }
 }
 
 /// The steps of a study, each adding its JSON (or `null`) to `steps`; stops at the first
@@ -307,4 +317,23 @@ fn write_report(folder: &Path, report: &Value) -> Result<()> {
     let text = serde_json::to_string_pretty(report)?;
     endocast_io::atomic::write_file(&file, |out| out.write_all(text.as_bytes()))
         .with_context(|| format!("cannot write {}", file.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
+    use super::*;
+
+    /// A structure found without confidence is said in the record; a confident one says
+    /// nothing.
+    #[test]
+    fn a_structure_found_without_confidence_is_a_warning() {
+        let steps = |confident: bool| {
+            let path = json!({"study": {"confident": confident, "structure": "not confident: x"}});
+            json!({ "path": path }).as_object().unwrap().clone()
+        };
+        assert_eq!(warning(&steps(false)), "warning: not confident: x");
+        assert_eq!(warning(&steps(true)), "");
+        assert_eq!(warning(&serde_json::Map::new()), "");
+    }
 }
