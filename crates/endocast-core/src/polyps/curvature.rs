@@ -9,6 +9,9 @@ use glam::{DMat3, DVec3};
 
 /// Smoothing kernels reach this many standard deviations on each side.
 const KERNEL_SIGMAS: f64 = 3.0;
+/// How far from a wall voxel toward the lumen its surface point is sought, voxels (a wall
+/// voxel touches a lumen voxel: the isosurface lies within a voxel's diagonal of it).
+const SURFACE_SEARCH_VOX: f64 = 1.75;
 
 /// The surface shape at one wall voxel.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,6 +132,53 @@ pub(crate) fn derivatives(volume: &Volume, kernels: &Kernels, v: [usize; 3]) -> 
     (gradient, hessian)
 }
 
+/// Where the isosurface at `threshold` of the unsmoothed volume crosses the segment from voxel
+/// `v` [`SURFACE_SEARCH_VOX`] toward the lumen along `toward_lumen` (index axes), by linear
+/// interpolation of the trilinear values at its ends, voxel index; the voxel itself where the
+/// segment does not cross it.
+pub(crate) fn surface_vox(
+    volume: &Volume,
+    v: [usize; 3],
+    threshold: f64,
+    toward_lumen: DVec3,
+) -> DVec3 {
+    let here = DVec3::from(v.map(|c| c as f64));
+    let end = here + toward_lumen.normalize_or_zero() * SURFACE_SEARCH_VOX;
+    match (volume.sample_physical(here), volume.sample_physical(end)) {
+        (Some(a), Some(b)) if (a - threshold) * (b - threshold) <= 0.0 && a != b => {
+            here.lerp(end, (a - threshold) / (a - b))
+        }
+        _ => here,
+    }
+}
+
+/// The unit normal into the lumen (on `side` of the wall) of the unsmoothed isosurface at `p`
+/// (voxel index), world axes: from the trilinear values' central differences half a voxel
+/// either side; zero where they are flat or leave the grid.
+pub(crate) fn raw_normal(volume: &Volume, p: DVec3, side: LumenSide) -> DVec3 {
+    let geometry = volume.geometry();
+    let spacing = geometry.spacing_mm();
+    let difference = |a: usize| {
+        let e = DVec3::AXES[a] * 0.5;
+        Some((volume.sample_physical(p + e)? - volume.sample_physical(p - e)?) / spacing[a])
+    };
+    match (difference(0), difference(1), difference(2)) {
+        (Some(x), Some(y), Some(z)) => {
+            let rising = geometry.direction() * DVec3::new(x, y, z);
+            (rising * -rising_away(side)).normalize_or_zero()
+        }
+        _ => DVec3::ZERO,
+    }
+}
+
+/// 1 where the value rises away from a lumen on `side` of the wall (a dark lumen), else −1.
+pub(crate) fn rising_away(side: LumenSide) -> f64 {
+    match side {
+        LumenSide::Below => 1.0,
+        LumenSide::Above => -1.0,
+    }
+}
+
 /// The surface shape from the gradient and Hessian of the value along orthonormal axes (mm),
 /// for a lumen on `side` of the wall, the normal turned to world axes by `direction`.
 /// Curvatures are positive where the surface is convex seen from the lumen.
@@ -140,10 +190,7 @@ pub(crate) fn shape(
 ) -> SurfaceShape {
     // Make the value rise away from the lumen: then a bump into the lumen has positive mean
     // curvature in the formulas below.
-    let sign = match side {
-        LumenSide::Below => 1.0,
-        LumenSide::Above => -1.0,
-    };
+    let sign = rising_away(side);
     let (g, h) = (gradient * sign, hessian * sign);
     let g2 = g.length_squared();
     if !(g2.is_finite() && g2 > 0.0) {

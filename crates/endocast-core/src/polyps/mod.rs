@@ -3,13 +3,15 @@
 //! curvatures of the isosurface through the voxel ([`curvature`]); polyps are caps (shape
 //! index near 1) of a curvedness between that of folds' crests and noise. Cap voxels seed
 //! regions grown over the wall through looser thresholds (hysteresis); each region is a
-//! candidate with its tip on the wall, its size across the wall and a score.
+//! candidate with its tip on the wall, a score and a size: the largest diameter of what stands
+//! out of the local wall around it ([`protrusion`]), as a radiologist measures a polyp.
 //!
 //! Only the wall of the given lumen is searched (the study's colon, not the outside of the
 //! body): non-lumen voxels 6-adjacent to it.
 
 mod cluster;
 pub mod curvature;
+mod protrusion;
 #[cfg(test)]
 mod tests;
 mod view;
@@ -38,8 +40,9 @@ pub struct PolypOptions {
     /// polyp's dome to that of noise bumps (default 0.05..=1.0: radii 1–20 mm; a 6 mm flat
     /// polyp 1 mm high is a dome of radius 5 mm, flatter still once smoothed).
     pub curvedness_per_mm: (f64, f64),
-    /// Candidates smaller than this across the wall are dropped, mm (default 4: a 6 mm polyp
-    /// between folds measures 4.7–5.5 mm, its cap region narrowed by the wall's concavity).
+    /// Candidates whose cap region (the grown region, not the size measured) is narrower than
+    /// this across the wall are dropped, mm (default 4: the cap region of a 6 mm polyp between
+    /// folds measures 4.7–5.5 mm, narrowed by the wall's concavity).
     pub min_size_mm: f64,
 }
 
@@ -127,7 +130,8 @@ pub struct Candidate {
     pub centre_mm: DVec3,
     /// Unit normal into the lumen: the mean of the region's normals, world axes.
     pub normal: DVec3,
-    /// Size across the wall: the region's largest extent perpendicular to its normal, mm.
+    /// Size: the largest diameter, across its normal, of what stands out of the local wall
+    /// around it ([`protrusion`]), mm; the cap region's extent where the wall cannot be fitted.
     pub size_mm: f64,
     /// Ranking in [0, 1]: how cap-like the region is (its mean shape index from 0.5 to 1)
     /// times how much of it is cap ([`cluster`]'s seed area against that of a 5 mm cap).
@@ -145,6 +149,10 @@ pub(crate) struct WallPoint {
     pub(crate) voxel: [usize; 3],
     /// The shape there.
     pub(crate) shape: SurfaceShape,
+    /// The (unsmoothed) isosurface's point next to the voxel on the lumen's side, world (LPS) mm.
+    pub(crate) surface_mm: DVec3,
+    /// The unsmoothed isosurface's unit normal there, into the lumen, world axes.
+    pub(crate) surface_normal: DVec3,
 }
 
 /// The polyp candidates on the wall of `lumen` in `volume`, best score first.
@@ -185,12 +193,24 @@ pub fn searched_lumen(
     }
 }
 
+/// The 26 neighbours of `v` inside the grid.
+fn neighbours(dims: [usize; 3], v: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
+    (0..27).filter(|&n| n != 13).filter_map(move |n| {
+        let offset = [n % 3, n / 3 % 3, n / 9];
+        let shifted = |a: usize| (v[a] + offset[a]).checked_sub(1).filter(|&c| c < dims[a]);
+        Some([shifted(0)?, shifted(1)?, shifted(2)?])
+    })
+}
+
 /// Every wall voxel of `lumen` (sorted by linear index) with its surface shape at `sigma_mm`.
 fn wall_shapes(volume: &Volume, lumen: &Lumen, sigma_mm: f64) -> Vec<WallPoint> {
     let geometry = volume.geometry();
     let dims = geometry.dims();
     let kernels = curvature::Kernels::new(sigma_mm, geometry.spacing_mm());
     let direction = geometry.direction();
+    let spacing = geometry.spacing_mm();
+    let threshold = lumen.threshold();
+    let away = curvature::rising_away(lumen.side());
     let (lo, hi) = lumen.bounds();
     let range = |a: usize| lo[a].saturating_sub(1)..(hi[a] + 2).min(dims[a]);
     let (xs, ys) = (range(0), range(1));
@@ -202,10 +222,14 @@ fn wall_shapes(volume: &Volume, lumen: &Lumen, sigma_mm: f64) -> Vec<WallPoint> 
                 .filter(|&v| lumen.is_wall(v))
                 .map(|v| {
                     let (g, h) = curvature::derivatives(volume, &kernels, v);
+                    let toward_lumen = -g * away / spacing;
+                    let surface = curvature::surface_vox(volume, v, threshold, toward_lumen);
                     WallPoint {
                         index: v[0] + dims[0] * (v[1] + dims[1] * v[2]),
                         voxel: v,
                         shape: curvature::shape(g, h, lumen.side(), direction),
+                        surface_mm: geometry.world_of(surface),
+                        surface_normal: curvature::raw_normal(volume, surface, lumen.side()),
                     }
                 })
                 .collect::<Vec<_>>()

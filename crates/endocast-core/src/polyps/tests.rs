@@ -61,12 +61,14 @@ fn matches(
     (per_polyp, false_positives)
 }
 
-/// Per shape: polyps of 6 mm or more drawn, found, and the worst size error of those found (mm).
+/// Per shape: polyps of 6 mm or more drawn, found, and the worst and summed size errors of those
+/// found (mm).
 #[derive(Default, Debug)]
 struct Tally {
     drawn: usize,
     found: usize,
     worst_size_mm: f64,
+    total_size_mm: f64,
 }
 
 #[test]
@@ -95,6 +97,7 @@ fn finds_polyps_of_6_mm_and_more_of_every_shape_at_their_size() {
                 t.found += 1;
                 let error = (found[*n].size_mm - polyp.diameter_vox).abs();
                 t.worst_size_mm = t.worst_size_mm.max(error);
+                t.total_size_mm += error;
             }
         }
     }
@@ -104,14 +107,12 @@ fn finds_polyps_of_6_mm_and_more_of_every_shape_at_their_size() {
     assert!(drawn >= 25, "only {drawn} polyps of 6 mm or more drawn");
     assert!(tally.iter().all(|t| t.drawn >= 5), "{tally:?}");
     assert!(hit as f64 >= 0.9 * drawn as f64, "found {hit} of {drawn}");
-    // The issue asks sizes within 1.5 mm; measured here (six seeds): pedunculated 0.87 mm,
-    // sessile 1.79 mm (a 6.5 mm one reads 4.7: its cap region narrowed by the concave wall)
-    // and flat 2.43 mm (its base merges into the wall). These bounds guard what is measured;
-    // the 1.5 mm is not met for small sessile and flat polyps (issue 36 stays open on it).
-    let [sessile, pedunculated, flat] = &tally;
-    assert!(pedunculated.worst_size_mm <= 1.5, "{pedunculated:?}");
-    assert!(sessile.worst_size_mm <= 1.8, "{sessile:?}");
-    assert!(flat.worst_size_mm <= 2.5, "{flat:?}");
+    // The issue asks sizes within 1.5 mm: the largest diameter of the base (of the head for a
+    // pedunculated polyp), what the phantom draws and a radiologist measures. Measured (six
+    // seeds, mean / worst): sessile 0.41 / 0.98 mm, pedunculated 0.18 / 0.22, flat 0.31 / 1.20.
+    for t in &tally {
+        assert!(t.worst_size_mm <= 1.5, "{tally:?}");
+    }
 }
 
 #[test]
