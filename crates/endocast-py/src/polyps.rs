@@ -17,8 +17,8 @@ use pyo3::types::{PyDict, PyList};
 /// Returns the dict `endocast polyps --json` prints: `candidates`, best score first, each with
 /// `centre` (the tip on the wall, LPS mm), `size_mm` and `score` (0–1).
 ///
-/// Options: `sigma` (smoothing, mm, default 1), `min_size` (mm, default 5) and the look and
-/// lumen options of `render` (`preset`, `iso`, `lumen_threshold`, …).
+/// Options: `sigma` (smoothing, mm, default 1), `min_size` (mm, default 4: smaller candidates
+/// are dropped) and the look and lumen options of `render` (`preset`, `iso`, `lumen_threshold`, …).
 #[pyfunction]
 #[pyo3(signature = (volume, path = None, **options))]
 pub fn polyps<'py>(

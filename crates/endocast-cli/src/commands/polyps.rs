@@ -44,8 +44,8 @@ pub struct PolypsArgs {
     /// Gaussian smoothing before the curvatures, mm.
     #[arg(long, value_name = "MM", default_value_t = PolypOptions::default().sigma_mm)]
     sigma: f64,
-    /// Smallest candidate listed: its cap region's extent across the wall (narrower than the
-    /// size listed, which is the whole protrusion's), mm.
+    /// Smallest candidate listed, mm: both its size and its cap region's extent across the
+    /// wall (narrower than the size, which is the whole protrusion's) must reach it.
     #[arg(long, value_name = "MM", default_value_t = PolypOptions::default().min_size_mm)]
     min_size: f64,
     /// Write a view of each candidate, from the lumen, as polyp_NNN.png (in the list's order,

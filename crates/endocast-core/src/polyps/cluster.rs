@@ -31,7 +31,9 @@ pub(super) fn candidates(
             let cap_mm = candidate.size_mm;
             candidate.size_mm =
                 diameter_mm(geometry, wall, tip, candidate.normal, cap_mm).unwrap_or(cap_mm);
-            found.push(candidate);
+            if candidate.size_mm >= options.min_size_mm {
+                found.push(candidate);
+            }
         }
     }
     found

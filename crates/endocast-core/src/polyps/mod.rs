@@ -40,9 +40,10 @@ pub struct PolypOptions {
     /// polyp's dome to that of noise bumps (default 0.05..=1.0: radii 1–20 mm; a 6 mm flat
     /// polyp 1 mm high is a dome of radius 5 mm, flatter still once smoothed).
     pub curvedness_per_mm: (f64, f64),
-    /// Candidates whose cap region (the grown region, not the size measured) is narrower than
-    /// this across the wall are dropped, mm (default 4: the cap region of a 6 mm polyp between
-    /// folds measures 4.7–5.5 mm, narrowed by the wall's concavity).
+    /// Candidates whose cap region (the grown region) or whose measured size is narrower than
+    /// this across the wall are dropped, so that none is listed smaller, mm (default 4: the cap
+    /// region of a 6 mm polyp between folds measures 4.7–5.5 mm, narrowed by the wall's
+    /// concavity).
     pub min_size_mm: f64,
 }
 

@@ -285,7 +285,7 @@ def polyps(
     preset: Optional[str] = None,
     iso: Optional[float] = None,
     sigma: float = 1.0,
-    min_size: float = 5.0,
+    min_size: float = 4.0,
     lumen_threshold: Optional[float] = None,
     bright_lumen: bool = False,
     threads: Optional[int] = None,
