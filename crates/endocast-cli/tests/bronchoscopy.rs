@@ -134,6 +134,54 @@ fn the_chest_ct_tree_is_labelled_and_routes_reach_targets_beside_it() {
     }
 }
 
+/// The carina, measured on the chest CT (issue 36 item 7; pydicom and scipy, independently of
+/// endocast): the airway component below −900 HU (as above) cut into axial slices, each
+/// slice's section split into 8-connected parts: the trachea's section is one part down to
+/// z = −2.5 (371 voxels around (−21.0, 72.7)) and two from z = −4.5 (the main bronchi, 232
+/// voxels around (−29.3, 70.5) and 134 around (−7.6, 75.3)): the split lies at z = −3.5 ± 1.
+/// The spur between them, where the line between those two sections is most dense at
+/// z = −4.5, lies at (−17.6, 73.1); the −500 HU wall surface, interpolated along z through
+/// the points within 2 mm of it, tops at z = −3.3 at (−16.6, 71.1). The tree's branch point
+/// (the trachea's last centreline point) lay 11 mm higher.
+const CARINA: [f64; 3] = [-17.0, 72.0, -3.5];
+/// The middle of the trachea's section in the scan's top slice (z = 75.5): the mean position
+/// of its 142 voxels below −900 HU.
+const TRACHEA_TOP: [f64; 3] = [-2.2, 55.1, 75.5];
+
+fn distance(a: [f64; 3], b: &Value) -> f64 {
+    let b: Vec<f64> = b
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_f64().unwrap())
+        .collect();
+    (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Issue 36 item 7: the carina where the trachea splits, and the route from the trachea's top.
+#[test]
+fn the_carina_is_where_the_chest_cts_trachea_splits_and_routes_start_at_its_top() {
+    let Some(chest) = endocast_testdata::shared_data("chest-ct-airways-dicom") else {
+        return;
+    };
+    let report = route(chest.to_str().unwrap(), MEASURED[1].1, 4.9);
+    let carina = &report["carina"];
+    assert!(distance(CARINA, carina) <= 3.0, "carina {carina}");
+    assert!(
+        (carina[2].as_f64().unwrap() - CARINA[2]).abs() <= 2.0,
+        "{carina}"
+    );
+    let trachea = &report["airway_tree"][0];
+    assert_eq!(trachea["name"], "trachea");
+    assert_eq!(trachea["split"], *carina);
+    assert!(distance(TRACHEA_TOP, &trachea["start"]) <= 2.0, "{trachea}");
+    // The trachea's centrelines fork above the spur: the scope passes it centred.
+    assert!(
+        trachea["end"][2].as_f64().unwrap() > CARINA[2] + 4.0,
+        "{trachea}"
+    );
+}
+
 /// The target drawn in the endoscope view (issue 36): the route to the left lower lobe nodule
 /// keeps its target, and the last frame of the flight along it rings the target.
 #[test]

@@ -32,8 +32,9 @@ type Point = (f64, f64, f64);
 /// the reachable centreline point nearest the target, as `endocast path --target` plans it, and
 /// a third element is returned: a dict with `target`, `scope_diameter_mm`, `end`,
 /// `remaining_mm` (from the end to the target), `narrowest_diameter_mm` (None where only the
-/// scan's border limits it) and `branches` (the branches passed, each a dict of `name` and
-/// `generation`).
+/// scan's border limits it), `branches` (the branches passed, each a dict of `name` and
+/// `generation`) and `carina` (where the trachea's lumen splits, LPS mm; None when it does not
+/// fork).
 #[pyfunction]
 #[pyo3(signature = (volume, start = None, end = None, **options))]
 pub fn path<'py>(

@@ -53,6 +53,7 @@ pub struct RouteSummary {
     remaining_mm: f64,
     narrowest_diameter_mm: Option<f64>,
     branches: Vec<(String, u32)>,
+    carina: Option<[f64; 3]>,
 }
 
 impl RouteSummary {
@@ -71,6 +72,7 @@ impl RouteSummary {
                 .iter()
                 .map(|&b| (all[b].name.clone(), all[b].generation))
                 .collect(),
+            carina: routed.tree.carina_mm().map(|c| c.to_array()),
         }
     }
 
@@ -93,6 +95,7 @@ impl RouteSummary {
             })
             .collect::<PyResult<Vec<_>>>()?;
         dict.set_item("branches", branches)?;
+        dict.set_item("carina", self.carina)?;
         Ok(dict)
     }
 }

@@ -23,6 +23,7 @@ def test_route_to_a_target_is_the_clis(shared_data, cli, tmp_path):
     args = ["path", chest, "--preset", "bronchoscopy", "--target", target]
     theirs = json.loads(cli(*args, "--scope-diameter", "4.9", "-o", out, "--json"))
     assert route["branches"] == theirs["branches"]
+    np.testing.assert_allclose(route["carina"], theirs["carina"], atol=1e-9)
     assert route["remaining_mm"] == pytest.approx(theirs["remaining_mm"], abs=1e-9)
     np.testing.assert_allclose(route["end"], theirs["end"], atol=1e-9)
     assert len(points) == theirs["points"] and len(radii) == len(points)

@@ -62,8 +62,8 @@ pub struct PathArgs {
     /// A target (a nodule), world mm: with the bronchoscopy preset, the path runs from the
     /// trachea through the labelled airway tree, in airways at least --scope-diameter wide, to
     /// the reachable centreline point nearest the target; --json then also lists the branches
-    /// passed (trachea, main, lobar, segmental), the distance left to the target and the
-    /// labelled tree. The path JSON keeps the target ("target"), so that `fly`, Python and the
+    /// passed (trachea, main, lobar, segmental), the distance left to the target, the carina
+    /// (where the trachea's lumen splits) and the labelled tree (each fork's split too). The path JSON keeps the target ("target"), so that `fly`, Python and the
     /// workstation's "Read path" draw it in the endoscope view.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
           conflicts_with_all = ["from", "from_voxel", "to", "to_voxel"])]

@@ -22,7 +22,7 @@ pub(crate) fn plan(
 }
 
 /// The route's part of `path --json`: target, scope, end, remaining distance, the branches
-/// passed and the whole labelled tree.
+/// passed, the carina and the whole labelled tree.
 pub(crate) fn to_json(target: &TargetPath) -> Value {
     let route = &target.route;
     let tree = &target.tree;
@@ -38,6 +38,7 @@ pub(crate) fn to_json(target: &TargetPath) -> Value {
         "remaining_mm": route.remaining_mm,
         "narrowest_diameter_mm": finite(route.narrowest_mm),
         "branches": passed,
+        "carina": tree.carina_mm().map(|c| c.to_array()),
         "airway_tree": tree_json(tree),
     })
 }
@@ -63,7 +64,8 @@ fn branch_label(branch: &AirwayBranch) -> Value {
     json!({"name": branch.name, "generation": branch.generation})
 }
 
-/// Every branch of the tree: name, generation, parent, ends, length and narrowest diameter.
+/// Every branch of the tree: name, generation, parent, ends, length, narrowest diameter and
+/// where its fork splits (`null` for a tip).
 fn tree_json(tree: &AirwayTree) -> Vec<Value> {
     tree.branches()
         .iter()
@@ -77,6 +79,7 @@ fn tree_json(tree: &AirwayTree) -> Vec<Value> {
                 "end": b.points_mm[b.points_mm.len() - 1].to_array(),
                 "length_mm": b.length_mm(),
                 "min_diameter_mm": finite(narrowest),
+                "split": b.split_mm.map(|s| s.to_array()),
             })
         })
         .collect()

@@ -151,6 +151,12 @@ impl<'a> CentredPaths<'a> {
         Some([0, 1, 2].map(|a| v[a].wrapping_add_signed(-o[a])))
     }
 
+    /// The centred path from lumen voxel `from` to lumen voxel `to`, `from` first (a search of
+    /// its own, over the same costs); `None` when `to` is not reached from `from`.
+    pub(crate) fn between(&self, from: [usize; 3], to: [usize; 3]) -> Option<Vec<[usize; 3]>> {
+        self.graph.search(from, Some(to)).path_to(&self.graph, to)
+    }
+
     /// The lumen's numbering.
     pub(crate) fn numbering(&self) -> &LumenNumbering<'a> {
         &self.graph.numbering

@@ -17,10 +17,7 @@ pub(super) fn outside_body(volume: &Volume, p_mm: DVec3, threshold: f64) -> bool
     if (0..3).any(|a| voxel[a] >= dims[a]) {
         return false;
     }
-    let m = g.world_from_voxel().matrix3;
-    let across = (0..3)
-        .max_by(|&a, &b| m.col(a).z.abs().total_cmp(&m.col(b).z.abs()))
-        .unwrap_or(2);
+    let across = long_axis(volume);
     let plane: Vec<usize> = (0..3).filter(|&a| a != across).collect();
     let air = |w: [usize; 3]| {
         volume
@@ -50,4 +47,13 @@ pub(super) fn outside_body(volume: &Volume, p_mm: DVec3, threshold: f64) -> bool
         }
     }
     false
+}
+
+/// The index axis nearest the world's superior axis: the body's long axis, along which the
+/// trachea runs.
+pub(super) fn long_axis(volume: &Volume) -> usize {
+    let m = volume.geometry().world_from_voxel().matrix3;
+    (0..3)
+        .max_by(|&a, &b| m.col(a).z.abs().total_cmp(&m.col(b).z.abs()))
+        .unwrap_or(2)
 }

@@ -68,6 +68,28 @@ pub(super) fn length_mm(nodes: &[Node], chain: &[usize]) -> f64 {
         .sum()
 }
 
+/// The length of the centrelines below each branch, its own (`own_mm`) included, mm, from each
+/// branch's parent (every branch after its parent).
+pub(super) fn lengths_below(parents: &[Option<usize>], mut own_mm: Vec<f64>) -> Vec<f64> {
+    for r in (1..parents.len()).rev() {
+        if let Some(p) = parents[r] {
+            own_mm[p] += own_mm[r];
+        }
+    }
+    own_mm
+}
+
+/// The two of `kids` with the most centreline below them (`below`, by index), the larger
+/// first; `None` when fewer than two.
+pub(super) fn largest_two(kids: &[usize], below: &[f64]) -> Option<[usize; 2]> {
+    let mut by_size = kids.to_vec();
+    by_size.sort_by(|&a, &b| below[b].total_cmp(&below[a]));
+    match by_size[..] {
+        [a, b, ..] => Some([a, b]),
+        _ => None,
+    }
+}
+
 /// The radius at a chain's first node, mm.
 fn radius(nodes: &[Node], chain: &[usize]) -> f64 {
     nodes[chain[0]].distance_mm

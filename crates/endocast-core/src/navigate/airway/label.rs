@@ -17,7 +17,7 @@
 //! "Largest" is by the length of all the centrelines below a run; "heading" is the direction
 //! over the first [`HEADING_MM`] of a run.
 
-use super::branches::{direction, length_mm, Run};
+use super::branches::{direction, largest_two, length_mm, lengths_below, Run};
 use super::skeleton::Node;
 
 /// How far along a run its heading is measured, mm.
@@ -34,15 +34,12 @@ pub(super) fn label(nodes: &[Node], runs: &[Run]) -> Vec<Label> {
             children[p].push(r);
         }
     }
-    let mut below = runs
+    let parents: Vec<Option<usize>> = runs.iter().map(|run| run.parent).collect();
+    let own_mm = runs
         .iter()
         .map(|run| length_mm(nodes, &run.nodes))
-        .collect::<Vec<_>>();
-    for r in (1..runs.len()).rev() {
-        if let Some(p) = runs[r].parent {
-            below[p] += below[r];
-        }
-    }
+        .collect();
+    let below = lengths_below(&parents, own_mm);
     let heading = |r: usize| direction(nodes, &runs[r].nodes, HEADING_MM);
     let namer = Namer {
         children: &children,
@@ -107,14 +104,10 @@ impl Namer<'_> {
     /// Of the two largest runs leaving `parent`: the one scoring higher by `score`, then the
     /// other; neither when fewer than two leave it.
     fn pair(&self, parent: usize, score: impl Fn(usize) -> f64) -> (Option<usize>, Option<usize>) {
-        let kids = &self.children[parent];
-        if kids.len() < 2 {
-            return (None, None);
-        }
         // Only the two largest: a twig must not win by its heading.
-        let mut by_size = kids.clone();
-        by_size.sort_by(|&a, &b| self.below[b].total_cmp(&self.below[a]));
-        let (a, b) = (by_size[0], by_size[1]);
+        let Some([a, b]) = largest_two(&self.children[parent], self.below) else {
+            return (None, None);
+        };
         if score(a) >= score(b) {
             (Some(a), Some(b))
         } else {

@@ -12,6 +12,7 @@ mod branches;
 mod label;
 mod route;
 mod skeleton;
+mod split;
 #[cfg(test)]
 mod tests;
 
@@ -38,6 +39,10 @@ pub struct AirwayBranch {
     pub points_mm: Vec<DVec3>,
     /// The lumen's diameter at each point, mm.
     pub diameters_mm: Vec<f64>,
+    /// Where its two largest branches part in the lumen, world mm: the top of the spur of wall
+    /// between them (the carina, for the trachea), about a radius below its last point, where
+    /// the centrelines fork (see [`split`]); `None` for a branch that does not fork.
+    pub split_mm: Option<DVec3>,
 }
 
 impl AirwayBranch {
@@ -100,8 +105,13 @@ impl AirwayTree {
         let nodes = skeleton::skeletonise(volume, lumen, field, root);
         let runs = branches::runs(&nodes);
         let labels = label::label(&nodes, &runs);
-        let diameter = |node: &Node| diameter_mm(volume, field, node);
-        let branches = runs
+        // The entry from the scan's top (nodes before the root) is taken as wide as the root:
+        // the cut limits its distance to the wall, and so does noise (the chest CT's top
+        // slices hold voxels of −900 to −830 HU inside the trachea, 3 mm wide holes in its
+        // lumen below −900); the scope comes from above it.
+        let root_node = nodes.iter().position(|n| n.voxel == root).unwrap_or(0);
+        let diameter = |n: usize| diameter_mm(volume, field, &nodes[n.max(root_node)]);
+        let mut branches: Vec<AirwayBranch> = runs
             .into_iter()
             .zip(labels)
             .map(|(run, (name, generation))| AirwayBranch {
@@ -109,9 +119,13 @@ impl AirwayTree {
                 generation,
                 parent: run.parent,
                 points_mm: run.nodes.iter().map(|&n| nodes[n].point_mm).collect(),
-                diameters_mm: run.nodes.iter().map(|&n| diameter(&nodes[n])).collect(),
+                diameters_mm: run.nodes.iter().map(|&n| diameter(n)).collect(),
+                split_mm: None,
             })
             .collect();
+        for (b, split) in split::splits(&branches, field).into_iter().enumerate() {
+            branches[b].split_mm = split;
+        }
         Self {
             branches,
             threshold: lumen.threshold(),
@@ -131,6 +145,12 @@ impl AirwayTree {
         }
         line.reverse();
         line
+    }
+
+    /// The carina: where the trachea's lumen splits into the main bronchi (the trachea's
+    /// [`AirwayBranch::split_mm`]), world mm; `None` when the tree does not fork.
+    pub fn carina_mm(&self) -> Option<DVec3> {
+        self.branches.first().and_then(|b| b.split_mm)
     }
 
     /// The first branch named `name`.

@@ -2,10 +2,17 @@
 //! centred paths from the root to every lumen voxel (one Dijkstra search), then repeatedly the
 //! path to the farthest voxel not yet covered, down to where it meets the tree; each path added
 //! covers the lumen within a few radii of it, so that the wall's bumps give no branches.
+//!
+//! The tree starts in the middle of the trachea's section where the scan's top cuts it
+//! ([`top_middle`]) and runs down the centred path to the root ([`root_near`]), so that a route
+//! starts on the trachea's axis as high as the scan shows it; a branch is joined to the tree by
+//! the centred path from its branch point ([`Tree::link`]), so that every branch runs on
+//! without a gap, voxel by voxel, on the lumen's medial ridge.
 
 use super::super::centreline::CentredPaths;
 use super::super::distance::DistanceField;
 use super::super::lumen::Lumen;
+use super::body::long_axis;
 use crate::Volume;
 use glam::DVec3;
 
@@ -16,9 +23,10 @@ const COVER_MARGIN_MM: f64 = 2.0;
 /// A branch is kept when it runs this far beyond the lumen around the tree, mm: shorter ones
 /// are the wall's bumps.
 const MIN_BRANCH_MM: f64 = 3.0;
-/// The root is the widest lumen voxel this near the seed, mm: the seed lies on the scan's top
-/// face, where the border, not the wall, limits the distance to the wall.
-pub(super) const ROOT_REACH_MM: f64 = 25.0;
+/// The root is the widest lumen voxel this near the seed, mm, and no branch starts this near
+/// the seed: the seed lies on the scan's top face, where the border, not the wall, limits the
+/// distance to the wall, and the rim of the trachea's cut is no branch.
+const ROOT_REACH_MM: f64 = 25.0;
 /// At most this many paths are tried (each covers some of the lumen, so all are needed only in
 /// a lumen of scattered specks).
 const MAX_PATHS: usize = 2000;
@@ -37,7 +45,8 @@ pub(super) struct Node {
 }
 
 /// The tree of centreline voxels of `lumen` (with its distance `field`) grown from `root` (see
-/// [`root_near`]), root first, every node after its parent. No
+/// [`root_near`]), its entry from the scan's top first ([`entry`]: nodes 0 up to the root),
+/// every node after its parent. No
 /// branch starts within [`ROOT_REACH_MM`] of the lumen's seed (the trachea's top, above the
 /// root); a branch the scan's face cuts ends in the middle of the cut ([`Tree::trimmed`]).
 pub(super) fn skeletonise(
@@ -62,8 +71,9 @@ pub(super) fn skeletonise(
         node_of: vec![u32::MAX; voxels.len()],
         nodes: Vec::new(),
     };
-    tree.add(&[root], None);
-    tree.cover(&[root]);
+    let entry = entry(&paths, top_middle(volume, lumen, field), root);
+    tree.add(&entry, None);
+    tree.cover(&entry);
     let mut tried = 0;
     for &(n, _) in &farthest_first {
         if tried == MAX_PATHS {
@@ -114,10 +124,42 @@ impl Tree<'_> {
             .chain(new.iter().map(|&v| self.field.world_of_voxel(v)))
             .collect();
         let length: f64 = points.windows(2).map(|w| w[0].distance(w[1])).sum();
-        if length >= MIN_BRANCH_MM {
-            self.add(self.trimmed(new), Some(junction));
+        if let (true, Some(&first)) = (length >= MIN_BRANCH_MM, new.first()) {
+            let (junction, link) = self.link(junction, first);
+            let branch: Vec<[usize; 3]> = link
+                .into_iter()
+                .chain(self.trimmed(new)[1..].iter().copied())
+                .collect();
+            self.add(&branch, Some(junction));
         }
         self.cover(&chain);
+    }
+
+    /// The centred path from tree node `junction` to voxel `first` (off the tree), from where
+    /// it last leaves the tree: that node and the voxels after it, `first` the last. The
+    /// branch's own path parts from the tree above its branch point (see [`Tree::leaving`]),
+    /// and a straight link from the branch point to where it leaves its parent's lumen (up to
+    /// a radius and a half away) would cut the corner; this one runs along the ridge between
+    /// the parent's and the branch's lumens.
+    fn link(&self, junction: usize, first: [usize; 3]) -> (usize, Vec<[usize; 3]>) {
+        let numbering = self.paths.numbering();
+        let node = |v: [usize; 3]| {
+            numbering
+                .number(v)
+                .map(|n| self.node_of[n])
+                .filter(|&n| n != u32::MAX)
+        };
+        let path = self
+            .paths
+            .between(self.nodes[junction].voxel, first)
+            .unwrap_or_else(|| vec![self.nodes[junction].voxel, first]);
+        match path.iter().rposition(|&v| node(v).is_some()) {
+            Some(last) => (
+                node(path[last]).map_or(junction, |n| n as usize),
+                path[last + 1..].to_vec(),
+            ),
+            None => (junction, path),
+        }
     }
 
     /// Where a path from the tree's node `junction` down `chain` leaves the lumen around the tree:
@@ -208,6 +250,17 @@ impl Tree<'_> {
     }
 }
 
+/// The centred path from voxel `top` down to `root` (whose centred `paths` they are), `top`
+/// first; `[root]` when `top` is not reached.
+fn entry(paths: &CentredPaths, top: [usize; 3], root: [usize; 3]) -> Vec<[usize; 3]> {
+    let chain: Vec<[usize; 3]> = std::iter::successors(Some(top), |&v| paths.parent(v)).collect();
+    if chain.last() == Some(&root) {
+        chain
+    } else {
+        vec![root]
+    }
+}
+
 /// The widest voxel of `lumen` within [`ROOT_REACH_MM`] of `seed`: the tree's root.
 pub(super) fn root_near(lumen: &Lumen, field: &DistanceField, seed: [usize; 3]) -> [usize; 3] {
     let seed_mm = field.world_of_voxel(seed);
@@ -220,4 +273,25 @@ pub(super) fn root_near(lumen: &Lumen, field: &DistanceField, seed: [usize; 3]) 
                 .total_cmp(&field.distance_at_voxel(b))
         })
         .unwrap_or(seed)
+}
+
+/// The lumen voxel nearest the middle of the lumen's section through its seed across the
+/// body's long axis (within [`ROOT_REACH_MM`] of the seed). The seed lies on the scan's top
+/// face, where the scan cuts the trachea, and on the rim of that cut as often as not; this
+/// voxel is on the trachea's axis there.
+fn top_middle(volume: &Volume, lumen: &Lumen, field: &DistanceField) -> [usize; 3] {
+    let seed = lumen.seed();
+    let axis = long_axis(volume);
+    let seed_mm = field.world_of_voxel(seed);
+    let section: Vec<([usize; 3], DVec3)> = lumen
+        .voxels()
+        .filter(|v| v[axis] == seed[axis])
+        .map(|v| (v, field.world_of_voxel(v)))
+        .filter(|(_, p)| p.distance(seed_mm) <= ROOT_REACH_MM)
+        .collect();
+    let middle = section.iter().map(|(_, p)| *p).sum::<DVec3>() / section.len().max(1) as f64;
+    section
+        .into_iter()
+        .min_by(|a, b| a.1.distance(middle).total_cmp(&b.1.distance(middle)))
+        .map_or(seed, |(v, _)| v)
 }
