@@ -201,10 +201,19 @@ fn edit_zarray(root: &Path, change: impl FnOnce(&mut Value)) {
     std::fs::write(path, zarray.to_string()).unwrap();
 }
 
+/// A hostile store: an edit of the attributes, one of the files, the name the error must give
+/// and the words it must hold.
+type Case = (
+    Box<dyn Fn(&mut Value)>,
+    Box<dyn Fn(&Path)>,
+    &'static str,
+    Vec<&'static str>,
+);
+
 #[test]
 fn hostile_metadata_is_refused_with_the_file_and_the_problem() {
     let no_change = |_: &mut Value| {};
-    let cases: Vec<(Box<dyn Fn(&mut Value)>, Box<dyn Fn(&Path)>, &str, Vec<&str>)> = vec![
+    let cases: Vec<Case> = vec![
         (
             Box::new(no_change),
             Box::new(|r| std::fs::write(r.join(".zattrs"), b"{\"multiscales\": [").unwrap()),
