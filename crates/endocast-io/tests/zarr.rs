@@ -17,7 +17,7 @@ fn open_within(path: &Path) -> Result<endocast_io::Loaded, ReadError> {
     std::thread::spawn(move || {
         let mut options = OpenOptions::default();
         options.limits = Limits::with_max_voxels(1 << 24);
-        send.send(open(&path, &options))
+        let _ = send.send(open(&path, &options));
     });
     receive
         .recv_timeout(Duration::from_secs(10))
@@ -163,7 +163,7 @@ fn an_affine_transformation_is_applied() {
     attributes["multiscales"][0]["datasets"][0]["coordinateTransformations"] =
         json!([{"type": "affine", "affine": rows}]);
     let root = v2_store(dir.path(), &attributes, &levels_04());
-    let g = open_within(&root).unwrap().volume.geometry().clone();
+    let g = *open_within(&root).unwrap().volume.geometry();
     // Units: micrometres.
     assert!(g
         .spacing_mm()

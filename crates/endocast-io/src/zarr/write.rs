@@ -79,7 +79,7 @@ fn write_store(dir: &Path, volume: &Volume) -> std::result::Result<(), String> {
         write_level(&store, index, level, encoding)?;
         datasets.push(dataset(index, level));
     }
-    let attributes = group_attributes(volume, encoding, datasets);
+    let attributes = group_attributes(volume, encoding, &datasets);
     let group = GroupBuilder::new()
         .attributes(attributes)
         .build(store, "/")
@@ -148,7 +148,7 @@ fn write_level(
         Samples::Wide(_) => (data_type::uint16(), FillValue::from(0u16)),
     };
     let array = ArrayBuilder::new(shape.clone(), chunk, zarr_type, fill)
-        .bytes_to_bytes_codecs(vec![Arc::new(ZstdCodec::new(ZSTD_LEVEL.into(), false))])
+        .bytes_to_bytes_codecs(vec![Arc::new(ZstdCodec::new(ZSTD_LEVEL, false))])
         .dimension_names(["z", "y", "x"].into())
         .build(store.clone(), &format!("/{index}"))
         .map_err(|e| e.to_string())?;
@@ -182,11 +182,7 @@ fn dataset(index: usize, volume: &Volume) -> Value {
 }
 
 /// The group's attributes: `ome` (version 0.5, one multiscale) and endocast's own.
-fn group_attributes(
-    volume: &Volume,
-    encoding: Samples,
-    datasets: Vec<Value>,
-) -> Map<String, Value> {
+fn group_attributes(volume: &Volume, encoding: Samples, datasets: &[Value]) -> Map<String, Value> {
     let axes: Vec<Value> = ["z", "y", "x"]
         .iter()
         .map(|name| json!({"name": name, "type": "space", "unit": "millimeter"}))
