@@ -12,7 +12,8 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug)]
 pub struct InputArgs {
     /// The scan: a DICOM directory or file, .nii/.nii.gz, .hdr with its .img (NIfTI or Analyze
-    /// 7.5), .nrrd/.nhdr, .mha/.mhd, or a raw file.
+    /// 7.5), .nrrd/.nhdr, .mha/.mhd, an OME-Zarr 0.4/0.5 folder (x.zarr: its full resolution;
+    /// x.zarr/1: its level 1), or a raw file.
     pub path: PathBuf,
     /// DICOM: load this SeriesInstanceUID instead of the largest series.
     #[arg(long, value_name = "UID")]
@@ -20,8 +21,9 @@ pub struct InputArgs {
     /// Refuse volumes with more voxels than this (default: half the memory at 2 bytes a voxel).
     #[arg(long, value_name = "N")]
     pub max_voxels: Option<u64>,
-    /// For files that declare no patient orientation (raw, NRRD without a space): where the
-    /// index axes point, e.g. LPI for slices stored from the top of the head down.
+    /// For files that declare no patient orientation (raw, NRRD without a space, OME-Zarr not
+    /// written by endocast): where the index axes point, e.g. LPI for slices stored from the
+    /// top of the head down.
     #[arg(long, value_name = "CODE")]
     pub orientation: Option<String>,
     /// DICOM: read a series with missing slices (a gap of whole steps in evenly spaced slices),

@@ -32,7 +32,7 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Make an analytic phantom volume and save it (.nii, .nii.gz, .nrrd or .mha).
     Phantom(commands::phantom::PhantomArgs),
-    /// Convert a scan to another format (.nii, .nii.gz, .nrrd or .mha).
+    /// Convert a scan to another format (.nii, .nii.gz, .nrrd, .mha or an OME-Zarr .zarr folder).
     Convert(commands::convert::ConvertArgs),
     /// Render one endoscopic (or outside) view of a scan to PNG.
     Render(Box<commands::render::RenderArgs>),

@@ -22,3 +22,4 @@ mod render;
 mod scene;
 mod study_table;
 mod view;
+mod zarr_round_trip;

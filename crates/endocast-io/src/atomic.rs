@@ -263,7 +263,7 @@ fn refuse_other_kinds(target: &Path, expected: Expected) -> Result<()> {
             "exists and is not a regular file (a FIFO, device or socket): refusing to replace it"
         }
         Expected::Folder if !meta.is_dir() => {
-            "exists and is not a folder: refusing to replace it with a folder of frames"
+            "exists and is not a folder: refusing to replace it with a folder"
         }
         _ => return Ok(()),
     };

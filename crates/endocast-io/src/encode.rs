@@ -47,6 +47,15 @@ impl SampleEncoding {
         }
     }
 
+    /// `int16` physical values where they are exact (see [`Self::exact_integer`]), the
+    /// stored `u16` values otherwise: for formats that carry a rescale (NIfTI, OME-Zarr).
+    pub(crate) fn int16_or_stored(volume: &Volume) -> Self {
+        match Self::exact_integer(volume) {
+            Some(e @ Self::I16Physical { .. }) => e,
+            _ => Self::U16Stored,
+        }
+    }
+
     /// The type of the samples in the file.
     pub(crate) fn element_type(self) -> ElementType {
         match self {

@@ -3,7 +3,8 @@
 //! in physical units, or a [`ReadError`] that names the file and the problem.
 //!
 //! [`open`] picks the reader from the path (a directory or DICOM magic → DICOM series;
-//! `.nii`/`.nii.gz` → NIfTI; `.nrrd`/`.nhdr` → NRRD; `.mha`/`.mhd` → MetaImage; or raw when
+//! `.nii`/`.nii.gz` → NIfTI; `.nrrd`/`.nhdr` → NRRD; `.mha`/`.mhd` → MetaImage; a Zarr
+//! folder → OME-Zarr; or raw when
 //! [`OpenOptions::raw`] says how):
 //!
 //! ```no_run
@@ -48,6 +49,7 @@ mod text;
 pub mod texture;
 pub mod transfer_json;
 pub mod video;
+pub mod zarr;
 
 pub use error::{ReadError, Result};
 pub use escape::escape;

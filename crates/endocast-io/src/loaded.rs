@@ -23,6 +23,8 @@ pub enum Format {
     MetaImage,
     /// Headerless samples described on the command line.
     Raw,
+    /// OME-Zarr 0.4 or 0.5 (a folder, `.zarr`).
+    OmeZarr,
 }
 
 impl Format {
@@ -35,10 +37,12 @@ impl Format {
             Self::Nrrd => "NRRD",
             Self::MetaImage => "MetaImage",
             Self::Raw => "raw",
+            Self::OmeZarr => "OME-Zarr",
         }
     }
 
-    /// The format a path's name implies (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`, `.mha`, `.mhd`).
+    /// The format a path's name implies (`.nii`, `.nii.gz`, `.nrrd`, `.nhdr`, `.mha`, `.mhd`,
+    /// `.zarr`).
     pub fn from_extension(path: &Path) -> Option<Self> {
         let name = path.file_name()?.to_string_lossy().to_ascii_lowercase();
         let ends = |suffixes: &[&str]| suffixes.iter().any(|s| name.ends_with(s));
@@ -50,6 +54,8 @@ impl Format {
             Some(Self::MetaImage)
         } else if ends(&[".dcm", ".dicom"]) {
             Some(Self::Dicom)
+        } else if ends(&[".zarr"]) {
+            Some(Self::OmeZarr)
         } else {
             None
         }

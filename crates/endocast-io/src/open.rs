@@ -4,7 +4,7 @@
 use crate::error::{ReadError, Result};
 use crate::escape::escape;
 use crate::loaded::{Format, Loaded, OpenOptions};
-use crate::{dicom, metaimage, nifti, nrrd, raw};
+use crate::{dicom, metaimage, nifti, nrrd, raw, zarr};
 use endocast_core::navigate::guess_head_orientation;
 use endocast_core::{Geometry, Volume};
 use std::io::Read;
@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 /// Entries of a folder looked at for a scan file when it holds no DICOM series.
 const MAX_FOLDER_ENTRIES: usize = 100_000;
 
-/// Reads the scan at `path`, choosing the reader from the path: a directory is a DICOM series
+/// Reads the scan at `path`, choosing the reader from the path: a directory holding Zarr
+/// metadata is an OME-Zarr image (or one of its levels); another directory is a DICOM series
 /// (or, without one, the one scan file of another format it holds, with a warning); otherwise
 /// the extension; otherwise the file's magic bytes. Raw files are read only when
 /// `options.raw` describes them. The warnings come with control characters escaped
@@ -23,7 +24,9 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<Loaded> {
     if options.raw.is_some() {
         return raw::read(path, options);
     }
-    let (path, loaded) = if meta.is_dir() {
+    let (path, loaded) = if meta.is_dir() && zarr::is_zarr(path) {
+        (path.to_owned(), zarr::read(path, options)?)
+    } else if meta.is_dir() {
         read_folder(path, options)?
     } else {
         (path.to_owned(), read_file(path, options)?)
@@ -48,6 +51,10 @@ fn read_file(path: &Path, options: &OpenOptions) -> Result<Loaded> {
         Format::Nrrd => nrrd::read(path, options),
         Format::MetaImage => metaimage::read(path, options),
         Format::Raw => raw::read(path, options),
+        Format::OmeZarr => Err(ReadError::format(
+            path,
+            "an OME-Zarr image is a folder, and this is a file",
+        )),
     }
 }
 
@@ -174,15 +181,16 @@ fn oriented(path: &Path, mut loaded: Loaded, code: &str) -> Result<Loaded> {
 }
 
 /// Writes `volume` to `path` atomically, in the format its extension names
-/// (`.nii`, `.nii.gz`, `.nrrd`, `.mha`).
+/// (`.nii`, `.nii.gz`, `.nrrd`, `.mha`, or `.zarr`: an OME-Zarr 0.5 folder).
 pub fn write(path: &Path, volume: &Volume) -> Result<()> {
     match Format::from_extension(path) {
         Some(Format::Nifti) => nifti::write(path, volume),
         Some(Format::Nrrd) => nrrd::write(path, volume),
         Some(Format::MetaImage) => metaimage::write(path, volume),
+        Some(Format::OmeZarr) => zarr::write(path, volume),
         _ => Err(ReadError::unsupported(
             path,
-            "output format: name the file .nii, .nii.gz, .nrrd or .mha",
+            "output format: name the file .nii, .nii.gz, .nrrd, .mha or .zarr",
         )),
     }
 }

@@ -25,3 +25,4 @@ mod structures_found;
 mod test_volumes;
 mod transfer_json;
 mod video;
+mod zarr;

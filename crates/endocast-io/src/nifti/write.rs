@@ -33,7 +33,7 @@ pub fn write(path: &Path, volume: &Volume) -> Result<()> {
     let header_bytes = header
         .encode_nifti1()
         .map_err(|why| ReadError::unsupported(path, format!("NIfTI-1 output: {why}")))?;
-    let encoding = encoding_for(volume);
+    let encoding = SampleEncoding::int16_or_stored(volume);
     let gzip = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gz"));
@@ -50,15 +50,8 @@ pub fn write(path: &Path, volume: &Volume) -> Result<()> {
     })
 }
 
-fn encoding_for(volume: &Volume) -> SampleEncoding {
-    match SampleEncoding::exact_integer(volume) {
-        Some(e @ SampleEncoding::I16Physical { .. }) => e,
-        _ => SampleEncoding::U16Stored,
-    }
-}
-
 fn header_for(volume: &Volume) -> Header {
-    let encoding = encoding_for(volume);
+    let encoding = SampleEncoding::int16_or_stored(volume);
     let (scl_slope, scl_inter) = match encoding {
         SampleEncoding::U16Stored => (volume.value_map().scale(), volume.value_map().offset()),
         _ => (1.0, 0.0),
