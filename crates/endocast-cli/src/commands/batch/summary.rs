@@ -105,7 +105,7 @@ fn to_csv(records: &[Record]) -> Result<Vec<u8>> {
     Ok(writer.into_inner()?)
 }
 
-/// Prints the summary: as JSON, or the counts and each failure in words.
+/// Prints the summary: as JSON, or the counts and each failure and warning in words.
 pub fn say(records: &[Record], took: Duration, json: bool) -> Result<()> {
     if json {
         let all = serde_json::json!({ "studies": records });
@@ -121,8 +121,11 @@ pub fn say(records: &[Record], took: Duration, json: bool) -> Result<()> {
         count(Status::Skipped),
         count(Status::Failed)
     );
-    for r in records.iter().filter(|r| r.status == Status::Failed) {
-        println!("  failed: {}: {}", r.scan, r.message);
+    for r in records.iter().filter(|r| !r.message.is_empty()) {
+        match r.status {
+            Status::Failed => println!("  failed: {}: {}", r.scan, r.message),
+            _ => println!("  {}: {}", r.scan, r.message),
+        }
     }
     Ok(())
 }
